@@ -1,0 +1,46 @@
+// Names of methods, integrators and statuses: the one table shared by the CLI, study files and HDF5.
+#include <array>
+#include <utility>
+
+#include "methods/trajectory.hpp"
+
+namespace ks {
+namespace {
+template <class E, std::size_t N>
+using Table = std::array<std::pair<E, std::string_view>, N>;
+
+constexpr Table<TrajectoryMethod, 3> kMethods{{{TrajectoryMethod::local_weighted, "local_weighted"},
+                                               {TrajectoryMethod::local_unweighted, "local_unweighted"},
+                                               {TrajectoryMethod::vertex_alpha, "vertex_alpha"}}};
+constexpr Table<Integrator, 2> kIntegrators{
+    {{Integrator::semi_implicit_euler, "semi_implicit_euler"}, {Integrator::rk4, "rk4"}}};
+constexpr Table<RunStatus, 4> kStatuses{{{RunStatus::ok, "ok"},
+                                         {RunStatus::unreachable_start, "unreachable_start"},
+                                         {RunStatus::singular, "singular"},
+                                         {RunStatus::diverged, "diverged"}}};
+
+template <class E, std::size_t N>
+std::string_view name_of(const Table<E, N>& t, E e) {
+  for (const auto& [v, n] : t)
+    if (v == e) return n;
+  return "?";
+}
+template <class E, std::size_t N>
+bool value_of(const Table<E, N>& t, std::string_view name, E& out) {
+  for (const auto& [v, n] : t)
+    if (n == name) {
+      out = v;
+      return true;
+    }
+  return false;
+}
+}  // namespace
+
+std::string_view to_string(TrajectoryMethod m) { return name_of(kMethods, m); }
+std::string_view to_string(Integrator i) { return name_of(kIntegrators, i); }
+std::string_view to_string(RunStatus s) { return name_of(kStatuses, s); }
+bool parse(std::string_view n, TrajectoryMethod& out) { return value_of(kMethods, n, out); }
+bool parse(std::string_view n, Integrator& out) { return value_of(kIntegrators, n, out); }
+bool parse(std::string_view n, RunStatus& out) { return value_of(kStatuses, n, out); }
+
+}  // namespace ks

@@ -1,0 +1,202 @@
+// simulate(): the seed's loop (Appendix F) with solves instead of inverses, one Cholesky of M per
+// evaluation, fixed-size types and no allocation per step.
+#include "methods/trajectory.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <cmath>
+#include <optional>
+#include <stdexcept>
+
+#include "methods/resolution.hpp"
+#include "model/dynamics.hpp"
+
+namespace ks {
+
+void TrajectoryHistory::prepare(std::size_t samples) {
+  const Eigen::Index n = static_cast<Eigen::Index>((samples + stride - 1) / stride + 1);
+  if (t.size() < n) {
+    t.resize(n);
+    q.resize(3, n);
+    qd.resize(3, n);
+    qdd.resize(3, n);
+    tau.resize(3, n);
+    x.resize(2, n);
+    alpha.resize(n);
+  }
+  size = 0;
+}
+
+std::size_t sample_count(double duration, double dt) {
+  return static_cast<std::size_t>(std::floor(duration / dt + 1e-9)) + 1;
+}
+
+namespace {
+
+/// Everything one evaluation of the method at (t, q, qd) produces.
+struct Evaluation {
+  JointTrig trig;
+  Mat3 M;
+  Eigen::LLT<Mat3> llt;
+  Vec3 c, g, qdd;
+  Mat23 J;
+  Vec2 x_ref;                  // path position at t
+  double singularity_measure;  // manipulability (local) or |det J3| (vertex_alpha)
+};
+
+class Resolver {
+ public:
+  Resolver(const PlanarArm3& arm, const Path2& path, const TrajectoryOptions& o,
+           const std::optional<Profile1>& alpha_profile)
+      : arm_(arm), path_(path), o_(o), alpha_(alpha_profile) {}
+
+  /// Joint accelerations of the method at (t, q, qd); fills every intermediate in `e`.
+  /// Returns false when the Jacobian is singular.
+  bool evaluate(double t, std::size_t segment, const Vec3& q, const Vec3& qd, Evaluation& e) const {
+    e.trig = joint_trig(q);
+    e.M = mass_matrix(arm_, e.trig);
+    e.c = coriolis(arm_, e.trig, qd);
+    e.g = gravity(arm_, e.trig);
+    e.J = jacobian(arm_, e.trig);
+    e.llt.compute(e.M);
+    const Mat23 Jd = jacobian_dot(arm_, e.trig, qd);
+    const PathSample<2> xs = path_.sample_on(segment, t);
+    const Vec2 b = xs.a - Jd * qd;
+    e.x_ref = xs.p;
+    if (o_.method == TrajectoryMethod::vertex_alpha) {
+      double det = 0;
+      e.qdd = nonredundant_acceleration(e.J, b, alpha_->sample_on(segment, t).a[0], det);
+      e.singularity_measure = std::abs(det);
+      return e.singularity_measure >= o_.singular_tolerance;
+    }
+    e.singularity_measure = manipulability(e.J);
+    if (!(e.singularity_measure >= o_.singular_tolerance)) return false;
+    const Weighting w = o_.method == TrajectoryMethod::local_unweighted ? Weighting::inertia_squared : Weighting::inertia;
+    e.qdd = local_acceleration(w, e.llt, e.J, b, e.c, e.g, o_.k, o_.null_damping, qd);
+    return true;
+  }
+
+ private:
+  const PlanarArm3& arm_;
+  const Path2& path_;
+  const TrajectoryOptions& o_;
+  const std::optional<Profile1>& alpha_;
+};
+
+bool finite(const Vec3& v) { return v.allFinite(); }
+
+}  // namespace
+
+TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const TrajectoryOptions& o,
+                           TrajectoryHistory* history) {
+  TrajectoryMetrics out;
+  std::optional<Profile1> alpha_profile;
+  if (o.method == TrajectoryMethod::vertex_alpha) {
+    if (o.vertex_alpha.size() != path.segments())
+      throw std::invalid_argument("vertex_alpha needs one alpha per vertex after the first (" +
+                                  std::to_string(path.segments()) + ")");
+    std::vector<Eigen::Matrix<double, 1, 1>> a{Eigen::Matrix<double, 1, 1>(o.alpha1A)};
+    for (double v : o.vertex_alpha) a.emplace_back(v);
+    alpha_profile.emplace(std::move(a), path.durations());
+  }
+  const std::size_t n = sample_count(path.duration(), o.dt);
+  if (history) history->prepare(n);
+
+  const std::optional<Vec3> q0 = inverse_kinematics(arm, path.vertices().front(), o.alpha1A, o.elbow);
+  if (!q0) {
+    out.status = RunStatus::unreachable_start;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    out.E = out.E_M = out.min_manipulability = out.torque_sq_integral = out.power_sq_integral = nan;
+    out.max_tracking_error = out.final_alpha = nan;
+    out.tau_inf.setConstant(nan);
+    return out;
+  }
+  Vec3 q = *q0, qd = Vec3::Zero();
+  const Resolver resolver(arm, path, o, alpha_profile);
+  Evaluation e, s;  // e: at the sample; s: RK4 stages
+  double sumE = 0, sumEM = 0, min_w = std::numeric_limits<double>::infinity(), max_err = 0;
+  double f5 = 0, f6 = 0, prev5 = 0, prev6 = 0;
+  Vec3 tau_inf = Vec3::Zero();
+  const double dt = o.dt;
+  std::size_t done = 0;
+  double last_t = 0, last_alpha = q.sum();
+
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) * dt;
+    const std::size_t seg = path.segment_at(t);
+    if (!resolver.evaluate(t, seg, q, qd, e)) {
+      out.status = RunStatus::singular;
+      break;
+    }
+    const Vec3 tau = e.M * e.qdd + e.c + e.g;
+    if (!finite(tau) || !finite(q) || !finite(qd) || tau.cwiseAbs().maxCoeff() > o.torque_bound) {
+      out.status = RunStatus::diverged;
+      break;
+    }
+    // metrics of this sample
+    const double tt = tau.squaredNorm();
+    sumE += std::sqrt(tt);
+    sumEM += std::sqrt(e.llt.matrixL().solve(tau).squaredNorm());
+    tau_inf = tau_inf.cwiseMax(tau.cwiseAbs());
+    min_w = std::min(min_w, manipulability(e.J));
+    const Vec2 tip = end_effector(arm, e.trig);
+    max_err = std::max(max_err, (tip - e.x_ref).norm());
+    const double p6 = tau.cwiseProduct(qd).squaredNorm();
+    if (i > 0) {
+      f5 += 0.5 * dt * (prev5 + tt);
+      f6 += 0.5 * dt * (prev6 + p6);
+    }
+    prev5 = tt;
+    prev6 = p6;
+    last_t = t;
+    last_alpha = q.sum();
+    if (history && (i % history->stride == 0 || i + 1 == n)) {
+      const Eigen::Index c = history->size++;
+      history->t[c] = t;
+      history->q.col(c) = q;
+      history->qd.col(c) = qd;
+      history->qdd.col(c) = e.qdd;
+      history->tau.col(c) = tau;
+      history->x.col(c) = tip;
+      history->alpha[c] = last_alpha;
+    }
+    ++done;
+    if (i + 1 == n) break;  // the last sample is measured, not integrated past
+    // integrate to the next sample
+    if (o.integrator == Integrator::semi_implicit_euler) {
+      qd += dt * e.qdd;
+      q += dt * qd;
+    } else {
+      const double th = t + 0.5 * dt, t1 = t + dt;
+      const std::size_t sh = path.segment_at(th), s1 = path.segment_at(t1);
+      const Vec3 k1q = qd, k1v = e.qdd;
+      bool good = resolver.evaluate(th, sh, q + 0.5 * dt * k1q, qd + 0.5 * dt * k1v, s);
+      const Vec3 k2q = qd + 0.5 * dt * k1v, k2v = s.qdd;
+      good = good && resolver.evaluate(th, sh, q + 0.5 * dt * k2q, qd + 0.5 * dt * k2v, s);
+      const Vec3 k3q = qd + 0.5 * dt * k2v, k3v = s.qdd;
+      good = good && resolver.evaluate(t1, s1, q + dt * k3q, qd + dt * k3v, s);
+      if (!good) {
+        out.status = RunStatus::singular;
+        break;
+      }
+      const Vec3 k4q = qd + dt * k3v, k4v = s.qdd;
+      q += dt / 6.0 * (k1q + 2.0 * k2q + 2.0 * k3q + k4q);
+      qd += dt / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+    }
+  }
+  out.samples = done;
+  if (done > 0) {
+    out.E = sumE / static_cast<double>(done);
+    out.E_M = sumEM / static_cast<double>(done);
+    out.tau_inf = tau_inf;
+    out.min_manipulability = min_w;
+    out.torque_sq_integral = f5;
+    out.power_sq_integral = f6;
+    out.max_tracking_error = max_err;
+  }
+  out.final_alpha = last_alpha;
+  out.stop_time = last_t;
+  return out;
+}
+
+}  // namespace ks

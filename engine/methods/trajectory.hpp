@@ -1,0 +1,98 @@
+#pragma once
+// Redundancy resolution along a path (seed 000, chapter 3): one run = one simulation of the arm
+// following the path from rest, with joint accelerations chosen by a method, integrated open loop.
+#include <Eigen/Core>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "model/arm.hpp"
+#include "model/kinematics.hpp"
+#include "task/quintic_path.hpp"
+
+namespace ks {
+
+/// The seed's cases. Names are the study-file, HDF5 and plot names.
+enum class TrajectoryMethod {
+  local_weighted,    ///< case 1, Eq. 51: inertia-weighted pseudo-inverse, minimises tau^T M^-1 tau
+  local_unweighted,  ///< case 2, Eq. 56: M^-2-weighted pseudo-inverse, minimises tau^T tau
+  vertex_alpha,      ///< cases 3-5: alpha prescribed at every vertex, quintic alpha(t), non-redundant
+};
+
+enum class Integrator {
+  semi_implicit_euler,  ///< the seed's: qd += dt qdd; q += dt qd (new qd)
+  rk4,                  ///< classic fourth-order Runge-Kutta on (q, qd)
+};
+
+/// Outcome of a run. Anything but ok stops the run early; the metrics then cover the samples done.
+enum class RunStatus {
+  ok,
+  unreachable_start,  ///< no real analytic IK at the first vertex for alpha1A: nothing simulated
+  singular,           ///< the Jacobian became singular (see TrajectoryOptions::singular_tolerance)
+  diverged,           ///< a non-finite value, or a torque above TrajectoryOptions::torque_bound
+};
+
+std::string_view to_string(TrajectoryMethod m);
+std::string_view to_string(Integrator i);
+std::string_view to_string(RunStatus s);
+/// Parse a name; false when unknown.
+bool parse(std::string_view name, TrajectoryMethod& out);
+bool parse(std::string_view name, Integrator& out);
+bool parse(std::string_view name, RunStatus& out);
+
+/// Options of one run. Defaults reproduce the seed.
+struct TrajectoryOptions {
+  TrajectoryMethod method = TrajectoryMethod::local_weighted;
+  double k = 0.0;                     ///< gravity weight in the resolution (local methods), in [0, 1]
+  double alpha1A = 0.0;               ///< orientation at the start (first vertex) [rad]
+  std::vector<double> vertex_alpha;   ///< vertex_alpha: alpha at vertices 2..n [rad] (n - 1 values)
+  double null_damping = 0.0;          ///< K_N [1/s]: adds -(I - J+ J) K_N qd to qdd (local methods)
+  Integrator integrator = Integrator::semi_implicit_euler;
+  double dt = 1e-3;                   ///< sample / integration step [s]
+  Elbow elbow = Elbow::positive;      ///< branch of the start IK (the seed's sin(theta2) >= 0)
+  double torque_bound = 1.0e6;        ///< |tau_i| above this [Nm] stops the run as diverged
+  /// singular when sqrt(det(J J^T)) [m^2] (local methods) or |det J3| (vertex_alpha) falls below this
+  double singular_tolerance = 1.0e-9;
+};
+
+/// Figures of merit of one run (seed Eq. 60 and seed 002's measures).
+struct TrajectoryMetrics {
+  RunStatus status = RunStatus::ok;
+  std::size_t samples = 0;            ///< samples computed (2001 for the seed's square at dt = 1 ms)
+  double E = 0.0;                     ///< mean over samples of sqrt(tau^T tau) [Nm]
+  double E_M = 0.0;                   ///< mean over samples of sqrt(tau^T M^-1 tau) [Nm / sqrt(kg m^2)]
+  Vec3 tau_inf = Vec3::Zero();        ///< max over samples of |tau_i| [Nm]
+  double min_manipulability = 0.0;    ///< min over samples of sqrt(det(J J^T)) [m^2]
+  double torque_sq_integral = 0.0;    ///< trapezoidal integral of sum tau_i^2 [N^2 m^2 s]
+  double power_sq_integral = 0.0;     ///< trapezoidal integral of sum (tau_i qd_i)^2 [W^2 s]
+  double max_tracking_error = 0.0;    ///< max over samples of |tip - path| [m] (open-loop drift)
+  double final_alpha = 0.0;           ///< alpha at the last sample [rad]
+  double stop_time = 0.0;             ///< time of the last sample computed [s]
+};
+
+/// Per-sample history, written in place by simulate() (no copy per sample). One column per stored
+/// sample; every `stride`-th sample is stored, and the last one computed always is.
+struct TrajectoryHistory {
+  int stride = 1;
+  Eigen::VectorXd t;                             ///< [s]
+  Eigen::Matrix<double, 3, Eigen::Dynamic> q;    ///< [rad]
+  Eigen::Matrix<double, 3, Eigen::Dynamic> qd;   ///< [rad/s]
+  Eigen::Matrix<double, 3, Eigen::Dynamic> qdd;  ///< [rad/s^2]
+  Eigen::Matrix<double, 3, Eigen::Dynamic> tau;  ///< [Nm]
+  Eigen::Matrix<double, 2, Eigen::Dynamic> x;    ///< end-effector position [m]
+  Eigen::VectorXd alpha;                         ///< end-effector orientation [rad]
+  Eigen::Index size = 0;                         ///< columns filled
+
+  /// Size the buffers for a run of `samples` samples; does not shrink capacity between runs.
+  void prepare(std::size_t samples);
+};
+
+/// Number of samples the seed takes on a path: t = 0 : dt : T.
+std::size_t sample_count(double duration, double dt);
+
+/// Simulate one run. Inputs: arm constants, path [m, s], options. Output: metrics; the history is
+/// filled when given. Never throws on bad numbers: trouble is a status.
+TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const TrajectoryOptions& options,
+                           TrajectoryHistory* history = nullptr);
+
+}  // namespace ks

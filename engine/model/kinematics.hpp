@@ -1,0 +1,98 @@
+#pragma once
+// Kinematics of the planar 3R arm: forward kinematics, Jacobians and their time derivative,
+// analytic inverse kinematics at a point for a prescribed orientation.
+#include <Eigen/Core>
+#include <optional>
+
+#include "model/arm.hpp"
+#include "model/trig.hpp"
+
+namespace ks {
+
+using Vec2 = Eigen::Vector2d;
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+using Mat23 = Eigen::Matrix<double, 2, 3>;
+
+/// Positions [m] of joint 2, joint 3 and the end-effector, and the orientation alpha [rad].
+struct ArmPose {
+  Vec2 elbow;     ///< joint 2 (tip of link 1)
+  Vec2 wrist;     ///< joint 3 (tip of link 2)
+  Vec2 tip;       ///< end-effector (tip of link 3)
+  double alpha;   ///< theta1 + theta2 + theta3 [rad]
+};
+
+/// End-effector position [m] from precomputed trig.
+inline Vec2 end_effector(const PlanarArm3& a, const JointTrig& t) {
+  return {a.l[0] * t.c1 + a.l[1] * t.c12 + a.l[2] * t.c123, a.l[0] * t.s1 + a.l[1] * t.s12 + a.l[2] * t.s123};
+}
+
+/// Forward kinematics. Input q [rad]. Output: every joint position and the orientation.
+inline ArmPose forward_kinematics(const PlanarArm3& a, const Vec3& q) {
+  const JointTrig t = joint_trig(q);
+  ArmPose p;
+  p.elbow = {a.l[0] * t.c1, a.l[0] * t.s1};
+  p.wrist = p.elbow + Vec2(a.l[1] * t.c12, a.l[1] * t.s12);
+  p.tip = p.wrist + Vec2(a.l[2] * t.c123, a.l[2] * t.s123);
+  p.alpha = q[0] + q[1] + q[2];
+  return p;
+}
+
+/// 2x3 position Jacobian d(tip)/dq [m/rad] (seed Eq. 24).
+inline Mat23 jacobian(const PlanarArm3& a, const JointTrig& t) {
+  const double x3 = a.l[2] * t.c123, y3 = a.l[2] * t.s123;
+  const double x2 = a.l[1] * t.c12 + x3, y2 = a.l[1] * t.s12 + y3;
+  const double x1 = a.l[0] * t.c1 + x2, y1 = a.l[0] * t.s1 + y2;
+  Mat23 J;
+  J << -y1, -y2, -y3, x1, x2, x3;
+  return J;
+}
+
+/// 3x3 Jacobian of (tip, alpha): the position rows and the row (1, 1, 1) (seed Eq. 23).
+inline Mat3 jacobian_with_alpha(const PlanarArm3& a, const JointTrig& t) {
+  Mat3 J;
+  J.topRows<2>() = jacobian(a, t);
+  J.row(2).setOnes();
+  return J;
+}
+
+/// Time derivative of the 2x3 position Jacobian [m/(rad s)], at joint velocities qd [rad/s].
+inline Mat23 jacobian_dot(const PlanarArm3& a, const JointTrig& t, const Vec3& qd) {
+  const double w1 = qd[0], w2 = w1 + qd[1], w3 = w2 + qd[2];  // absolute link angular rates
+  const double x3 = a.l[2] * t.c123 * w3, y3 = a.l[2] * t.s123 * w3;
+  const double x2 = a.l[1] * t.c12 * w2 + x3, y2 = a.l[1] * t.s12 * w2 + y3;
+  const double x1 = a.l[0] * t.c1 * w1 + x2, y1 = a.l[0] * t.s1 * w1 + y2;
+  Mat23 Jd;
+  Jd << -x1, -x2, -x3, -y1, -y2, -y3;
+  return Jd;
+}
+
+/// Manipulability sqrt(det(J J^T)) of the 2x3 position Jacobian [m^2]; 0 at a singular configuration.
+inline double manipulability(const Mat23& J) {
+  const double a = J.row(0).squaredNorm(), b = J.row(0).dot(J.row(1)), c = J.row(1).squaredNorm();
+  const double d = a * c - b * b;
+  return d > 0.0 ? std::sqrt(d) : 0.0;
+}
+
+/// Elbow branch of the analytic IK: sign of sin(theta2). The seed uses +1.
+enum class Elbow : int { positive = 1, negative = -1 };
+
+/// Analytic IK at point p [m] with orientation alpha [rad] (seed Appendix G).
+/// Output: q [rad] on the requested elbow branch, or std::nullopt when no real solution exists
+/// (|cos theta2| > 1: the wrist is out of reach of links 1 and 2).
+inline std::optional<Vec3> inverse_kinematics(const PlanarArm3& a, const Vec2& p, double alpha,
+                                              Elbow elbow = Elbow::positive) {
+  const double x2 = p.x() - a.l[2] * std::cos(alpha);
+  const double y2 = p.y() - a.l[2] * std::sin(alpha);
+  const double d = x2 * x2 + y2 * y2;
+  const double c2 = (d - a.l[0] * a.l[0] - a.l[1] * a.l[1]) / (2.0 * a.l[0] * a.l[1]);
+  if (!(std::abs(c2) <= 1.0) || d == 0.0) return std::nullopt;
+  const double s2 = static_cast<int>(elbow) * std::sqrt(1.0 - c2 * c2);
+  const double c1 = ((a.l[0] + a.l[1] * c2) * x2 + a.l[1] * s2 * y2) / d;
+  const double s1 = ((a.l[0] + a.l[1] * c2) * y2 - a.l[1] * s2 * x2) / d;
+  const double t1 = std::atan2(s1, c1);
+  const double t2 = std::atan2(s2, c2);
+  return Vec3(t1, t2, alpha - t1 - t2);
+}
+
+}  // namespace ks
