@@ -1,0 +1,41 @@
+#pragma once
+// What flows from a run to the store: a row of named, typed cells and the run's history arrays.
+// The store is the only code that knows HDF5; runs only fill these plain structures.
+#include <cstdint>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace ks {
+
+enum class CellType { f64, i64, str };
+/// One value of a /runs column. Missing values: NaN (f64), -1 (i64), "" (str).
+using Cell = std::variant<double, std::int64_t, std::string>;
+
+/// A column of /runs: its name (the user's word: "alpha1A", "E", "status", ...), type, unit, meaning.
+struct ColumnSpec {
+  std::string name;
+  CellType type = CellType::f64;
+  std::string unit;         ///< "rad", "Nm", "" for dimensionless or strings
+  std::string description;  ///< one line, stored as an HDF5 attribute
+};
+
+/// One result row: one cell per ColumnSpec of the study's schema, in schema order.
+struct Record {
+  std::vector<Cell> cells;
+};
+
+/// One history array of a run: `rows` samples (or iterations) x `cols` components, row-major.
+struct HistoryArray {
+  std::string name;   ///< "t", "q", "qd", "qdd", "tau", "x", "alpha"; "q", "F", "norm_F", "step", "lambda"
+  std::string unit;
+  std::size_t rows = 0, cols = 1;
+  std::vector<double> data;  ///< rows * cols values, row-major
+};
+
+/// A run's full history (empty when histories are off).
+struct RunHistory {
+  std::vector<HistoryArray> arrays;
+};
+
+}  // namespace ks
