@@ -95,3 +95,14 @@ TEST(Kinematics, AnalyticIkReportsUnreachable) {
   EXPECT_FALSE(inverse_kinematics(a, Vec2(5.0, 0.0), 0.0).has_value());
   EXPECT_TRUE(inverse_kinematics(a, Vec2(1.5, 1.5), 0.0).has_value());
 }
+
+TEST(Kinematics, JacobianDotTimesRatesAndTipFromJacobian) {
+  const PlanarArm3 a = PlanarArm3::seed();
+  test::RandomStates r;
+  for (int n = 0; n < 200; ++n) {
+    const Vec3 q = r.q(), qd = r.v();
+    const JointTrig t = joint_trig(q);
+    EXPECT_LT((jacobian_dot_times_qd(a, t, qd) - jacobian_dot(a, t, qd) * qd).norm(), 1e-12);
+    EXPECT_LT((end_effector_from_jacobian(jacobian(a, t)) - forward_kinematics(a, q).tip).norm(), 1e-12);
+  }
+}

@@ -77,7 +77,7 @@ TEST(LocalResolution, SatisfiesTaskAndIsOptimalInNullSpace) {
     const Mat23 J = jacobian(a, t);
     if (manipulability(J) < 0.05) continue;
     const Mat3 M = mass_matrix(a, t);
-    const Eigen::LLT<Mat3> llt(M);
+    const Ldlt3 llt(M);
     const Vec3 c = coriolis(a, t, qd), g = gravity(a, t);
     const Vec2 b(r.rate(r.rng), r.rate(r.rng));
     const double k = 0.3;
@@ -101,7 +101,7 @@ TEST(LocalResolution, NullSpaceDampingActsInNullSpace) {
   const Vec3 q(0.2, 1.1, -0.7), qd(0.5, -1.0, 2.0);
   const JointTrig t = joint_trig(q);
   const Mat23 J = jacobian(a, t);
-  const Eigen::LLT<Mat3> llt(mass_matrix(a, t));
+  const Ldlt3 llt(mass_matrix(a, t));
   const Vec2 b(0.3, -0.2);
   const Vec3 d0 = local_acceleration(Weighting::inertia, llt, J, b, coriolis(a, t, qd), gravity(a, t), 0, 0, qd);
   const Vec3 d1 = local_acceleration(Weighting::inertia, llt, J, b, coriolis(a, t, qd), gravity(a, t), 0, 5, qd);

@@ -1,8 +1,8 @@
 #pragma once
 // Joint accelerations of the seed's redundancy resolutions at one instant (free functions, no state).
-#include <Eigen/Cholesky>
 #include <Eigen/LU>
 
+#include "model/ldlt3.hpp"
 #include "model/kinematics.hpp"
 
 namespace ks {
@@ -15,18 +15,24 @@ enum class Weighting {
 /// Local (instantaneous) resolution at acceleration level:
 ///   qdd = J_W+ b - (I - J_W+ J) v,  J_W+ = W^-1 J^T (J W^-1 J^T)^-1,  v = M^-1 (c + k g) + K_N qd,
 /// computed as qdd = Y A^-1 (b + J v) - v with Y = W^-1 J^T and A = J Y (a 2x2 solve, no inverse).
-/// Inputs: Cholesky factor of M [kg m^2], J (2x3) [m], b = xdd - Jdot qd [m/s^2], c and g [Nm],
+/// Inputs: Cholesky factor of M (Ldlt3) [kg m^2], J (2x3) [m], b = xdd - Jdot qd [m/s^2], c and g [Nm],
 /// gravity weight k [-], null-space damping K_N [1/s], qd [rad/s]. Output: qdd [rad/s^2].
-inline Vec3 local_acceleration(Weighting w, const Eigen::LLT<Mat3>& llt, const Mat23& J, const Vec2& b,
-                               const Vec3& c, const Vec3& g, double k, double K_N, const Vec3& qd) {
-  Eigen::Matrix<double, 3, 2> Y = llt.solve(J.transpose());
-  if (w == Weighting::inertia_squared) Y = llt.solve(Y);
-  const Vec3 v = llt.solve(c + k * g) + K_N * qd;
-  const Eigen::Matrix2d A = J * Y;
-  const Vec2 r = b + J * v;
-  const double det = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
-  const Vec2 z((A(1, 1) * r.x() - A(0, 1) * r.y()) / det, (A(0, 0) * r.y() - A(1, 0) * r.x()) / det);
-  return Y * z - v;
+inline Vec3 local_acceleration(Weighting w, const Ldlt3& llt, const Mat23& J, const Vec2& b, const Vec3& c,
+                               const Vec3& g, double k, double K_N, const Vec3& qd) {
+  Vec3 y0 = llt.solve(J.row(0).transpose()), y1 = llt.solve(J.row(1).transpose());
+  if (w == Weighting::inertia_squared) {
+    y0 = llt.solve(y0);
+    y1 = llt.solve(y1);
+  }
+  const Vec3 v = llt.solve(Vec3(c[0] + k * g[0], c[1] + k * g[1], c[2] + k * g[2])) + K_N * qd;
+  const double a00 = J(0, 0) * y0[0] + J(0, 1) * y0[1] + J(0, 2) * y0[2];
+  const double a01 = J(0, 0) * y1[0] + J(0, 1) * y1[1] + J(0, 2) * y1[2];  // A is symmetric
+  const double a11 = J(1, 0) * y1[0] + J(1, 1) * y1[1] + J(1, 2) * y1[2];
+  const double r0 = b[0] + J(0, 0) * v[0] + J(0, 1) * v[1] + J(0, 2) * v[2];
+  const double r1 = b[1] + J(1, 0) * v[0] + J(1, 1) * v[1] + J(1, 2) * v[2];
+  const double inv_det = 1.0 / (a00 * a11 - a01 * a01);
+  const double z0 = (a11 * r0 - a01 * r1) * inv_det, z1 = (a00 * r1 - a01 * r0) * inv_det;
+  return {y0[0] * z0 + y1[0] * z1 - v[0], y0[1] * z0 + y1[1] * z1 - v[1], y0[2] * z0 + y1[2] * z1 - v[2]};
 }
 
 /// Non-redundant resolution (vertex_alpha, seed cases 3-5): solve [J; 1 1 1] qdd = [b; alpha_dd]

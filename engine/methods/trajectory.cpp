@@ -2,7 +2,6 @@
 // evaluation, fixed-size types and no allocation per step.
 #include "methods/trajectory.hpp"
 
-#include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <cmath>
 #include <optional>
@@ -37,53 +36,51 @@ namespace {
 struct Evaluation {
   JointTrig trig;
   Mat3 M;
-  Eigen::LLT<Mat3> llt;
+  Ldlt3 llt;
   Vec3 c, g, qdd;
   Mat23 J;
-  Vec2 x_ref;                  // path position at t
-  double singularity_measure;  // manipulability (local) or |det J3| (vertex_alpha)
+  Vec2 x_ref;    // path position at t
+  double w2;     // squared manipulability det(J J^T) (the square root is taken once, at the end)
 };
 
 class Resolver {
  public:
   Resolver(const PlanarArm3& arm, const Path2& path, const TrajectoryOptions& o,
            const std::optional<Profile1>& alpha_profile)
-      : arm_(arm), path_(path), o_(o), alpha_(alpha_profile) {}
+      : arm_(arm), dyn_(arm), path_(path), o_(o), alpha_(alpha_profile) {}
 
   /// Joint accelerations of the method at (t, q, qd); fills every intermediate in `e`.
   /// Returns false when the Jacobian is singular.
   bool evaluate(double t, std::size_t segment, const Vec3& q, const Vec3& qd, Evaluation& e) const {
     e.trig = joint_trig(q);
-    e.M = mass_matrix(arm_, e.trig);
-    e.c = coriolis(arm_, e.trig, qd);
-    e.g = gravity(arm_, e.trig);
+    e.M = mass_matrix(dyn_, e.trig);
+    e.c = coriolis(dyn_, e.trig, qd);
+    e.g = gravity(dyn_, e.trig);
     e.J = jacobian(arm_, e.trig);
     e.llt.compute(e.M);
-    const Mat23 Jd = jacobian_dot(arm_, e.trig, qd);
     const PathSample<2> xs = path_.sample_on(segment, t);
-    const Vec2 b = xs.a - Jd * qd;
+    const Vec2 b = xs.a - jacobian_dot_times_qd(arm_, e.trig, qd);
     e.x_ref = xs.p;
     if (o_.method == TrajectoryMethod::vertex_alpha) {
       double det = 0;
       e.qdd = nonredundant_acceleration(e.J, b, alpha_->sample_on(segment, t).a[0], det);
-      e.singularity_measure = std::abs(det);
-      return e.singularity_measure >= o_.singular_tolerance;
+      e.w2 = manipulability_squared(e.J);
+      return std::abs(det) >= o_.singular_tolerance;
     }
-    e.singularity_measure = manipulability(e.J);
-    if (!(e.singularity_measure >= o_.singular_tolerance)) return false;
+    e.w2 = manipulability_squared(e.J);
+    if (!(e.w2 >= o_.singular_tolerance * o_.singular_tolerance)) return false;
     const Weighting w = o_.method == TrajectoryMethod::local_unweighted ? Weighting::inertia_squared : Weighting::inertia;
     e.qdd = local_acceleration(w, e.llt, e.J, b, e.c, e.g, o_.k, o_.null_damping, qd);
     return true;
   }
 
  private:
-  const PlanarArm3& arm_;
+  const PlanarArm3 arm_;
+  const DynamicsCoefficients dyn_;
   const Path2& path_;
   const TrajectoryOptions& o_;
   const std::optional<Profile1>& alpha_;
 };
-
-bool finite(const Vec3& v) { return v.allFinite(); }
 
 }  // namespace
 
@@ -114,7 +111,7 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const Traje
   Vec3 q = *q0, qd = Vec3::Zero();
   const Resolver resolver(arm, path, o, alpha_profile);
   Evaluation e, s;  // e: at the sample; s: RK4 stages
-  double sumE = 0, sumEM = 0, min_w = std::numeric_limits<double>::infinity(), max_err = 0;
+  double sumE = 0, sumEM = 0, min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0;
   double f5 = 0, f6 = 0, prev5 = 0, prev6 = 0;
   Vec3 tau_inf = Vec3::Zero();
   const double dt = o.dt;
@@ -129,18 +126,20 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const Traje
       break;
     }
     const Vec3 tau = e.M * e.qdd + e.c + e.g;
-    if (!finite(tau) || !finite(q) || !finite(qd) || tau.cwiseAbs().maxCoeff() > o.torque_bound) {
+    // NaN fails every comparison: one test catches non-finite values and the bound
+    const double tt = tau.squaredNorm();
+    if (!(std::abs(tau[0]) <= o.torque_bound && std::abs(tau[1]) <= o.torque_bound &&
+          std::abs(tau[2]) <= o.torque_bound && std::isfinite(tt))) {
       out.status = RunStatus::diverged;
       break;
     }
     // metrics of this sample
-    const double tt = tau.squaredNorm();
     sumE += std::sqrt(tt);
-    sumEM += std::sqrt(e.llt.matrixL().solve(tau).squaredNorm());
-    tau_inf = tau_inf.cwiseMax(tau.cwiseAbs());
-    min_w = std::min(min_w, manipulability(e.J));
-    const Vec2 tip = end_effector(arm, e.trig);
-    max_err = std::max(max_err, (tip - e.x_ref).norm());
+    sumEM += std::sqrt(e.llt.inverse_quadratic_form(tau));
+    for (int j = 0; j < 3; ++j) tau_inf[j] = std::max(tau_inf[j], std::abs(tau[j]));
+    min_w2 = std::min(min_w2, e.w2);
+    const Vec2 tip = end_effector_from_jacobian(e.J);
+    max_err2 = std::max(max_err2, (tip - e.x_ref).squaredNorm());
     const double p6 = tau.cwiseProduct(qd).squaredNorm();
     if (i > 0) {
       f5 += 0.5 * dt * (prev5 + tt);
@@ -189,10 +188,10 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const Traje
     out.E = sumE / static_cast<double>(done);
     out.E_M = sumEM / static_cast<double>(done);
     out.tau_inf = tau_inf;
-    out.min_manipulability = min_w;
+    out.min_manipulability = std::sqrt(min_w2);
     out.torque_sq_integral = f5;
     out.power_sq_integral = f6;
-    out.max_tracking_error = max_err;
+    out.max_tracking_error = std::sqrt(max_err2);
   }
   out.final_alpha = last_alpha;
   out.stop_time = last_t;

@@ -67,12 +67,25 @@ inline Mat23 jacobian_dot(const PlanarArm3& a, const JointTrig& t, const Vec3& q
   return Jd;
 }
 
+/// Jdot qd [m/s^2], the velocity-product part of the tip acceleration: (-sum l_j cos(phi_j) w_j^2,
+/// -sum l_j sin(phi_j) w_j^2) with phi_j, w_j the absolute angle and rate of link j. Equals
+/// jacobian_dot(a, t, qd) * qd at a third of the cost.
+inline Vec2 jacobian_dot_times_qd(const PlanarArm3& a, const JointTrig& t, const Vec3& qd) {
+  const double w1 = qd[0], w2 = w1 + qd[1], w3 = w2 + qd[2];
+  const double e1 = a.l[0] * w1 * w1, e2 = a.l[1] * w2 * w2, e3 = a.l[2] * w3 * w3;
+  return {-(e1 * t.c1 + e2 * t.c12 + e3 * t.c123), -(e1 * t.s1 + e2 * t.s12 + e3 * t.s123)};
+}
+
+/// The end-effector position read off the Jacobian's first column (J = [-y1 ...; x1 ...]).
+inline Vec2 end_effector_from_jacobian(const Mat23& J) { return {J(1, 0), -J(0, 0)}; }
+
 /// Manipulability sqrt(det(J J^T)) of the 2x3 position Jacobian [m^2]; 0 at a singular configuration.
-inline double manipulability(const Mat23& J) {
+inline double manipulability_squared(const Mat23& J) {
   const double a = J.row(0).squaredNorm(), b = J.row(0).dot(J.row(1)), c = J.row(1).squaredNorm();
   const double d = a * c - b * b;
-  return d > 0.0 ? std::sqrt(d) : 0.0;
+  return d > 0.0 ? d : 0.0;
 }
+inline double manipulability(const Mat23& J) { return std::sqrt(manipulability_squared(J)); }
 
 /// Elbow branch of the analytic IK: sign of sin(theta2). The seed uses +1.
 enum class Elbow : int { positive = 1, negative = -1 };

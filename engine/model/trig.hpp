@@ -1,6 +1,6 @@
 #pragma once
 // Every trigonometric term the planar 3R model needs, from three sincos calls and angle sums.
-#include <cmath>
+#include "model/sincos.hpp"
 
 namespace ks {
 
@@ -15,12 +15,9 @@ struct JointTrig {
 template <class Vec3>
 inline JointTrig joint_trig(const Vec3& q) {
   JointTrig t;
-  t.s1 = std::sin(q[0]);
-  t.c1 = std::cos(q[0]);
-  t.s2 = std::sin(q[1]);
-  t.c2 = std::cos(q[1]);
-  t.s3 = std::sin(q[2]);
-  t.c3 = std::cos(q[2]);
+  fast_sincos(q[0], t.s1, t.c1);
+  fast_sincos(q[1], t.s2, t.c2);
+  fast_sincos(q[2], t.s3, t.c3);
   t.s23 = t.s2 * t.c3 + t.c2 * t.s3;
   t.c23 = t.c2 * t.c3 - t.s2 * t.s3;
   t.s12 = t.s1 * t.c2 + t.c1 * t.s2;

@@ -28,6 +28,7 @@ class QuinticPath {
       if (!(d > 0.0)) throw std::invalid_argument("QuinticPath: segment durations must be > 0");
       t += d;
       ends_.push_back(t);
+      inverse_.push_back(1.0 / d);
     }
   }
 
@@ -48,12 +49,12 @@ class QuinticPath {
   PathSample<Dim> sample(double t) const { return sample_on(segment_at(t), t); }
 
   PathSample<Dim> sample_on(std::size_t i, double t) const {
-    const double T = durations_[i];
-    const double s = (t - (ends_[i] - T)) / T;
+    const double iT = inverse_[i];  // multiply by 1/T: no division in the simulation's hot loop
+    const double s = (t - (ends_[i] - durations_[i])) * iT;
     const double s2 = s * s, s3 = s2 * s;
     const double h = s3 * (10.0 - 15.0 * s + 6.0 * s2);
-    const double hd = 30.0 * s2 * (1.0 - 2.0 * s + s2) / T;
-    const double hdd = 60.0 * s * (1.0 - 3.0 * s + 2.0 * s2) / (T * T);
+    const double hd = 30.0 * s2 * (1.0 - 2.0 * s + s2) * iT;
+    const double hdd = 60.0 * s * (1.0 - 3.0 * s + 2.0 * s2) * (iT * iT);
     const Point d = vertices_[i + 1] - vertices_[i];
     return {vertices_[i] + h * d, hd * d, hdd * d};
   }
@@ -62,6 +63,7 @@ class QuinticPath {
   std::vector<Point> vertices_;
   std::vector<double> durations_;
   std::vector<double> ends_;
+  std::vector<double> inverse_;  // 1 / durations
 };
 
 using Path2 = QuinticPath<2>;
