@@ -1,15 +1,26 @@
-// kinesweep: the command-line front end.
+// kinesweep: the command-line front end (run, table4; info and query read results files).
 #include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "cli/run_command.hpp"
 #include "cli/table4.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"kinesweep: parameter-sweep studies of redundant manipulators"};
   app.set_version_flag("--version", std::string("kinesweep ") + KINESWEEP_VERSION);
   app.require_subcommand(1);
-  auto* table4 = app.add_subcommand("table4", "Print seed 000's Table 4 beside kinesweep's figures");
-  CLI11_PARSE(app, argc, argv);
-  if (table4->parsed()) ks::print_table4(std::cout);
+  ks::cli::RunArgs& run = ks::cli::add_run_command(app);
+  auto* table4 = app.add_subcommand("table4", "Print seed 000's Table 4 beside kinesweep's figures (no file)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  if (table4->parsed()) {
+    ks::print_table4(std::cout);
+    return 0;
+  }
+  if (app.got_subcommand("run")) return ks::cli::run_command(run);
   return 0;
 }

@@ -1,0 +1,26 @@
+#pragma once
+// `kinesweep run STUDY.toml [-o FILE] [--threads N] [--resume] [--overwrite] [--dry-run]
+//  [--histories full|every=N|none]`
+#include <string>
+
+namespace CLI {
+class App;
+}
+
+namespace ks::cli {
+
+struct RunArgs {
+  std::string study;
+  std::string output;      ///< empty: the study's output
+  int threads = 0;         ///< 0: all cores
+  bool resume = false, overwrite = false, dry_run = false;
+  std::string histories;   ///< empty: the study's policy
+  bool quiet = false;      ///< no progress display
+};
+
+/// Register the subcommand; returns the argument struct it fills.
+RunArgs& add_run_command(CLI::App& app);
+/// Exit codes: 0 done, 1 store or I/O failure, 2 bad study file or arguments, 130 interrupted.
+int run_command(const RunArgs& args);
+
+}  // namespace ks::cli

@@ -1,0 +1,344 @@
+#pragma once
+// Definitions of ik/solve.hpp. Include this (instead of solve.hpp) in the one .cpp that instantiates
+// solve() for a new problem description; the engine's problems are instantiated in ik/solve.cpp.
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <ostream>
+
+#include "ik/solve.hpp"
+
+namespace ks::ik {
+namespace detail {
+
+/// Reciprocal condition below which a matrix is treated as singular; NaN counts as singular.
+inline bool too_singular(double rcond, double rcond_min) { return !(rcond >= rcond_min); }
+
+/// Reciprocal condition number of a square matrix in the 1-norm, 1 / (|A|_1 |A^-1|_1): exact and
+/// cheap for N <= 3 (|A^-1|_1 = |adj A|_1 / |det A|), the LU estimate (LAPACK's) beyond. 0 for an
+/// exactly singular A, NaN for a non-finite one.
+template <int N>
+inline double rcond1(const Mat<N, N>& A) {
+  if constexpr (N == 1) {
+    return A(0, 0) != 0.0 ? 1.0 : (A(0, 0) == 0.0 ? 0.0 : A(0, 0));
+  } else if constexpr (N == 2) {
+    const double det = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
+    const double n1 = std::max(std::abs(A(0, 0)) + std::abs(A(1, 0)), std::abs(A(0, 1)) + std::abs(A(1, 1)));
+    const double ni = std::max(std::abs(A(1, 1)) + std::abs(A(1, 0)), std::abs(A(0, 1)) + std::abs(A(0, 0)));
+    return det == 0.0 ? 0.0 : std::abs(det) / (n1 * ni);
+  } else if constexpr (N == 3) {
+    Mat<3, 3> C;  // cofactors; adj A = C^T, so |adj A|_1 = max row sum of |C|
+    C(0, 0) = A(1, 1) * A(2, 2) - A(1, 2) * A(2, 1);
+    C(0, 1) = A(1, 2) * A(2, 0) - A(1, 0) * A(2, 2);
+    C(0, 2) = A(1, 0) * A(2, 1) - A(1, 1) * A(2, 0);
+    C(1, 0) = A(0, 2) * A(2, 1) - A(0, 1) * A(2, 2);
+    C(1, 1) = A(0, 0) * A(2, 2) - A(0, 2) * A(2, 0);
+    C(1, 2) = A(0, 1) * A(2, 0) - A(0, 0) * A(2, 1);
+    C(2, 0) = A(0, 1) * A(1, 2) - A(0, 2) * A(1, 1);
+    C(2, 1) = A(0, 2) * A(1, 0) - A(0, 0) * A(1, 2);
+    C(2, 2) = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
+    const double det = A(0, 0) * C(0, 0) + A(0, 1) * C(0, 1) + A(0, 2) * C(0, 2);
+    const double n1 = A.cwiseAbs().colwise().sum().maxCoeff();
+    const double ni = C.cwiseAbs().rowwise().sum().maxCoeff();
+    return det == 0.0 ? 0.0 : std::abs(det) / (n1 * ni);
+  } else {
+    return Eigen::PartialPivLU<Mat<N, N>>(A).rcond();
+  }
+}
+
+/// Solve A x = b in Newton's sense for an M x N matrix A: exact (M = N, LU), minimum-norm
+/// x = A^T (A A^T)^-1 b (M < N) or least squares x = (A^T A)^-1 A^T b (M > N). Returns the
+/// reciprocal condition of A (for M != N the square root of that of the Gram matrix solved).
+template <int M, int N>
+inline double newton_solve(const Mat<M, N>& A, const Vec<M>& b, Vec<N>& x) {
+  if constexpr (M == N) {
+    x = Eigen::PartialPivLU<Mat<N, N>>(A).solve(b);
+    return rcond1<N>(A);
+  } else if constexpr (M < N) {
+    const Mat<M, M> G = A * A.transpose();
+    x = A.transpose() * Eigen::LLT<Mat<M, M>>(G).solve(b);
+    return std::sqrt(rcond1<M>(G));
+  } else {
+    const Mat<N, N> G = A.transpose() * A;
+    x = Eigen::LLT<Mat<N, N>>(G).solve(A.transpose() * b);
+    return std::sqrt(rcond1<N>(G));
+  }
+}
+
+template <int N, int M>
+inline bool all_finite(const Vec<N>& q, const Vec<M>& F) {
+  return q.allFinite() && F.allFinite();
+}
+
+/// The last few iterates, for the cycle check: q and the path length travelled up to it.
+template <int N>
+struct CycleWatch {
+  static constexpr int kCapacity = 17;  // window of at most 16 earlier iterates
+  std::array<Vec<N>, kCapacity> q;
+  std::array<double, kCapacity> path;
+  std::array<double, kCapacity> error;
+  int window = 0;
+  int newest = -1;  // slot of the newest iterate
+  long count = 0;
+  double travelled = 0.0;
+  double best_error = std::numeric_limits<double>::infinity();  // min ||F|| before the newest
+
+  void push(const Vec<N>& qk, double step, double e) {
+    travelled += step;
+    newest = newest + 1 == kCapacity ? 0 : newest + 1;
+    q[newest] = qk;
+    path[newest] = travelled;
+    error[newest] = e;
+    ++count;
+  }
+  /// Does the newest iterate return to one of the `window` iterates before its predecessor?
+  /// Returning within d puts ||F|| back within |J| d of the earlier value, so only earlier iterates
+  /// with ||F|| within 0.1 % are compared, and none when the newest halves the best ||F|| so far
+  /// (cheap filters: converging runs do no distance computations).
+  bool returned(const std::array<bool, N>& revolute, double tolerance) {
+    const double e = error[newest];
+    const bool progress = e < 0.5 * best_error;
+    best_error = std::min(best_error, e);
+    if (progress) return false;
+    const Vec<N>& qk = q[newest];
+    const double tol = tolerance * std::max(1.0, qk.norm());
+    for (int p = 2; p <= window && p < count; ++p) {
+      const int i = newest - p < 0 ? newest - p + kCapacity : newest - p;
+      if (!(std::abs(e - error[i]) <= 1e-3 * error[i])) continue;
+      const double d = joint_difference<N>(qk, q[i], revolute).norm();
+      if (d <= tol && travelled - path[i] > 1000.0 * d) return true;
+    }
+    return false;
+  }
+};
+
+}  // namespace detail
+
+template <Problem P>
+void solve(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P::unknowns, P::residuals>& s) {
+  constexpr int N = P::unknowns, M = P::residuals;
+  using VecN = Vec<N>;
+  using VecM = Vec<M>;
+  using MatMN = Mat<M, N>;
+  using MatNN = Mat<N, N>;
+
+  s.method = o.method;
+  s.status = Status::max_iter;
+  s.iterations = 0;
+  s.rejected = 0;
+  s.solution = -1;
+  s.min_rcond = std::numeric_limits<double>::infinity();
+  s.history.clear();
+  const bool keep = o.keep_history;
+  if (keep) s.history.reserve(static_cast<std::size_t>(std::max(o.max_iter, 0)) + 1);
+
+  VecN q = q0;
+  VecM F;
+  MatMN J;
+  pb.evaluate(q, F, J);
+  double e = F.norm();
+
+  // lm_adaptive state (Madsen, Nielsen & Tingleff, "Methods for non-linear least squares problems", 2004).
+  double mu = 0.0, nu = 2.0;
+  if (o.method == Method::lm_adaptive) {
+    const double d = (J.transpose() * J).diagonal().maxCoeff();
+    mu = o.lambda_scale * (d > 0.0 && std::isfinite(d) ? d : 1.0);
+  }
+  const double lambda0 = o.method == Method::lm ? o.lambda : mu;
+  if (keep) s.history.push(q, F, e, 0.0, lambda0);
+
+  auto finish = [&](Status st) {
+    s.status = st;
+    s.q = q;
+    s.F = F;
+    s.error = e;
+    if constexpr (HasKnownSolutions<P>) s.solution = match_solution<N>(pb.known_solutions(), q, P::revolute, o.match_tolerance);
+  };
+  auto rcond_ok = [&](double rc) {
+    s.min_rcond = std::min(s.min_rcond, rc);
+    return !detail::too_singular(rc, o.rcond_min);
+  };
+
+  if (!detail::all_finite<N, M>(q, F)) return finish(Status::diverged);
+
+  if (o.method == Method::analytic) {
+    if constexpr (HasKnownSolutions<P>) {
+      const SolutionSet<N> set = pb.known_solutions();
+      if (set.count == 0) return finish(set.continuum ? Status::unsupported : Status::no_solution);
+      int best = 0;
+      double best_d = std::numeric_limits<double>::infinity();
+      for (int i = 0; i < set.count; ++i) {
+        const double d = joint_difference<N>(set.q[i], q0, P::revolute).norm();
+        if (d < best_d) best = i, best_d = d;
+      }
+      q = set.q[best];
+      pb.evaluate(q, F, J);
+      e = F.norm();
+      return finish(Status::converged);
+    } else {
+      return finish(Status::unsupported);
+    }
+  }
+  if (o.method == Method::halley || o.method == Method::halley_thesis) {
+    if constexpr (!HasSecondDerivatives<P>) return finish(Status::unsupported);
+    if (o.method == Method::halley_thesis && M != N) return finish(Status::unsupported);
+  }
+  if (e < o.tolerance) return finish(Status::converged);
+
+  detail::CycleWatch<N> watch;
+  watch.window = std::clamp(o.cycle_window, 0, detail::CycleWatch<N>::kCapacity - 1);
+  watch.push(q, 0.0, e);
+  watch.best_error = e;
+
+  VecN delta = VecN::Zero();
+  VecM Fn = VecM::Zero();  // lm_adaptive trial point
+  MatMN Jn = MatMN::Zero();
+  while (s.iterations < o.max_iter) {
+    double lambda_used = 0.0;
+    switch (o.method) {
+      case Method::newton: {
+        if (!rcond_ok(detail::newton_solve<M, N>(J, F, delta))) return finish(Status::singular);
+        delta = -delta;
+        break;
+      }
+      case Method::lm: {
+        MatNN A = J.transpose() * J;
+        A.diagonal().array() += o.lambda;
+        if (!rcond_ok(detail::rcond1<N>(A))) return finish(Status::singular);
+        const Eigen::LLT<MatNN> llt(A);
+        if (llt.info() != Eigen::Success) return finish(Status::singular);
+        delta = -llt.solve(J.transpose() * F);
+        lambda_used = o.lambda;
+        break;
+      }
+      case Method::lm_adaptive: {
+        const MatNN A = J.transpose() * J;
+        const VecN g = J.transpose() * F;
+        const double f2 = e * e;
+        for (;;) {  // trial steps until one is accepted
+          MatNN Am = A;
+          Am.diagonal().array() += mu;
+          if (!rcond_ok(detail::rcond1<N>(Am))) return finish(Status::singular);
+          const Eigen::LLT<MatNN> llt(Am);
+          if (llt.info() != Eigen::Success) return finish(Status::singular);
+          delta = -llt.solve(g);
+          if (!(delta.norm() >= o.step_floor)) return finish(Status::stalled);
+          pb.evaluate(q + delta, Fn, Jn);
+          const double en = Fn.norm();
+          const double predicted = delta.dot(mu * delta - g);  // 2 (L(0) - L(delta)) > 0
+          const double rho = std::isfinite(en) ? (f2 - en * en) / predicted : -1.0;
+          if (rho > 0.0) {
+            lambda_used = mu;
+            const double t = 2.0 * rho - 1.0;
+            mu *= std::max(1.0 / 3.0, 1.0 - t * t * t);
+            nu = 2.0;
+            break;
+          }
+          ++s.rejected;
+          mu *= nu;
+          nu *= 2.0;
+          if (!(mu < 1e300)) return finish(Status::stalled);
+        }
+        break;
+      }
+      case Method::halley_thesis: {
+        if constexpr (HasSecondDerivatives<P> && M == N) {
+          const SecondDerivatives<M, N> D = pb.second_derivatives(q);
+          MatNN Ht;  // H^T, H = dJ/dq1: H(i, j) = d2F_i/dq_j dq_1
+          for (int i = 0; i < M; ++i) Ht.col(i) = D[i].col(0);
+          if (!rcond_ok(detail::rcond1<N>(J))) return finish(Status::singular);
+          const Eigen::PartialPivLU<MatNN> lu(J);
+          const MatNN B = MatNN::Identity() - 0.5 * lu.solve(Ht);  // I - L/2, L = J^-1 H^T
+          if (!rcond_ok(detail::rcond1<N>(B))) return finish(Status::singular);
+          const Eigen::PartialPivLU<MatNN> luB(B);
+          delta = -luB.solve(lu.solve(F));
+        }
+        break;
+      }
+      case Method::halley: {
+        if constexpr (HasSecondDerivatives<P>) {
+          VecN a;
+          if (!rcond_ok(detail::newton_solve<M, N>(J, F, a))) return finish(Status::singular);
+          a = -a;  // the Newton step
+          const SecondDerivatives<M, N> D = pb.second_derivatives(q);
+          MatMN K = J;  // J + T[a] / 2, T[a]_ij = sum_k d2F_i/dq_j dq_k a_k
+          for (int i = 0; i < M; ++i) K.row(i) += 0.5 * (D[i] * a).transpose();
+          if (!rcond_ok(detail::newton_solve<M, N>(K, F, delta))) return finish(Status::singular);
+          delta = -delta;
+        }
+        break;
+      }
+      case Method::analytic:
+        break;  // handled above
+    }
+
+    const double step = delta.norm();
+    q += delta;
+    if (o.method == Method::lm_adaptive) {
+      F = Fn;
+      J = Jn;
+    } else {
+      pb.evaluate(q, F, J);
+    }
+    e = F.norm();
+    ++s.iterations;
+    if (keep) s.history.push(q, F, e, step, lambda_used);
+
+    if (!detail::all_finite<N, M>(q, F) || !(q.norm() <= o.divergence_bound)) return finish(Status::diverged);
+    if (e < o.tolerance) return finish(Status::converged);
+    if (!(step >= o.step_floor)) return finish(Status::stalled);
+    watch.push(q, step, e);
+    if (watch.window > 0 && watch.returned(P::revolute, o.cycle_tolerance)) return finish(Status::cycle);
+  }
+  finish(Status::max_iter);
+}
+
+template <int N, int M>
+std::string Summary<N, M>::brief() const {
+  char buf[256];
+  std::string out;
+  std::snprintf(buf, sizeof buf, "%s: %s after %d iteration%s", std::string(to_string(method)).c_str(),
+                std::string(to_string(status)).c_str(), iterations, iterations == 1 ? "" : "s");
+  out += buf;
+  if (rejected > 0) out += " (" + std::to_string(rejected) + " rejected)";
+  std::snprintf(buf, sizeof buf, ", |F| = %.3e, solution %d, min rcond %.2e, q = (", error, solution, min_rcond);
+  out += buf;
+  for (int j = 0; j < N; ++j) {
+    std::snprintf(buf, sizeof buf, "%s%.10g", j ? ", " : "", q[j]);
+    out += buf;
+  }
+  return out + ")";
+}
+
+template <int N, int M>
+std::string Summary<N, M>::report() const {
+  std::string out = brief() + "\n";
+  char buf[128];
+  out += "    k";
+  for (int j = 0; j < N; ++j) {
+    std::snprintf(buf, sizeof buf, "               q%d", j + 1);
+    out += buf;
+  }
+  out += "          |F|       |step|       lambda\n";
+  for (std::size_t k = 0; k < history.size(); ++k) {
+    std::snprintf(buf, sizeof buf, "%5zu", k);
+    out += buf;
+    for (int j = 0; j < N; ++j) {
+      std::snprintf(buf, sizeof buf, " %16.9f", history.q[k][j]);
+      out += buf;
+    }
+    std::snprintf(buf, sizeof buf, " %12.5e %12.5e %12.5e\n", history.error[k], history.step[k], history.lambda[k]);
+    out += buf;
+  }
+  return out;
+}
+
+template <int N, int M>
+std::ostream& operator<<(std::ostream& os, const Summary<N, M>& s) {
+  return os << s.brief();
+}
+
+}  // namespace ks::ik

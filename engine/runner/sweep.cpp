@@ -1,0 +1,276 @@
+#include "runner/sweep.hpp"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/info.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <ostream>
+
+#include "methods/seed_cases.hpp"
+#include "runner/landscape.hpp"
+
+namespace ks {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Job {
+  std::uint64_t id = 0;
+  RunRef ref;
+  Record row;
+  store::EncodedHistory history;
+};
+struct Batch {
+  std::vector<Job> jobs;
+};
+
+double as_f64(const Cell& c) {
+  if (const double* d = std::get_if<double>(&c)) return *d;
+  if (const std::int64_t* i = std::get_if<std::int64_t>(&c)) return static_cast<double>(*i);
+  return std::numeric_limits<double>::quiet_NaN();
+}
+const std::string& as_str(const Cell& c) {
+  static const std::string empty;
+  const std::string* s = std::get_if<std::string>(&c);
+  return s ? *s : empty;
+}
+
+/// The writer-side bookkeeping: landscapes, status counts, best rows, seed rows.
+class Accumulator {
+ public:
+  Accumulator(const Study& study, const StudySchema& schema) : study_(study), schema_(schema) {
+    for (std::size_t b = 0; b < study.blocks.size(); ++b) {
+      grids_.emplace_back(study.blocks[b]);
+      BlockReport r;
+      r.name = study.blocks[b].name();
+      r.kind = study.blocks[b].kind();
+      r.runs = study.blocks[b].run_count();
+      report_.blocks.push_back(std::move(r));
+    }
+    metric_ = [&](std::size_t b, std::string_view name) {
+      const auto& cols = metric_columns(study.blocks[b].kind());
+      for (std::size_t j = 0; j < cols.size(); ++j)
+        if (cols[j].name == name) return schema.metric_column[b][j];
+      return std::size_t(0);
+    };
+  }
+
+  void add(std::uint64_t id, const RunRef& ref, const Record& row) {
+    const Block& block = study_.blocks[ref.block];
+    BlockReport& br = report_.blocks[ref.block];
+    const std::string& status = as_str(row.cells[schema_.status]);
+    ++br.by_status[status];
+    grids_[ref.block].add(ref.local, row, schema_, ref.block);
+    const bool traj = block.kind() == BlockKind::trajectory;
+    const bool good = traj ? status == "ok" : status == "converged";
+    if (good) {
+      const double v = as_f64(row.cells[metric_(ref.block, traj ? "E" : "iterations")]);
+      consider_best(br, id, v, row, ref.block);
+    }
+    if (traj) {
+      const std::size_t pc = schema_.param_column[ref.block][block.column_index("preset")];
+      const std::string& preset = as_str(row.cells[pc]);
+      if (!preset.empty() && find_seed_case(preset) && report_.seed_rows.size() < 1000) {
+        SeedRow s;
+        s.preset = preset;
+        s.inertia = as_str(row.cells[schema_.param_column[ref.block][block.column_index("inertia")]]);
+        s.status = status;
+        s.E = as_f64(row.cells[metric_(ref.block, "E")]);
+        for (int j = 0; j < 3; ++j) s.tau[j] = as_f64(row.cells[metric_(ref.block, "tau" + std::to_string(j + 1) + "_inf")]);
+        seed_[id] = std::move(s);
+      }
+    }
+  }
+
+  SweepReport finish(store::ResultsWriter& writer) {
+    for (std::size_t b = 0; b < grids_.size(); ++b)
+      if (grids_[b].enabled()) writer.write_landscape(grids_[b].spec());
+    for (auto& [id, s] : seed_) report_.seed_rows.push_back(s);
+    return std::move(report_);
+  }
+
+  SweepReport& report() { return report_; }
+
+ private:
+  void consider_best(BlockReport& br, std::uint64_t id, double v, const Record& row, std::size_t b) {
+    if (!std::isfinite(v)) return;
+    if (br.best.size() == 3 && !(v < br.best.back().value)) return;
+    BestRun r{id, v, label(row, b)};
+    br.best.insert(std::upper_bound(br.best.begin(), br.best.end(), r,
+                                    [](const BestRun& a, const BestRun& c) {
+                                      return a.value < c.value || (a.value == c.value && a.run_id < c.run_id);
+                                    }),
+                   std::move(r));
+    if (br.best.size() > 3) br.best.pop_back();
+  }
+  /// The swept parameters of the run, in file units (angles in degrees).
+  std::string label(const Record& row, std::size_t b) const {
+    const Block& block = study_.blocks[b];
+    std::string out;
+    for (const Axis& a : block.axes()) {
+      const Cell& c = row.cells[schema_.param_column[b][block.column_index(a.name)]];
+      char buf[64];
+      if (const double* d = std::get_if<double>(&c))
+        std::snprintf(buf, sizeof buf, "%.6g", a.unit == "rad" ? *d * 180.0 / M_PI : *d);
+      else if (const std::int64_t* i = std::get_if<std::int64_t>(&c))
+        std::snprintf(buf, sizeof buf, "%lld", static_cast<long long>(*i));
+      else
+        std::snprintf(buf, sizeof buf, "%s", std::get<std::string>(c).c_str());
+      out += (out.empty() ? "" : ", ") + a.name + (a.unit == "rad" ? "[deg]=" : "=") + buf;
+    }
+    return out;
+  }
+
+  const Study& study_;
+  const StudySchema& schema_;
+  std::vector<LandscapeGrid> grids_;
+  SweepReport report_;
+  std::map<std::uint64_t, SeedRow> seed_;
+  std::function<std::size_t(std::size_t, std::string_view)> metric_;
+};
+
+}  // namespace
+
+PreviousRuns read_previous(const std::string& path, const StudySchema& schema) {
+  store::ResultsReader reader(path);
+  PreviousRuns p;
+  p.done = reader.done_mask();
+  for (const ColumnSpec& c : schema.columns) p.columns.push_back(reader.read_column(c.name));
+  return p;
+}
+
+SweepReport run_sweep(const Study& study, const StudySchema& schema, store::ResultsWriter& writer,
+                      const SweepOptions& options, const PreviousRuns* previous) {
+  const std::uint64_t total = study.run_count();
+  Accumulator acc(study, schema);
+  std::uint64_t skipped = 0;
+  if (previous) {
+    for (std::uint64_t id = 0; id < total && id < previous->done.size(); ++id) {
+      if (!previous->done[id]) continue;
+      Record r;
+      for (const auto& col : previous->columns) r.cells.push_back(col[id]);
+      acc.add(id, study.locate(id), r);
+      ++skipped;
+    }
+  }
+  const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
+  const int stride = options.histories.mode == HistoryPolicy::Mode::none ? 0
+                     : options.histories.mode == HistoryPolicy::Mode::every ? options.histories.stride
+                                                                              : 1;
+  tbb::enumerable_thread_specific<RunWorkspace> workspaces;
+  const auto start = Clock::now();
+  auto last_progress = start;
+  std::uint64_t next = 0, written = 0;
+  const std::uint64_t todo = total - skipped;
+  bool interrupted = false;
+  auto is_done = [&](std::uint64_t id) { return previous && id < previous->done.size() && previous->done[id]; };
+
+  tbb::task_arena arena(threads);
+  arena.execute([&] {
+    tbb::parallel_pipeline(
+        static_cast<std::size_t>(4 * threads),
+        tbb::make_filter<void, std::shared_ptr<Batch>>(
+            tbb::filter_mode::serial_in_order,
+            [&](tbb::flow_control& fc) -> std::shared_ptr<Batch> {
+              if (options.stop && options.stop->load()) interrupted = true;
+              auto b = std::make_shared<Batch>();
+              while (!interrupted && next < total && b->jobs.size() < options.batch) {
+                const std::uint64_t id = next++;
+                if (!is_done(id)) b->jobs.push_back(Job{id, study.locate(id), {}, {}});
+              }
+              if (b->jobs.empty()) {
+                fc.stop();
+                return nullptr;
+              }
+              return b;
+            }) &
+            tbb::make_filter<std::shared_ptr<Batch>, std::shared_ptr<Batch>>(
+                tbb::filter_mode::parallel,
+                [&](std::shared_ptr<Batch> b) {
+                  RunWorkspace& ws = workspaces.local();
+                  for (Job& j : b->jobs) {
+                    const Block& block = study.blocks[j.ref.block];
+                    const std::vector<Cell> params = block.params(j.ref.local);
+                    const auto t0 = Clock::now();
+                    RunOutcome o = execute_run(study, j.ref.block, params, stride, ws);
+                    const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+                    if (!o.history.arrays.empty()) j.history = store::encode_history(o.history, options.compression);
+                    j.row = schema.row(j.id, j.ref.block, block.name(), params, o, wall);
+                  }
+                  return b;
+                }) &
+            tbb::make_filter<std::shared_ptr<Batch>, void>(
+                tbb::filter_mode::serial_in_order, [&](std::shared_ptr<Batch> b) {
+                  for (Job& j : b->jobs) {
+                    writer.write_run(static_cast<std::int64_t>(j.id), j.row, j.history);
+                    acc.add(j.id, j.ref, j.row);
+                    ++written;
+                  }
+                  const auto now = Clock::now();
+                  if (options.on_progress &&
+                      std::chrono::duration<double>(now - last_progress).count() >= options.progress_interval_s) {
+                    last_progress = now;
+                    options.on_progress({written, todo, std::chrono::duration<double>(now - start).count()});
+                  }
+                }));
+  });
+  writer.flush();
+  if (options.on_progress) options.on_progress({written, todo, std::chrono::duration<double>(Clock::now() - start).count()});
+  SweepReport report;
+  if (!interrupted) {
+    report = acc.finish(writer);
+  } else {
+    report = std::move(acc.report());
+  }
+  report.total = total;
+  report.written = written;
+  report.skipped = skipped;
+  report.interrupted = interrupted;
+  report.elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return report;
+}
+
+void print_report(std::ostream& os, const Study& study, const SweepReport& r) {
+  char line[512];
+  std::snprintf(line, sizeof line, "%llu runs (%llu computed now, %llu already in the file) in %.2f s\n",
+                static_cast<unsigned long long>(r.total), static_cast<unsigned long long>(r.written),
+                static_cast<unsigned long long>(r.skipped), r.elapsed_s);
+  os << line;
+  for (const BlockReport& b : r.blocks) {
+    os << "block " << b.name << " (" << to_string(b.kind) << ", " << b.runs << " runs):";
+    for (const auto& [status, n] : b.by_status) os << ' ' << status << '=' << n;
+    os << '\n';
+    for (const BestRun& best : b.best) {
+      std::snprintf(line, sizeof line, "  best: run %llu  %s = %.6g  (%s)\n", static_cast<unsigned long long>(best.run_id),
+                    b.kind == BlockKind::trajectory ? "E [Nm]" : "iterations", best.value, best.label.c_str());
+      os << line;
+    }
+  }
+  if (!r.seed_rows.empty()) {
+    os << "\nSeed 000, Table 4: thesis vs kinesweep (E = mean |tau|, t1..t3 = max |tau_i|, in Nm; dev = worst "
+          "relative deviation)\n";
+    std::snprintf(line, sizeof line, "%-5s %-11s | %8s %8s %8s %7s | %8s %8s %8s %7s %7s | %s\n", "case", "inertia",
+                  "E", "t1", "t2", "t3", "E", "t1", "t2", "t3", "dev", "status");
+    os << "                  | thesis                              | kinesweep\n" << line;
+    for (const SeedRow& s : r.seed_rows) {
+      const SeedCase& c = *find_seed_case(s.preset);
+      double dev = std::abs(s.E / c.E - 1);
+      for (int j = 0; j < 3; ++j) dev = std::max(dev, std::abs(s.tau[j] / c.tau_inf[j] - 1));
+      std::snprintf(line, sizeof line, "%-5s %-11s | %8.2f %8.2f %8.2f %7.2f | %8.2f %8.2f %8.2f %7.2f %6.1f%% | %s\n",
+                    s.preset.c_str(), s.inertia.c_str(), c.E, c.tau_inf[0], c.tau_inf[1], c.tau_inf[2], s.E, s.tau[0],
+                    s.tau[1], s.tau[2], 100 * dev, s.status.c_str());
+      os << line;
+    }
+  }
+  (void)study;
+}
+
+}  // namespace ks

@@ -1,0 +1,83 @@
+#pragma once
+// The sweep: TBB tasks over run ids, one writer, bounded memory, landscapes and a summary.
+//
+// Data flow: a serial stage hands out batches of run ids (skipping the done ones when resuming);
+// parallel stages decode parameters, execute the runs and compress their histories (so the
+// single-threaded HDF5 filter pipeline never runs on the writer); a serial in-order stage writes
+// rows and histories, fills the landscape grids and reports progress. At most `4 x threads`
+// batches are in flight, whatever the number of runs.
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "runner/schema.hpp"
+#include "store/store.hpp"
+#include "study/study.hpp"
+
+namespace ks {
+
+struct SweepProgress {
+  std::uint64_t done = 0;      ///< runs written in this sweep
+  std::uint64_t todo = 0;      ///< runs this sweep has to write
+  double elapsed_s = 0.0;
+};
+
+struct SweepOptions {
+  int threads = 0;                   ///< worker threads (0: all cores)
+  HistoryPolicy histories;           ///< what to keep of each run's history
+  int compression = 4;               ///< zlib level of the histories (0..9)
+  std::size_t batch = 8;             ///< runs per pipeline token
+  const std::atomic<bool>* stop = nullptr;  ///< set (e.g. by SIGINT): finish the runs in flight and return
+  std::function<void(const SweepProgress&)> on_progress;  ///< called by the writer after each batch
+  double progress_interval_s = 0.25;  ///< minimum time between on_progress calls
+};
+
+/// One notable row for the summary.
+struct BestRun {
+  std::uint64_t run_id = 0;
+  double value = 0.0;    ///< E (trajectory) or iterations (ik)
+  std::string label;     ///< "method=..., alpha1A=..., k=..." or "method=..., lambda=..."
+};
+
+struct BlockReport {
+  std::string name;
+  BlockKind kind = BlockKind::trajectory;
+  std::uint64_t runs = 0;
+  std::map<std::string, std::uint64_t> by_status;  ///< over the whole block (resumed runs included)
+  std::vector<BestRun> best;                       ///< up to 3: lowest E among ok / fewest iterations among converged
+};
+
+/// A run whose preset names a row of seed 000's Table 4 (for the thesis-vs-kinesweep table).
+struct SeedRow {
+  std::string preset, inertia, status;
+  double E = 0, tau[3] = {0, 0, 0};
+};
+
+struct SweepReport {
+  std::uint64_t total = 0, written = 0, skipped = 0;
+  bool interrupted = false;
+  double elapsed_s = 0.0;
+  std::vector<BlockReport> blocks;
+  std::vector<SeedRow> seed_rows;  ///< in run-id order (sweeps that ran the seed presets)
+};
+
+/// What a results file already holds, read before resuming (closed again before writing).
+struct PreviousRuns {
+  std::vector<std::uint8_t> done;           ///< per run id
+  std::vector<std::vector<Cell>> columns;   ///< schema order, one cell per run id
+};
+/// Read the done mask and every column of an existing results file. Throws store::StoreError.
+PreviousRuns read_previous(const std::string& path, const StudySchema& schema);
+
+/// Run the runs of a study not done in `previous` (all when null) into `writer`, then write its
+/// landscapes. Throws store::StoreError when the store fails.
+SweepReport run_sweep(const Study& study, const StudySchema& schema, store::ResultsWriter& writer,
+                      const SweepOptions& options, const PreviousRuns* previous = nullptr);
+
+/// Print the summary (runs by status, best rows per block, the thesis comparison when present).
+void print_report(std::ostream& os, const Study& study, const SweepReport& report);
+
+}  // namespace ks

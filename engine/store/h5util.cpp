@@ -1,0 +1,122 @@
+#include "store/h5util.hpp"
+
+#include <cstring>
+
+namespace ks::store::detail {
+
+namespace {
+herr_t walk_cb(unsigned n, const H5E_error2_t* e, void* data) {
+  auto* out = static_cast<std::string*>(data);
+  if (n > 3) return 0;  // the innermost few messages carry the cause
+  if (!out->empty()) *out += "; ";
+  *out += e->desc ? e->desc : "?";
+  if (e->func_name) *out += std::string(" (") + e->func_name + ")";
+  return 0;
+}
+}  // namespace
+
+std::string h5_error_text() {
+  std::string out;
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, walk_cb, &out);
+  H5Eclear2(H5E_DEFAULT);
+  return out.empty() ? "HDF5 error" : out;
+}
+
+hid_t check(hid_t id, const std::string& path, const std::string& what) {
+  if (id < 0) throw StoreError(path, what + ": " + h5_error_text());
+  return id;
+}
+
+hid_t utf8_vlen_type() {
+  hid_t t = H5Tcopy(H5T_C_S1);
+  H5Tset_size(t, H5T_VARIABLE);
+  H5Tset_cset(t, H5T_CSET_UTF8);
+  return t;
+}
+
+void write_str_attr(hid_t obj, const char* name, const std::string& value) {
+  if (H5Aexists(obj, name) > 0) H5Adelete(obj, name);
+  Hid type(utf8_vlen_type());
+  Hid space(H5Screate(H5S_SCALAR));
+  Hid attr(H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT));
+  if (!attr.ok()) throw StoreError("", std::string("cannot create attribute ") + name + ": " + h5_error_text());
+  const char* p = value.c_str();
+  if (H5Awrite(attr, type, &p) < 0)
+    throw StoreError("", std::string("cannot write attribute ") + name + ": " + h5_error_text());
+}
+
+void write_i64_attr(hid_t obj, const char* name, std::int64_t value) {
+  if (H5Aexists(obj, name) > 0) H5Adelete(obj, name);
+  Hid space(H5Screate(H5S_SCALAR));
+  Hid attr(H5Acreate2(obj, name, H5T_STD_I64LE, space, H5P_DEFAULT, H5P_DEFAULT));
+  if (!attr.ok() || H5Awrite(attr, H5T_NATIVE_INT64, &value) < 0)
+    throw StoreError("", std::string("cannot write attribute ") + name + ": " + h5_error_text());
+}
+
+void write_str_list_attr(hid_t obj, const char* name, const std::vector<std::string>& values) {
+  if (H5Aexists(obj, name) > 0) H5Adelete(obj, name);
+  Hid type(utf8_vlen_type());
+  hsize_t n = values.size();
+  Hid space(H5Screate_simple(1, &n, nullptr));
+  Hid attr(H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT));
+  if (!attr.ok()) throw StoreError("", std::string("cannot create attribute ") + name + ": " + h5_error_text());
+  std::vector<const char*> ptrs;
+  for (auto& v : values) ptrs.push_back(v.c_str());
+  if (!values.empty() && H5Awrite(attr, type, ptrs.data()) < 0)
+    throw StoreError("", std::string("cannot write attribute ") + name + ": " + h5_error_text());
+}
+
+bool has_attr(hid_t obj, const char* name) { return H5Aexists(obj, name) > 0; }
+
+namespace {
+std::vector<std::string> read_strings(hid_t attr) {
+  std::vector<std::string> out;
+  Hid ftype(H5Aget_type(attr));
+  Hid space(H5Aget_space(attr));
+  hssize_t n = H5Sget_simple_extent_npoints(space);
+  if (n <= 0) return out;
+  if (H5Tis_variable_str(ftype) > 0) {
+    Hid mtype(utf8_vlen_type());
+    std::vector<char*> ptrs(static_cast<std::size_t>(n), nullptr);
+    if (H5Aread(attr, mtype, ptrs.data()) < 0) return out;
+    for (char* p : ptrs) out.emplace_back(p ? p : "");
+    H5Dvlen_reclaim(mtype, space, H5P_DEFAULT, ptrs.data());
+  } else {
+    std::size_t sz = H5Tget_size(ftype);
+    Hid mtype(H5Tcopy(H5T_C_S1));
+    H5Tset_size(mtype, sz);
+    std::vector<char> buf(sz * static_cast<std::size_t>(n));
+    if (H5Aread(attr, mtype, buf.data()) < 0) return out;
+    for (hssize_t i = 0; i < n; ++i) {
+      const char* p = buf.data() + static_cast<std::size_t>(i) * sz;
+      out.emplace_back(p, strnlen(p, sz));
+    }
+  }
+  return out;
+}
+}  // namespace
+
+std::string read_str_attr(hid_t obj, const char* name) {
+  if (H5Aexists(obj, name) <= 0) return {};
+  Hid attr(H5Aopen(obj, name, H5P_DEFAULT));
+  auto v = read_strings(attr);
+  return v.empty() ? std::string() : v.front();
+}
+
+std::int64_t read_i64_attr(hid_t obj, const char* name, std::int64_t fallback) {
+  if (H5Aexists(obj, name) <= 0) return fallback;
+  Hid attr(H5Aopen(obj, name, H5P_DEFAULT));
+  std::int64_t v = fallback;
+  if (H5Aread(attr, H5T_NATIVE_INT64, &v) < 0) return fallback;
+  return v;
+}
+
+std::vector<std::string> read_str_list_attr(hid_t obj, const char* name) {
+  if (H5Aexists(obj, name) <= 0) return {};
+  Hid attr(H5Aopen(obj, name, H5P_DEFAULT));
+  return read_strings(attr);
+}
+
+bool link_exists(hid_t loc, const std::string& path) { return H5Lexists(loc, path.c_str(), H5P_DEFAULT) > 0; }
+
+}  // namespace ks::store::detail

@@ -1,0 +1,74 @@
+#pragma once
+// Internal HDF5 helpers of the store (RAII ids, string attributes, error text). Only store/*.cpp.
+#include <hdf5.h>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "store/store.hpp"
+
+namespace ks::store::detail {
+
+/// Owns an HDF5 id; closes it with H5Idec_ref-like semantics via H5Oclose/H5Sclose/... by type.
+class Hid {
+ public:
+  Hid() = default;
+  explicit Hid(hid_t id) : id_(id) {}
+  Hid(Hid&& o) noexcept : id_(std::exchange(o.id_, -1)) {}
+  Hid& operator=(Hid&& o) noexcept {
+    if (this != &o) { reset(); id_ = std::exchange(o.id_, -1); }
+    return *this;
+  }
+  ~Hid() { reset(); }
+  void reset() {
+    if (id_ >= 0) {
+      switch (H5Iget_type(id_)) {
+        case H5I_FILE: H5Fclose(id_); break;
+        case H5I_GROUP: H5Gclose(id_); break;
+        case H5I_DATASET: H5Dclose(id_); break;
+        case H5I_DATASPACE: H5Sclose(id_); break;
+        case H5I_DATATYPE: H5Tclose(id_); break;
+        case H5I_ATTR: H5Aclose(id_); break;
+        case H5I_GENPROP_LST: H5Pclose(id_); break;
+        default: break;
+      }
+    }
+    id_ = -1;
+  }
+  hid_t get() const { return id_; }
+  hid_t release() { return std::exchange(id_, -1); }
+  operator hid_t() const { return id_; }
+  bool ok() const { return id_ >= 0; }
+
+ private:
+  hid_t id_ = -1;
+};
+
+/// Silences HDF5's automatic error printing for this thread while alive.
+struct QuietHdf5 {
+  H5E_auto2_t func = nullptr;
+  void* data = nullptr;
+  QuietHdf5() {
+    H5Eget_auto2(H5E_DEFAULT, &func, &data);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  ~QuietHdf5() { H5Eset_auto2(H5E_DEFAULT, func, data); }
+};
+
+/// The current HDF5 error stack as one line (and clears it).
+std::string h5_error_text();
+/// Throws StoreError(path, what + HDF5 error text) when id < 0 / rc < 0.
+hid_t check(hid_t id, const std::string& path, const std::string& what);
+
+hid_t utf8_vlen_type();  // caller closes
+void write_str_attr(hid_t obj, const char* name, const std::string& value);
+void write_i64_attr(hid_t obj, const char* name, std::int64_t value);
+void write_str_list_attr(hid_t obj, const char* name, const std::vector<std::string>& values);
+bool has_attr(hid_t obj, const char* name);
+std::string read_str_attr(hid_t obj, const char* name);  // "" when absent
+std::int64_t read_i64_attr(hid_t obj, const char* name, std::int64_t fallback);
+std::vector<std::string> read_str_list_attr(hid_t obj, const char* name);
+bool link_exists(hid_t loc, const std::string& path);
+
+}  // namespace ks::store::detail

@@ -1,0 +1,525 @@
+// The "ksjournal" HDF5 virtual file driver: a redo journal under HDF5 (see journal_vfd.hpp, FORMAT.md).
+//
+// Invariant: between two commits the bytes of the results file below `committed` (its size at the
+// last commit) are never modified. Writes below it go to an in-memory page overlay (and reads see
+// the overlay); writes at or above it go straight to the file (they are beyond the committed EOA,
+// so no committed structure points at them). A commit (the driver's flush callback, i.e. the end
+// of every H5Fflush/H5Fclose) writes the overlay pages plus a checksummed trailer to the journal,
+// then applies them to the file, then resets the journal. A kill before the trailer is complete
+// leaves the file untouched below `committed` (recovery just truncates the appended bytes); a kill
+// after it is replayed by recover() (idempotent).
+#include "store/journal_vfd.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <random>
+#include <vector>
+
+namespace ks::store::detail {
+namespace {
+
+constexpr std::uint64_t kPage = 4096;
+constexpr char kHeadMagic[8] = {'K', 'S', 'J', 'R', 'N', 'L', '0', '1'};
+constexpr char kTailMagic[8] = {'K', 'S', 'J', 'C', 'M', 'T', '0', '1'};
+constexpr std::size_t kHeadSize = 48;  // magic, dev, ino, committed size, commit sequence, session id
+constexpr std::size_t kTailSize = 32;  // magic, n records, new size, crc32 (+4 pad)
+
+thread_local std::string g_last_error;
+
+void set_error(const std::string& what, int err) {
+  g_last_error = what + (err ? std::string(": ") + std::strerror(err) : std::string());
+}
+
+bool write_all(int fd, const void* buf, std::size_t n, std::uint64_t off) {
+  auto p = static_cast<const unsigned char*>(buf);
+  while (n > 0) {
+    ssize_t w = ::pwrite(fd, p, n, static_cast<off_t>(off));
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    if (w == 0) { errno = EIO; return false; }
+    p += w; n -= static_cast<std::size_t>(w); off += static_cast<std::uint64_t>(w);
+  }
+  return true;
+}
+
+/// Reads n bytes at off; bytes past end of file read as zero.
+bool read_all(int fd, void* buf, std::size_t n, std::uint64_t off) {
+  auto p = static_cast<unsigned char*>(buf);
+  while (n > 0) {
+    ssize_t r = ::pread(fd, p, n, static_cast<off_t>(off));
+    if (r < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    if (r == 0) { std::memset(p, 0, n); return true; }
+    p += r; n -= static_cast<std::size_t>(r); off += static_cast<std::uint64_t>(r);
+  }
+  return true;
+}
+
+void put64(unsigned char* p, std::uint64_t v) { std::memcpy(p, &v, 8); }
+std::uint64_t get64(const unsigned char* p) { std::uint64_t v; std::memcpy(&v, p, 8); return v; }
+
+std::vector<unsigned char> make_header(std::uint64_t dev, std::uint64_t ino, std::uint64_t committed,
+                                       std::uint64_t seq, std::uint64_t session) {
+  std::vector<unsigned char> h(kHeadSize);
+  std::memcpy(h.data(), kHeadMagic, 8);
+  put64(h.data() + 8, dev); put64(h.data() + 16, ino); put64(h.data() + 24, committed);
+  put64(h.data() + 32, seq); put64(h.data() + 40, session);
+  return h;
+}
+
+bool reset_journal(int jfd, std::uint64_t dev, std::uint64_t ino, std::uint64_t committed, std::uint64_t seq,
+                   std::uint64_t session) {
+  // Header first, then drop the old records: a kill in between leaves a header whose (old,
+  // still valid) commit is replayed again, which is harmless.
+  auto h = make_header(dev, ino, committed, seq, session);
+  if (!write_all(jfd, h.data(), h.size(), 0)) return false;
+  return ::ftruncate(jfd, static_cast<off_t>(kHeadSize)) == 0;
+}
+
+struct Parsed {
+  bool header_ok = false;   // magic and file identity match
+  std::uint64_t committed = 0;
+  bool commit_ok = false;   // a complete trailer with matching checksum
+  std::uint64_t new_size = 0;
+  std::vector<std::pair<std::uint64_t, std::vector<unsigned char>>> records;
+};
+
+Parsed parse_journal(int jfd, std::uint64_t dev, std::uint64_t ino) {
+  Parsed out;
+  struct stat st{};
+  if (::fstat(jfd, &st) != 0 || static_cast<std::size_t>(st.st_size) < kHeadSize) return out;
+  std::vector<unsigned char> buf(static_cast<std::size_t>(st.st_size));
+  if (!read_all(jfd, buf.data(), buf.size(), 0)) return out;
+  if (std::memcmp(buf.data(), kHeadMagic, 8) != 0 || get64(buf.data() + 8) != dev ||
+      get64(buf.data() + 16) != ino)
+    return out;
+  out.header_ok = true;
+  out.committed = get64(buf.data() + 24);
+  std::size_t pos = kHeadSize;
+  uLong crc = crc32(0L, Z_NULL, 0);
+  std::uint64_t n = 0;
+  while (pos + 16 <= buf.size()) {
+    if (std::memcmp(buf.data() + pos, kTailMagic, 8) == 0) {
+      if (pos + kTailSize > buf.size()) break;
+      std::uint64_t nrec = get64(buf.data() + pos + 8), nsize = get64(buf.data() + pos + 16);
+      std::uint32_t stored; std::memcpy(&stored, buf.data() + pos + 24, 4);
+      crc = crc32(crc, buf.data() + pos + 8, 16);
+      if (nrec == n && static_cast<std::uint32_t>(crc) == stored) {
+        out.commit_ok = true;
+        out.new_size = nsize;
+      }
+      break;
+    }
+    std::uint64_t addr = get64(buf.data() + pos), len = get64(buf.data() + pos + 8);
+    if (len > kPage || pos + 16 + len > buf.size()) break;
+    crc = crc32(crc, buf.data() + pos, static_cast<uInt>(16 + len));
+    out.records.emplace_back(addr, std::vector<unsigned char>(buf.begin() + static_cast<long>(pos + 16),
+                                                              buf.begin() + static_cast<long>(pos + 16 + len)));
+    pos += 16 + len;
+    ++n;
+  }
+  if (!out.commit_ok) out.records.clear();
+  return out;
+}
+
+/// With the journal locked: bring the data file to its last committed state. Returns false on I/O error.
+bool recover_locked(int fd, int jfd, std::uint64_t dev, std::uint64_t ino, bool* replayed) {
+  *replayed = false;
+  Parsed p = parse_journal(jfd, dev, ino);
+  if (!p.header_ok) return true;  // no journal content, or a stale journal of another file
+  struct stat st{};
+  if (::fstat(fd, &st) != 0) return false;
+  std::uint64_t size = static_cast<std::uint64_t>(st.st_size);
+  if (p.commit_ok) {
+    for (auto& [addr, bytes] : p.records)
+      if (!write_all(fd, bytes.data(), bytes.size(), addr)) return false;
+    if (size > p.new_size && ::ftruncate(fd, static_cast<off_t>(p.new_size)) != 0) return false;
+    *replayed = true;
+  } else if (size > p.committed) {
+    // bytes appended after the last commit: nothing committed points at them
+    if (::ftruncate(fd, static_cast<off_t>(p.committed)) != 0) return false;
+  }
+  return true;
+}
+
+// ------------------------------------------------------------------------------------------------
+struct JFile {
+  H5FD_t pub;  // must be first
+  int fd = -1, jfd = -1;
+  std::uint64_t dev = 0, ino = 0;
+  haddr_t eoa = 0;
+  std::uint64_t eof = 0;        // physical size
+  std::uint64_t committed = 0;  // physical size at the last commit
+  std::uint64_t seq = 0, session = 0;  // commits in this session; random id of this writer session
+  bool durable = false;
+  bool poisoned = false;        // an I/O error happened: never commit again (the journal stays)
+  std::string path;
+  std::map<std::uint64_t, std::vector<unsigned char>> pages;  // page number -> kPage bytes
+  // Test hook (crash-safety tests only): KS_STORE_TEST_CRASH="<n>:<phase>" makes the process
+  // _exit(86) during its n-th commit, phase = journal_half | journal_done | apply_half.
+  long crash_commit = -1, commits = 0;
+  std::string crash_phase;
+};
+
+void maybe_crash(JFile* f, const char* phase) {
+  if (f->commits == f->crash_commit && f->crash_phase == phase) ::_exit(86);
+}
+
+struct JFapl {
+  int durable;
+};
+
+std::vector<unsigned char>* page_for(JFile* f, std::uint64_t pno) {
+  auto it = f->pages.find(pno);
+  if (it != f->pages.end()) return &it->second;
+  std::vector<unsigned char> pg(kPage);
+  if (!read_all(f->fd, pg.data(), kPage, pno * kPage)) return nullptr;
+  return &f->pages.emplace(pno, std::move(pg)).first->second;
+}
+
+void* j_fapl_get(H5FD_t* file) {
+  auto* f = reinterpret_cast<JFile*>(file);
+  auto* fa = static_cast<JFapl*>(std::malloc(sizeof(JFapl)));
+  fa->durable = f->durable ? 1 : 0;
+  return fa;
+}
+void* j_fapl_copy(const void* old) {
+  auto* fa = static_cast<JFapl*>(std::malloc(sizeof(JFapl)));
+  std::memcpy(fa, old, sizeof(JFapl));
+  return fa;
+}
+herr_t j_fapl_free(void* fa) { std::free(fa); return 0; }
+
+H5FD_t* j_open(const char* name, unsigned flags, hid_t fapl, haddr_t /*maxaddr*/) {
+  if (!(flags & H5F_ACC_RDWR) || (flags & (H5F_ACC_TRUNC | H5F_ACC_CREAT))) {
+    set_error("ksjournal driver opens existing files for writing only", 0);
+    return nullptr;
+  }
+  bool durable = false;
+  if (const void* info = H5Pget_driver_info(fapl)) durable = static_cast<const JFapl*>(info)->durable != 0;
+  auto* f = new JFile();
+  std::memset(&f->pub, 0, sizeof(H5FD_t));
+  f->path = name;
+  f->durable = durable;
+  if (const char* c = std::getenv("KS_STORE_TEST_CRASH")) {
+    std::string spec(c);
+    auto colon = spec.find(':');
+    if (colon != std::string::npos) {
+      f->crash_commit = std::atol(spec.substr(0, colon).c_str());
+      f->crash_phase = spec.substr(colon + 1);
+    }
+  }
+  f->fd = ::open(name, O_RDWR | O_CLOEXEC);
+  if (f->fd < 0) { set_error("cannot open " + f->path + " for writing", errno); delete f; return nullptr; }
+  const std::string jp = journal_path(name);
+  f->jfd = ::open(jp.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (f->jfd < 0) {
+    set_error("cannot create journal " + jp, errno);
+    ::close(f->fd); delete f; return nullptr;
+  }
+  int tries = 0;  // a reader may hold the lock for a moment while it checks the journal
+  while (::flock(f->jfd, LOCK_EX | LOCK_NB) != 0 && ++tries < 20) ::usleep(50000);
+  if (tries >= 20) {
+    set_error("results file is being written by another process (journal " + jp + " is locked)", 0);
+    ::close(f->jfd); ::close(f->fd); delete f; return nullptr;
+  }
+  struct stat st{};
+  ::fstat(f->fd, &st);
+  f->dev = static_cast<std::uint64_t>(st.st_dev);
+  f->ino = static_cast<std::uint64_t>(st.st_ino);
+  bool replayed = false;
+  if (!recover_locked(f->fd, f->jfd, f->dev, f->ino, &replayed)) {
+    set_error("cannot recover " + f->path + " from its journal", errno);
+    ::close(f->jfd); ::close(f->fd); delete f; return nullptr;
+  }
+  ::fstat(f->fd, &st);
+  f->eof = f->committed = static_cast<std::uint64_t>(st.st_size);
+  f->session = (static_cast<std::uint64_t>(std::random_device{}()) << 32) ^ std::random_device{}() ^
+               static_cast<std::uint64_t>(::getpid());
+  if ((durable && ::fsync(f->fd) != 0) || !reset_journal(f->jfd, f->dev, f->ino, f->committed, 0, f->session) ||
+      (durable && ::fsync(f->jfd) != 0)) {
+    set_error("cannot write journal " + jp, errno);
+    ::close(f->jfd); ::close(f->fd); delete f; return nullptr;
+  }
+  return &f->pub;
+}
+
+bool commit_impl(JFile* f) {
+  struct stat st{};
+  if (::fstat(f->fd, &st) != 0) return false;
+  const std::uint64_t new_size = std::max<std::uint64_t>(f->eof, static_cast<std::uint64_t>(st.st_size));
+  if (f->pages.empty() && new_size == f->committed) return true;
+  if (f->durable && ::fdatasync(f->fd) != 0) return false;  // appended data before the commit record
+  std::vector<unsigned char> buf;
+  buf.reserve(f->pages.size() * (kPage + 16) + kTailSize);
+  uLong crc = crc32(0L, Z_NULL, 0);
+  std::uint64_t n = 0;
+  for (auto& [pno, pg] : f->pages) {
+    const std::uint64_t addr = pno * kPage;
+    if (addr >= f->committed) continue;
+    const std::uint64_t len = std::min<std::uint64_t>(kPage, f->committed - addr);  // never above committed
+    unsigned char rh[16];
+    put64(rh, addr); put64(rh + 8, len);
+    const std::size_t at = buf.size();
+    buf.insert(buf.end(), rh, rh + 16);
+    buf.insert(buf.end(), pg.begin(), pg.begin() + static_cast<long>(len));
+    crc = crc32(crc, buf.data() + at, static_cast<uInt>(16 + len));
+    ++n;
+  }
+  unsigned char tail[kTailSize] = {};
+  std::memcpy(tail, kTailMagic, 8);
+  put64(tail + 8, n); put64(tail + 16, new_size);
+  crc = crc32(crc, tail + 8, 16);
+  const std::uint32_t c32 = static_cast<std::uint32_t>(crc);
+  std::memcpy(tail + 24, &c32, 4);
+  buf.insert(buf.end(), tail, tail + kTailSize);
+  ++f->commits;
+  if (f->commits == f->crash_commit && f->crash_phase == "journal_half") {
+    write_all(f->jfd, buf.data(), buf.size() / 2, kHeadSize);
+    ::_exit(86);
+  }
+  if (!write_all(f->jfd, buf.data(), buf.size(), kHeadSize)) return false;
+  if (f->durable && ::fdatasync(f->jfd) != 0) return false;
+  maybe_crash(f, "journal_done");
+  // the commit point has passed: apply
+  std::size_t applied = 0;
+  for (auto& [pno, pg] : f->pages) {
+    if (applied++ == f->pages.size() / 2) maybe_crash(f, "apply_half");
+    const std::uint64_t addr = pno * kPage;
+    if (addr >= f->committed) continue;
+    const std::uint64_t len = std::min<std::uint64_t>(kPage, f->committed - addr);
+    if (!write_all(f->fd, pg.data(), len, addr)) return false;
+  }
+  if (f->durable && ::fdatasync(f->fd) != 0) return false;
+  if (!reset_journal(f->jfd, f->dev, f->ino, new_size, f->seq + 1, f->session)) return false;
+  ++f->seq;
+  f->committed = new_size;
+  f->eof = new_size;
+  f->pages.clear();
+  return true;
+}
+
+bool commit(JFile* f) {
+  if (f->poisoned) return false;
+  if (!commit_impl(f)) { f->poisoned = true; return false; }
+  return true;
+}
+
+herr_t j_close(H5FD_t* file) {
+  auto* f = reinterpret_cast<JFile*>(file);
+  herr_t rc = 0;
+  if (!commit(f)) { set_error("commit failed on close of " + f->path, errno); rc = -1; }
+  if (rc == 0) ::unlink(journal_path(f->path).c_str());  // clean close: nothing to recover
+  ::close(f->fd);
+  ::close(f->jfd);  // releases the lock
+  delete f;
+  return rc;
+}
+
+int j_cmp(const H5FD_t* a, const H5FD_t* b) {
+  auto* f1 = reinterpret_cast<const JFile*>(a);
+  auto* f2 = reinterpret_cast<const JFile*>(b);
+  if (f1->dev != f2->dev) return f1->dev < f2->dev ? -1 : 1;
+  if (f1->ino != f2->ino) return f1->ino < f2->ino ? -1 : 1;
+  return 0;
+}
+
+herr_t j_query(const H5FD_t*, unsigned long* flags) {
+  *flags = H5FD_FEAT_AGGREGATE_METADATA | H5FD_FEAT_ACCUMULATE_METADATA | H5FD_FEAT_DATA_SIEVE |
+           H5FD_FEAT_AGGREGATE_SMALLDATA;
+  return 0;
+}
+
+haddr_t j_get_eoa(const H5FD_t* file, H5FD_mem_t) { return reinterpret_cast<const JFile*>(file)->eoa; }
+herr_t j_set_eoa(H5FD_t* file, H5FD_mem_t, haddr_t addr) { reinterpret_cast<JFile*>(file)->eoa = addr; return 0; }
+haddr_t j_get_eof(const H5FD_t* file, H5FD_mem_t) { return reinterpret_cast<const JFile*>(file)->eof; }
+herr_t j_get_handle(H5FD_t* file, hid_t, void** handle) { *handle = &reinterpret_cast<JFile*>(file)->fd; return 0; }
+
+herr_t j_read(H5FD_t* file, H5FD_mem_t, hid_t, haddr_t addr, size_t size, void* buffer) {
+  auto* f = reinterpret_cast<JFile*>(file);
+  auto* out = static_cast<unsigned char*>(buffer);
+  std::uint64_t a = addr;
+  while (size > 0) {
+    if (a >= f->committed) {
+      if (!read_all(f->fd, out, size, a)) return -1;
+      return 0;
+    }
+    const std::uint64_t pno = a / kPage, in = a % kPage;
+    std::size_t len = static_cast<std::size_t>(std::min<std::uint64_t>({size, kPage - in, f->committed - a}));
+    auto it = f->pages.find(pno);
+    if (it != f->pages.end()) std::memcpy(out, it->second.data() + in, len);
+    else if (!read_all(f->fd, out, len, a)) return -1;
+    out += len; a += len; size -= len;
+  }
+  return 0;
+}
+
+herr_t j_write(H5FD_t* file, H5FD_mem_t, hid_t, haddr_t addr, size_t size, const void* buffer) {
+  auto* f = reinterpret_cast<JFile*>(file);
+  auto* in = static_cast<const unsigned char*>(buffer);
+  std::uint64_t a = addr;
+  while (size > 0) {
+    if (a >= f->committed) {
+      if (!write_all(f->fd, in, size, a)) {
+        set_error("write to " + f->path + " failed", errno);
+        f->poisoned = true;
+        return -1;
+      }
+      f->eof = std::max<std::uint64_t>(f->eof, a + size);
+      return 0;
+    }
+    const std::uint64_t pno = a / kPage, off = a % kPage;
+    std::size_t len = static_cast<std::size_t>(std::min<std::uint64_t>({size, kPage - off, f->committed - a}));
+    auto* pg = page_for(f, pno);
+    if (!pg) { f->poisoned = true; return -1; }
+    std::memcpy(pg->data() + off, in, len);
+    in += len; a += len; size -= len;
+  }
+  return 0;
+}
+
+herr_t j_flush(H5FD_t* file, hid_t, hbool_t) {
+  auto* f = reinterpret_cast<JFile*>(file);
+  if (!commit(f)) { set_error("commit of " + f->path + " failed", errno); return -1; }
+  return 0;
+}
+
+herr_t j_truncate(H5FD_t* file, hid_t, hbool_t) {
+  auto* f = reinterpret_cast<JFile*>(file);
+  // Grow to the EOA when needed; never shrink below the committed size (committed readers need it).
+  const std::uint64_t want = std::max<std::uint64_t>(f->eoa, f->committed);
+  if (want > f->eof) {
+    if (::ftruncate(f->fd, static_cast<off_t>(want)) != 0) { set_error("ftruncate " + f->path, errno); return -1; }
+    f->eof = want;
+  } else if (want < f->eof) {
+    if (::ftruncate(f->fd, static_cast<off_t>(want)) != 0) { set_error("ftruncate " + f->path, errno); return -1; }
+    f->eof = want;
+  }
+  return 0;
+}
+
+herr_t j_lock(H5FD_t*, hbool_t) { return 0; }  // the journal lock is the writer lock; readers stay free
+herr_t j_unlock(H5FD_t*) { return 0; }
+
+H5FD_class_t make_class() {
+  H5FD_class_t c;
+  std::memset(&c, 0, sizeof(c));
+  c.name = "ksjournal";
+  c.maxaddr = static_cast<haddr_t>(1) << 62;
+  c.fc_degree = H5F_CLOSE_WEAK;
+  c.fapl_size = sizeof(JFapl);
+  c.fapl_get = j_fapl_get;
+  c.fapl_copy = j_fapl_copy;
+  c.fapl_free = j_fapl_free;
+  c.open = j_open;
+  c.close = j_close;
+  c.cmp = j_cmp;
+  c.query = j_query;
+  c.get_eoa = j_get_eoa;
+  c.set_eoa = j_set_eoa;
+  c.get_eof = j_get_eof;
+  c.get_handle = j_get_handle;
+  c.read = j_read;
+  c.write = j_write;
+  c.flush = j_flush;
+  c.truncate = j_truncate;
+  c.lock = j_lock;
+  c.unlock = j_unlock;
+  H5FD_mem_t map[H5FD_MEM_NTYPES] = H5FD_FLMAP_DICHOTOMY;
+  std::memcpy(c.fl_map, map, sizeof(map));
+  return c;
+}
+
+const H5FD_class_t g_class = make_class();
+
+}  // namespace
+
+hid_t journal_driver_id() {
+  static std::mutex m;
+  static hid_t id = -1;
+  std::lock_guard<std::mutex> lk(m);
+  if (id < 0 || H5Iis_valid(id) <= 0) id = H5FDregister(&g_class);
+  return id;
+}
+
+hid_t make_journal_fapl(bool durable) {
+  hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+  JFapl fa{durable ? 1 : 0};
+  H5Pset_driver(fapl, journal_driver_id(), &fa);
+  return fapl;
+}
+
+std::string journal_path(const std::string& results_path) { return results_path + ".journal"; }
+
+std::string journal_last_error() { return g_last_error; }
+
+RecoverOutcome recover(const std::string& results_path) {
+  const std::string jp = journal_path(results_path);
+  int jfd = ::open(jp.c_str(), O_RDWR | O_CLOEXEC);
+  if (jfd < 0) return errno == ENOENT ? RecoverOutcome::no_journal : RecoverOutcome::not_permitted;
+  if (::flock(jfd, LOCK_EX | LOCK_NB) != 0) { ::close(jfd); return RecoverOutcome::writer_alive; }
+  int fd = ::open(results_path.c_str(), O_RDWR | O_CLOEXEC);
+  if (fd < 0) {
+    ::close(jfd);
+    if (errno == ENOENT) { ::unlink(jp.c_str()); return RecoverOutcome::clean; }  // orphan journal
+    return RecoverOutcome::not_permitted;
+  }
+  struct stat st{};
+  ::fstat(fd, &st);
+  bool replayed = false;
+  bool ok = recover_locked(fd, jfd, static_cast<std::uint64_t>(st.st_dev), static_cast<std::uint64_t>(st.st_ino),
+                           &replayed);
+  if (ok) ::unlink(jp.c_str());
+  ::close(fd);
+  ::close(jfd);
+  if (!ok) return RecoverOutcome::not_permitted;
+  return replayed ? RecoverOutcome::replayed : RecoverOutcome::clean;
+}
+
+std::string consistency_stamp(const std::string& results_path) {
+  int jfd = ::open(journal_path(results_path).c_str(), O_RDONLY | O_CLOEXEC);
+  if (jfd < 0) {  // no writer: the file's own size and mtime
+    struct stat st{};
+    if (::stat(results_path.c_str(), &st) != 0) return {};
+    return "static:" + std::to_string(st.st_size) + ":" + std::to_string(st.st_mtim.tv_sec) + "." +
+           std::to_string(st.st_mtim.tv_nsec);
+  }
+  std::string out;
+  struct stat st{};
+  if (::fstat(jfd, &st) == 0 && static_cast<std::size_t>(st.st_size) == kHeadSize) {
+    std::vector<unsigned char> h(kHeadSize);
+    if (read_all(jfd, h.data(), kHeadSize, 0) && std::memcmp(h.data(), kHeadMagic, 8) == 0)
+      out = "journal:" + std::string(h.begin(), h.end());
+  }
+  ::close(jfd);
+  return out;  // empty: a commit is in progress
+}
+
+bool journal_has_pending_commit(const std::string& results_path) {
+  int jfd = ::open(journal_path(results_path).c_str(), O_RDONLY | O_CLOEXEC);
+  if (jfd < 0) return false;
+  struct stat st{};
+  bool pending = false;
+  if (::stat(results_path.c_str(), &st) == 0) {
+    Parsed p = parse_journal(jfd, static_cast<std::uint64_t>(st.st_dev), static_cast<std::uint64_t>(st.st_ino));
+    pending = p.commit_ok;
+  }
+  ::close(jfd);
+  return pending;
+}
+
+}  // namespace ks::store::detail

@@ -1,0 +1,270 @@
+// ResultsReader (see store.hpp, FORMAT.md).
+#include <unistd.h>
+
+#include <cmath>
+#include <limits>
+
+#include "store/h5util.hpp"
+#include "store/journal_vfd.hpp"
+#include "store/store.hpp"
+
+namespace ks::store {
+using namespace detail;
+
+struct ResultsReader::Impl {
+  std::string path;
+  Hid file;
+  StoreMeta meta;
+  std::vector<ColumnSpec> columns;
+  std::int64_t n_runs = 0;
+  std::string stamp;  // consistency stamp at open
+
+  void load() {
+    hid_t f = file;
+    meta.format = read_str_attr(f, "format");
+    if (meta.format != kFormatName)
+      throw StoreError(path, "not a kinesweep results file (attribute format = '" + meta.format + "')");
+    meta.format_version = read_i64_attr(f, "format_version", -1);
+    if (meta.format_version != kFormatVersion)
+      throw StoreError(path, "unsupported format_version " + std::to_string(meta.format_version));
+    meta.engine_version = read_str_attr(f, "engine_version");
+    meta.study_sha256 = read_str_attr(f, "study_sha256");
+    meta.created = read_str_attr(f, "created");
+    meta.study_name = read_str_attr(f, "study_name");
+    Hid study(check(H5Gopen2(f, "study", H5P_DEFAULT), path, "open /study"));
+    meta.study_path = read_str_attr(study, "path");
+    {
+      Hid d(check(H5Dopen2(study, "text", H5P_DEFAULT), path, "open /study/text"));
+      Hid t(utf8_vlen_type());
+      Hid s(H5Dget_space(d));
+      char* p = nullptr;
+      check(H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, &p), path, "read /study/text");
+      meta.study_text = p ? p : "";
+      H5Dvlen_reclaim(t, s, H5P_DEFAULT, &p);
+    }
+    Hid runs(check(H5Gopen2(f, "runs", H5P_DEFAULT), path, "open /runs"));
+    n_runs = read_i64_attr(runs, "n_runs", -1);
+    for (auto& name : read_str_list_attr(runs, "columns")) {
+      Hid d(check(H5Dopen2(runs, name.c_str(), H5P_DEFAULT), path, "open /runs/" + name));
+      Hid t(H5Dget_type(d));
+      ColumnSpec c;
+      c.name = name;
+      H5T_class_t cls = H5Tget_class(t);
+      c.type = cls == H5T_FLOAT ? CellType::f64 : cls == H5T_INTEGER ? CellType::i64 : CellType::str;
+      c.unit = read_str_attr(d, "unit");
+      c.description = read_str_attr(d, "description");
+      columns.push_back(std::move(c));
+    }
+    if (n_runs < 0) {
+      Hid d(check(H5Dopen2(runs, "done", H5P_DEFAULT), path, "open /runs/done"));
+      n_runs = H5Sget_simple_extent_npoints(Hid(H5Dget_space(d)));
+    }
+  }
+
+  const ColumnSpec& column(const std::string& name) const {
+    for (auto& c : columns)
+      if (c.name == name) return c;
+    throw StoreError(path, "no column '" + name + "'");
+  }
+
+  /// Reads `count` rows from `first` of a /runs dataset into typed storage.
+  template <class T>
+  std::vector<T> read_num(const std::string& name, hid_t mtype, hsize_t first, hsize_t count) const {
+    std::vector<T> out(count);
+    if (count == 0) return out;
+    Hid d(check(H5Dopen2(file, ("runs/" + name).c_str(), H5P_DEFAULT), path, "open /runs/" + name));
+    Hid fs(H5Dget_space(d));
+    H5Sselect_hyperslab(fs, H5S_SELECT_SET, &first, nullptr, &count, nullptr);
+    Hid ms(H5Screate_simple(1, &count, nullptr));
+    check(H5Dread(d, mtype, ms, fs, H5P_DEFAULT, out.data()), path, "read /runs/" + name);
+    return out;
+  }
+  std::vector<std::string> read_strs(const std::string& name, hsize_t first, hsize_t count) const {
+    std::vector<std::string> out;
+    if (count == 0) return out;
+    Hid d(check(H5Dopen2(file, ("runs/" + name).c_str(), H5P_DEFAULT), path, "open /runs/" + name));
+    Hid fs(H5Dget_space(d));
+    H5Sselect_hyperslab(fs, H5S_SELECT_SET, &first, nullptr, &count, nullptr);
+    Hid ms(H5Screate_simple(1, &count, nullptr));
+    Hid t(utf8_vlen_type());
+    std::vector<char*> ptrs(count, nullptr);
+    check(H5Dread(d, t, ms, fs, H5P_DEFAULT, ptrs.data()), path, "read /runs/" + name);
+    out.reserve(count);
+    for (char* p : ptrs) out.emplace_back(p ? p : "");
+    H5Dvlen_reclaim(t, ms, H5P_DEFAULT, ptrs.data());
+    return out;
+  }
+};
+
+ResultsReader::ResultsReader(const std::string& path) : impl_(std::make_unique<Impl>()) {
+  impl_->path = path;
+  refresh();
+}
+
+void ResultsReader::refresh() {
+  QuietHdf5 quiet;
+  const std::string path = impl_->path;
+  impl_->file.reset();
+  if (::access(path.c_str(), F_OK) != 0) throw StoreError(path, "no such file");
+  // After a crashed writer, bring the file to its last committed state (no-op while a writer lives).
+  recover(path);
+  // Open between two commits of a live writer: the same consistency stamp before and after.
+  std::string last;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    if (attempt) ::usleep(attempt < 10 ? 2000 : 20000);
+    const std::string before = consistency_stamp(path);
+    if (before.empty() && attempt < 99) continue;  // a commit is being applied
+    Hid fapl(H5Pcreate(H5P_FILE_ACCESS));
+    hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl);
+    if (f < 0) { last = h5_error_text(); continue; }
+    impl_->file = Hid(f);
+    try {
+      impl_->columns.clear();
+      impl_->meta = StoreMeta{};
+      impl_->load();
+    } catch (const StoreError& e) {
+      last = e.cause();
+      impl_->file.reset();
+      if (e.cause().rfind("not a kinesweep", 0) == 0 || e.cause().rfind("unsupported", 0) == 0) throw;
+      continue;
+    }
+    impl_->stamp = before;
+    if (consistency_stamp(path) == before || attempt == 99) return;
+    impl_->file.reset();  // a commit happened meanwhile: open again
+  }
+  throw StoreError(path, "cannot open for reading: " + last);
+}
+
+bool ResultsReader::unchanged_since_open() const {
+  return !impl_->stamp.empty() && consistency_stamp(impl_->path) == impl_->stamp;
+}
+
+ResultsReader::~ResultsReader() = default;
+
+const StoreMeta& ResultsReader::meta() const { return impl_->meta; }
+const std::vector<ColumnSpec>& ResultsReader::columns() const { return impl_->columns; }
+std::int64_t ResultsReader::n_runs() const { return impl_->n_runs; }
+
+std::vector<std::uint8_t> ResultsReader::done_mask() const {
+  QuietHdf5 quiet;
+  return impl_->read_num<std::uint8_t>("done", H5T_NATIVE_UINT8, 0, static_cast<hsize_t>(impl_->n_runs));
+}
+
+std::vector<double> ResultsReader::read_f64(const std::string& name) const {
+  QuietHdf5 quiet;
+  if (impl_->column(name).type != CellType::f64) throw StoreError(impl_->path, "column " + name + " is not f64");
+  return impl_->read_num<double>(name, H5T_NATIVE_DOUBLE, 0, static_cast<hsize_t>(impl_->n_runs));
+}
+std::vector<std::int64_t> ResultsReader::read_i64(const std::string& name) const {
+  QuietHdf5 quiet;
+  if (impl_->column(name).type != CellType::i64) throw StoreError(impl_->path, "column " + name + " is not i64");
+  return impl_->read_num<std::int64_t>(name, H5T_NATIVE_INT64, 0, static_cast<hsize_t>(impl_->n_runs));
+}
+std::vector<std::string> ResultsReader::read_str(const std::string& name) const {
+  QuietHdf5 quiet;
+  if (impl_->column(name).type != CellType::str) throw StoreError(impl_->path, "column " + name + " is not str");
+  return impl_->read_strs(name, 0, static_cast<hsize_t>(impl_->n_runs));
+}
+
+std::vector<Cell> ResultsReader::read_column(const std::string& name) const {
+  std::vector<Cell> out;
+  switch (impl_->column(name).type) {
+    case CellType::f64: for (double v : read_f64(name)) out.emplace_back(v); break;
+    case CellType::i64: for (std::int64_t v : read_i64(name)) out.emplace_back(v); break;
+    case CellType::str: for (auto& v : read_str(name)) out.emplace_back(std::move(v)); break;
+  }
+  return out;
+}
+
+Record ResultsReader::read_record(std::int64_t run_id) const {
+  QuietHdf5 quiet;
+  if (run_id < 0 || run_id >= impl_->n_runs) throw StoreError(impl_->path, "run id out of range");
+  Record r;
+  const hsize_t at = static_cast<hsize_t>(run_id);
+  for (auto& c : impl_->columns) {
+    switch (c.type) {
+      case CellType::f64: r.cells.emplace_back(impl_->read_num<double>(c.name, H5T_NATIVE_DOUBLE, at, 1)[0]); break;
+      case CellType::i64:
+        r.cells.emplace_back(impl_->read_num<std::int64_t>(c.name, H5T_NATIVE_INT64, at, 1)[0]);
+        break;
+      case CellType::str: r.cells.emplace_back(impl_->read_strs(c.name, at, 1)[0]); break;
+    }
+  }
+  return r;
+}
+
+bool ResultsReader::has_history(std::int64_t run_id) const {
+  QuietHdf5 quiet;
+  return link_exists(impl_->file, "histories/" + history_group_name(run_id, impl_->n_runs));
+}
+
+RunHistory ResultsReader::read_history(std::int64_t run_id) const {
+  QuietHdf5 quiet;
+  RunHistory h;
+  const std::string g = "histories/" + history_group_name(run_id, impl_->n_runs);
+  if (!link_exists(impl_->file, g)) return h;
+  Hid grp(check(H5Gopen2(impl_->file, g.c_str(), H5P_DEFAULT), impl_->path, "open /" + g));
+  for (auto& name : read_str_list_attr(grp, "arrays")) {
+    Hid d(check(H5Dopen2(grp, name.c_str(), H5P_DEFAULT), impl_->path, "open /" + g + "/" + name));
+    Hid s(H5Dget_space(d));
+    hsize_t dims[2] = {0, 1};
+    int rank = H5Sget_simple_extent_dims(s, dims, nullptr);
+    HistoryArray a;
+    a.name = name;
+    a.unit = read_str_attr(d, "unit");
+    a.rows = rank >= 1 ? dims[0] : 1;
+    a.cols = rank >= 2 ? dims[1] : 1;
+    a.data.resize(a.rows * a.cols);
+    if (!a.data.empty())
+      check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.data.data()), impl_->path,
+            "read /" + g + "/" + name);
+    h.arrays.push_back(std::move(a));
+  }
+  return h;
+}
+
+namespace {
+herr_t collect_names(hid_t, const char* name, const H5L_info_t*, void* data) {
+  static_cast<std::vector<std::string>*>(data)->emplace_back(name);
+  return 0;
+}
+}  // namespace
+
+std::vector<std::string> ResultsReader::landscapes() const {
+  QuietHdf5 quiet;
+  std::vector<std::string> out;
+  if (!link_exists(impl_->file, "landscapes")) return out;
+  Hid g(check(H5Gopen2(impl_->file, "landscapes", H5P_DEFAULT), impl_->path, "open /landscapes"));
+  H5Literate(g, H5_INDEX_NAME, H5_ITER_INC, nullptr, collect_names, &out);
+  return out;
+}
+
+LandscapeSpec ResultsReader::read_landscape(const std::string& block) const {
+  QuietHdf5 quiet;
+  LandscapeSpec spec;
+  spec.block = block;
+  const std::string gp = "landscapes/" + block;
+  if (!link_exists(impl_->file, "landscapes") || !link_exists(impl_->file, gp))
+    throw StoreError(impl_->path, "no landscape '" + block + "'");
+  Hid g(check(H5Gopen2(impl_->file, gp.c_str(), H5P_DEFAULT), impl_->path, "open /" + gp));
+  auto read_all = [&](const std::string& name) {
+    Hid d(check(H5Dopen2(g, name.c_str(), H5P_DEFAULT), impl_->path, "open /" + gp + "/" + name));
+    Hid s(H5Dget_space(d));
+    std::vector<double> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
+    if (!v.empty())
+      check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), impl_->path, "read " + name);
+    return std::make_pair(std::move(v), read_str_attr(d, "unit"));
+  };
+  for (auto& name : read_str_list_attr(g, "axes")) {
+    auto [v, unit] = read_all(name);
+    spec.axes.push_back({name, unit, std::move(v)});
+  }
+  for (auto& name : read_str_list_attr(g, "metrics")) {
+    auto [v, unit] = read_all(name);
+    Hid d(H5Dopen2(g, name.c_str(), H5P_DEFAULT));
+    spec.metrics.push_back({name, unit, read_str_attr(d, "description"), std::move(v)});
+  }
+  return spec;
+}
+
+}  // namespace ks::store

@@ -1,0 +1,172 @@
+#pragma once
+// The HDF5 results store: the only code in kinesweep that knows HDF5. File layout: FORMAT.md.
+//
+// Threading: encode_history() is thread-safe and HDF5-free (zlib only): call it in worker threads.
+// A ResultsWriter must be used by one thread (the writer thread) only.
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "store/record.hpp"
+
+namespace ks::store {
+
+/// Every store failure: unwritable directory, disk full, existing file, sha mismatch, bad input...
+class StoreError : public std::runtime_error {
+ public:
+  StoreError(std::string path, std::string cause)
+      : std::runtime_error("results store: " + (path.empty() ? std::string() : path + ": ") + cause),
+        path_(std::move(path)), cause_(std::move(cause)) {}
+  const std::string& path() const { return path_; }
+  const std::string& cause() const { return cause_; }
+
+ private:
+  std::string path_, cause_;
+};
+
+inline constexpr const char* kFormatName = "kinesweep-results";
+inline constexpr std::int64_t kFormatVersion = 1;
+
+/// Root metadata of a results file.
+struct StoreMeta {
+  std::string study_name;
+  std::string study_path;    ///< attribute "path" of /study
+  std::string study_text;    ///< the study file's text verbatim (/study/text)
+  std::string study_sha256;  ///< hex
+  std::string engine_version = KINESWEEP_VERSION;
+  std::string created;       ///< ISO 8601 UTC; filled at creation when empty
+  std::string format = kFormatName;
+  std::int64_t format_version = kFormatVersion;
+};
+
+struct StoreOptions {
+  bool overwrite = false;            ///< replace an existing file at the path
+  std::size_t flush_every_runs = 64; ///< automatic flush after this many written runs (0: never)
+  double flush_every_seconds = 10.0; ///< ... or when this much time passed since the last flush (0: never)
+  bool durable = false;              ///< fsync around commits (power-loss safety; kill -9 safety needs none)
+};
+
+/// One history array compressed for HDF5's deflate filter (zlib stream of the row-major f64 data).
+struct EncodedArray {
+  std::string name, unit;
+  std::size_t rows = 0, cols = 1;
+  int level = 0;
+  std::vector<unsigned char> bytes;
+};
+struct EncodedHistory {
+  std::vector<EncodedArray> arrays;
+};
+/// Compress a run's history in the calling thread (zlib compress2, `level` 0..9). Thread-safe,
+/// no HDF5. Throws StoreError when an array's data size is not rows*cols.
+EncodedHistory encode_history(const RunHistory& history, int level = 4);
+
+/// One axis of a block's grid, or one gridded metric (row-major over the axes, NaN = no value).
+struct LandscapeAxis {
+  std::string name, unit;
+  std::vector<double> values;
+};
+struct LandscapeMetric {
+  std::string name, unit, description;
+  std::vector<double> grid;
+};
+struct LandscapeSpec {
+  std::string block;
+  std::vector<LandscapeAxis> axes;
+  std::vector<LandscapeMetric> metrics;
+};
+
+class ResultsWriter {
+ public:
+  struct Impl;
+  /// Create a new results file of `n_runs` rows (all missing, none done). The file is built under a
+  /// temporary name in the same directory and renamed into place; an existing file is replaced only
+  /// with options.overwrite. Throws StoreError.
+  static std::unique_ptr<ResultsWriter> create(const std::string& path, const StoreMeta& meta,
+                                               const std::vector<ColumnSpec>& columns, std::int64_t n_runs,
+                                               const StoreOptions& options = {});
+
+  struct Resumed;
+  /// Reopen an existing file to fill its missing runs (recovering it first after a crash). Refuses
+  /// with StoreError when the file's study_sha256 differs from `expected_sha256`.
+  static Resumed open_for_resume(const std::string& path, const std::string& expected_sha256,
+                                 const StoreOptions& options = {});
+
+  ~ResultsWriter();  ///< closes (commits) the file; errors are swallowed: call close() to see them
+  ResultsWriter(const ResultsWriter&) = delete;
+  ResultsWriter& operator=(const ResultsWriter&) = delete;
+
+  /// Store run `run_id` (0 <= run_id < n_runs, any order, rewriting allowed). The row becomes
+  /// visible (done) at the next flush, automatic or explicit; its history is stored at once.
+  void write_run(std::int64_t run_id, const Record& record, const EncodedHistory& history = {});
+  void write_run(std::int64_t run_id, const Record& record, const RunHistory& history, int level = 4);
+  /// Commit everything written so far (atomic: after a crash the file holds exactly the runs done
+  /// at the last completed flush).
+  void flush();
+  /// Write /landscapes/<block>/ (replacing an existing one) and flush.
+  void write_landscape(const LandscapeSpec& spec);
+  /// Flush and close; further calls throw.
+  void close();
+
+  const std::string& path() const;
+  const std::vector<ColumnSpec>& columns() const;
+  std::int64_t n_runs() const;
+  bool is_done(std::int64_t run_id) const;  ///< committed or pending
+  std::size_t pending() const;              ///< runs written since the last flush
+
+ private:
+  explicit ResultsWriter(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+struct ResultsWriter::Resumed {
+  std::unique_ptr<ResultsWriter> writer;
+  std::vector<std::int64_t> done;  ///< run ids already done, ascending
+};
+
+// ------------------------------------------------------------------------------------------------
+/// Read access (kinesweep info/query, tests). Works on a file that is being written: it sees the
+/// last committed state at open time (re-open to see newer runs; read the done mask before the
+/// columns). Opening a crashed file first recovers it (when the directory is writable).
+class ResultsReader {
+ public:
+  explicit ResultsReader(const std::string& path);
+  ~ResultsReader();
+  /// Close and reopen, to see the runs committed since the open.
+  ///
+  /// Reading while a writer runs: the reader opens between two commits, but the writer keeps
+  /// committing, and HDF5 reads metadata lazily, so a long-lived reader may mix two committed
+  /// states: a read may then throw StoreError (HDF5's checksums catch most mixtures) or miss the
+  /// newest runs' histories. Everything read is trustworthy when unchanged_since_open() is still
+  /// true after the reads; otherwise refresh() and read again.
+  void refresh();
+  /// True when no commit happened since the open (so all reads so far saw one committed state).
+  bool unchanged_since_open() const;
+  ResultsReader(const ResultsReader&) = delete;
+  ResultsReader& operator=(const ResultsReader&) = delete;
+
+  const StoreMeta& meta() const;
+  const std::vector<ColumnSpec>& columns() const;  ///< schema order
+  std::int64_t n_runs() const;
+  std::vector<std::uint8_t> done_mask() const;
+  std::vector<Cell> read_column(const std::string& name) const;
+  std::vector<double> read_f64(const std::string& name) const;
+  std::vector<std::int64_t> read_i64(const std::string& name) const;
+  std::vector<std::string> read_str(const std::string& name) const;
+  Record read_record(std::int64_t run_id) const;
+  bool has_history(std::int64_t run_id) const;
+  RunHistory read_history(std::int64_t run_id) const;  ///< empty when the run has none
+  std::vector<std::string> landscapes() const;
+  LandscapeSpec read_landscape(const std::string& block) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Name of run `run_id`'s group under /histories ("000123"; wider when n_runs needs it).
+std::string history_group_name(std::int64_t run_id, std::int64_t n_runs);
+
+}  // namespace ks::store

@@ -1,0 +1,217 @@
+#!/usr/bin/python3
+"""h5py check of the C++ results store (engine/store, FORMAT.md).
+
+usage: check_store.py STORE_WRITER_HELPER WORKDIR
+
+1. Writes a complete file with the C++ helper and checks, with h5py + numpy only, the attributes,
+   the /runs table (all columns one length, values recomputed here from the same formulas as
+   tests/store_testgen.cpp), the histories (bit-identical, chunked + deflate) and a landscape.
+2. Starts the helper writing slowly and reads the file concurrently, many times, while it grows.
+"""
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+
+STATUSES = ["ok", "diverged", "singular", "ok-\u00f1"]
+COLUMNS = [("alpha", "f", "rad"), ("E", "f", "Nm"), ("iters", "i", ""), ("status", "O", ""), ("method", "O", "")]
+failures = []
+
+
+def check(cond, msg):
+    if not cond:
+        failures.append(msg)
+        print("FAIL:", msg)
+
+
+def expected_row(i):
+    return {
+        "alpha": math.nan if i % 11 == 3 else i / 7.0,
+        "E": i * 0.5 - 3.25,
+        "iters": -1 if i % 13 == 0 else i * 3 - 5,
+        "status": "" if i % 17 == 5 else STATUSES[i % 4],
+        "method": "dls" if i % 2 else "pinv",
+    }
+
+
+def expected_history(i):
+    if i % 5 == 4:
+        return None
+    n = 10 + (i % 7) * 40
+    t = np.array([k / 8.0 + i for k in range(n)], dtype="<f8").reshape(n, 1)
+    q = np.array([[i + k * 0.25 - j / 3.0 for j in range(3)] for k in range(n)], dtype="<f8")
+    tau = np.array([[math.nan, math.inf], [-0.0, 1e-310 * (i + 1)]], dtype="<f8")
+    return {"t": (t, "s"), "q": (q, "rad"), "tau": (tau, "Nm"), "empty": (np.zeros((0, 3)), "")}
+
+
+def as_str(v):
+    return v.decode("utf-8") if isinstance(v, bytes) else str(v)
+
+
+def same_value(got, want):
+    if isinstance(want, float):
+        return (math.isnan(want) and math.isnan(got)) or float(got) == want
+    if isinstance(want, str):
+        return as_str(got) == want
+    return int(got) == want
+
+
+def check_table(f, n, require_all_done):
+    """Reads /runs like pandas would; done mask first, so that every row seen done is complete."""
+    runs = f["runs"]
+    done = runs["done"][()]
+    table = {k: runs[k][()] for k in runs}  # == pandas.DataFrame({k: f['runs'][k][()] for k in f['runs']})
+    lengths = {k: len(v) for k, v in table.items()}
+    check(len(set(lengths.values())) == 1 and lengths["done"] == n, f"/runs lengths differ or != {n}: {lengths}")
+    ok_rows = 0
+    for i in np.nonzero(done)[0]:
+        want = expected_row(int(i))
+        for name, _, _ in COLUMNS:
+            if not same_value(table[name][i], want[name]):
+                check(False, f"run {i} column {name}: got {table[name][i]!r}, want {want[name]!r}")
+        ok_rows += 1
+    if require_all_done:
+        check(ok_rows == n, f"only {ok_rows} of {n} runs done")
+    return int(done.sum())
+
+
+def check_history(f, i):
+    want = expected_history(i)
+    name = f"{i:06d}"
+    if want is None:
+        check(name not in f["histories"], f"run {i} should have no history")
+        return
+    g = f["histories"][name]
+    check(sorted(g.keys()) == sorted(want.keys()), f"run {i} arrays {list(g.keys())}")
+    for a, (arr, unit) in want.items():
+        d = g[a]
+        check(d.shape == arr.shape, f"run {i} {a} shape {d.shape} != {arr.shape}")
+        check(as_str(d.attrs["unit"]) == unit, f"run {i} {a} unit {d.attrs['unit']!r}")
+        got = d[()]
+        check(got.dtype == np.dtype("<f8"), f"run {i} {a} dtype {got.dtype}")
+        check(got.tobytes() == arr.astype("<f8").tobytes(), f"run {i} {a} not bit-identical")
+        if arr.size:
+            check(d.chunks == arr.shape and d.compression == "gzip", f"run {i} {a}: chunks {d.chunks} {d.compression}")
+
+
+def check_complete(path, n):
+    with h5py.File(path, "r") as f:
+        a = f.attrs
+        check(as_str(a["format"]) == "kinesweep-results", "format attribute")
+        check(int(a["format_version"]) == 1, "format_version attribute")
+        check(len(as_str(a["engine_version"])) > 0, "engine_version attribute")
+        check(re.fullmatch(r"[0-9a-f]{64}", as_str(a["study_sha256"])) is not None, "study_sha256 is 64 hex digits")
+        check(re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", as_str(a["created"])) is not None, "created ISO 8601")
+        check(as_str(a["study_name"]) == "store-test", "study_name")
+        text = as_str(f["study/text"][()])
+        check(text.startswith("# a study\n") and 'name = "store-test"' in text, "study/text verbatim")
+        check(as_str(f["study"].attrs["path"]) == "studies/store-test.toml", "study path attribute")
+        runs = f["runs"]
+        check([as_str(c) for c in runs.attrs["columns"]] == [c[0] for c in COLUMNS], "/runs columns attribute order")
+        for name, kind, unit in COLUMNS + [("done", "u", "")]:
+            d = runs[name]
+            check("unit" in d.attrs and "description" in d.attrs, f"/runs/{name} unit/description attributes")
+            check(as_str(d.attrs["unit"]) == unit, f"/runs/{name} unit {d.attrs['unit']!r}")
+            check(d.dtype.kind == kind, f"/runs/{name} dtype {d.dtype}")
+        check(check_table(f, n, True) == n, "all done")
+        for i in range(n):
+            check_history(f, i)
+        e = f["landscapes/A/E"]
+        check([as_str(x) for x in e.attrs["axes"]] == ["alpha1A", "alpha2A"], "landscape axes attribute")
+        check(e.shape == (3, 2) and math.isnan(e[1, 0]) and e[2, 1] == 21.0, "landscape grid")
+        check(list(f["landscapes/A/alpha1A"][()]) == [0.0, 0.5, 1.0], "landscape axis values")
+        check(as_str(f["landscapes/A/alpha1A"].attrs["unit"]) == "rad", "landscape axis unit")
+        try:
+            import pandas  # optional here
+
+            df = pandas.DataFrame({k: f["runs"][k][()] for k in f["runs"]})
+            check(len(df) == n, "pandas DataFrame rows")
+        except ImportError:
+            pass
+
+
+def stamp(path):
+    """FORMAT.md, "Reading while a sweep runs": the journal header (commit sequence + writer session)
+    while a writer lives, else the file's size and mtime; None while a commit is being applied."""
+    try:
+        with open(path + ".journal", "rb") as fh:
+            head = fh.read()
+    except FileNotFoundError:
+        st = os.stat(path)
+        return ("static", st.st_size, st.st_mtime_ns)
+    if len(head) != 48 or head[:8] != b"KSJRNL01":
+        return None
+    return ("journal", head)
+
+
+def concurrent_read(helper, path, n):
+    proc = subprocess.Popen([helper, path, str(n), "--delay-us", "500", "--flush-every", "64"],
+                            stdout=subprocess.DEVNULL)
+    snapshots, mid, errors, stale, stale_bad, seen = 0, 0, 0, 0, 0, []
+    try:
+        while proc.poll() is None:
+            time.sleep(0.02)
+            if not os.path.exists(path):
+                continue
+            before = stamp(path)
+            if before is None:
+                continue
+            mark = len(failures)
+            try:
+                with h5py.File(path, "r") as f:
+                    done = check_table(f, n, False)
+                    ids = np.nonzero(f["runs/done"][()])[0]
+                    for i in list(ids[::9]) + list(ids[-5:]):
+                        check_history(f, int(i))
+            except (OSError, KeyError, RuntimeError) as e:  # metadata changed under this read
+                del failures[mark:]
+                errors += 1
+                continue
+            if stamp(path) != before:  # a commit happened during the read: not one snapshot, discard
+                stale += 1
+                stale_bad += len(failures) > mark
+                del failures[mark:]
+                continue
+            snapshots += 1
+            seen.append(done)
+            if 0 < done < n:
+                mid += 1
+    finally:
+        rc = proc.wait(timeout=120)
+    check(rc == 0, f"writer exited with {rc}")
+    print(f"concurrent reads: {snapshots} consistent snapshots ({mid} mid-sweep); discarded: {errors} raised, "
+          f"{stale} saw a commit ({stale_bad} of them with odd newest runs); done counts: {seen[:3]} ... {seen[-3:]}")
+    check(mid >= 3, f"only {mid} consistent reads happened while the sweep was running")
+    check(all(b >= a for a, b in zip(seen, seen[1:])), "done count went backwards between snapshots")
+    check_complete_table(path, n)
+
+
+def check_complete_table(path, n):
+    with h5py.File(path, "r") as f:
+        check(check_table(f, n, True) == n, "all done after the concurrent run")
+
+
+def main():
+    helper, work = sys.argv[1], sys.argv[2]
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    full = os.path.join(work, "full.h5")
+    subprocess.run([helper, full, "60", "--landscape"], check=True, stdout=subprocess.DEVNULL)
+    check_complete(full, 60)
+    concurrent_read(helper, os.path.join(work, "growing.h5"), 1500)
+    if failures:
+        print(f"{len(failures)} failures")
+        return 1
+    shutil.rmtree(work, ignore_errors=True)
+    print("ok")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

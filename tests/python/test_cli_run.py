@@ -1,0 +1,255 @@
+"""End-to-end tests of `kinesweep run`: bad input, thread-count independence, SIGKILL + resume,
+SIGINT + resume, overwrite protection, reading with h5py.
+
+usage: /usr/bin/python3 test_cli_run.py KINESWEEP_BINARY STUDIES_DIR
+"""
+import hashlib
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+import h5py
+import numpy as np
+
+KS = None
+STUDIES = None
+
+SWEEP = """
+[study]
+name = "e2e"
+histories = "every=5"
+
+[[block]]
+name = "weighted"
+kind = "trajectory"
+method = "local_weighted"
+[block.axes]
+alpha1A = { from = -20, to = 30, step = 1 }
+k = { from = 0, to = 1, count = 11 }
+
+[[block]]
+name = "newton_basin"
+kind = "ik"
+problem = "scara"
+method = "newton"
+[block.axes]
+q0_1 = { from = -180, to = 180, count = 21 }
+q0_2 = { from = -180, to = 180, count = 21 }
+"""
+
+
+def run(*args, **kw):
+    return subprocess.run([KS, *args], capture_output=True, text=True, **kw)
+
+
+def runs_table(path):
+    with h5py.File(path, "r") as f:
+        return {k: f["runs"][k][()] for k in f["runs"] if k != "wall_time"}
+
+
+def same_tables(a, b):
+    if a.keys() != b.keys():
+        return False
+    for k in a:
+        x, y = a[k], b[k]
+        if x.dtype.kind == "f":
+            if not np.array_equal(x.view(np.uint64), y.view(np.uint64)):  # bitwise, NaN included
+                return False
+        elif not np.array_equal(x, y):
+            return False
+    return True
+
+
+class Base(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def write(self, name, text):
+        p = os.path.join(self.dir, name)
+        with open(p, "w") as f:
+            f.write(text)
+        return p
+
+
+class BadInput(Base):
+    CASES = {
+        "syntax": ("[study]\nname = \"x\n", 2),
+        "unknown_key": ("[study]\nname = \"x\"\n[[block]]\nname = \"b\"\nkind = \"trajectory\"\nalpha1a = 3\n", 6),
+        "wrong_type": ("[[block]]\nname = \"b\"\nkind = \"trajectory\"\nk = \"high\"\n", 4),
+        "inverted_range": ("[[block]]\nname = \"b\"\nkind = \"trajectory\"\n[block.axes]\nk = { from = 1, to = 0, step = 0.1 }\n", 5),
+        "empty_range": ("[[block]]\nname = \"b\"\nkind = \"trajectory\"\n[block.axes]\nk = { from = 0, to = 1, step = 0 }\n", 5),
+        "unknown_method": ("[[block]]\nname = \"b\"\nkind = \"trajectory\"\nmethod = \"local_weigthed\"\n", 4),
+        "unknown_preset": ("[[block]]\nname = \"b\"\nkind = \"trajectory\"\npreset = \"9z\"\n", 4),
+        "too_many": ("[[block]]\nname = \"b\"\nkind = \"ik\"\n[block.axes]\nq0_1 = { from = 0, to = 1, count = 100000 }\nq0_2 = { from = 0, to = 1, count = 100000 }\n", None),
+    }
+
+    def test_each_bad_study_is_rejected_with_location_and_no_file(self):
+        for name, (text, line) in self.CASES.items():
+            with self.subTest(name):
+                study = self.write(name + ".toml", text)
+                out = os.path.join(self.dir, name + ".h5")
+                r = run("run", study, "-o", out)
+                self.assertEqual(r.returncode, 2, r.stderr)
+                self.assertIn(study + ":", r.stderr)
+                if line is not None:
+                    self.assertIn(f"{study}:{line}:", r.stderr)
+                self.assertIn("expected", r.stderr)
+                self.assertFalse(os.path.exists(out))
+
+    def test_misspelled_key_gets_a_suggestion(self):
+        study = self.write("s.toml", self.CASES["unknown_key"][0])
+        r = run("run", study, "-o", os.path.join(self.dir, "s.h5"))
+        self.assertIn("did you mean 'alpha1A'", r.stderr)
+
+    def test_bad_histories_option(self):
+        study = self.write("ok.toml", SWEEP)
+        r = run("run", study, "-o", os.path.join(self.dir, "x.h5"), "--histories", "every=0")
+        self.assertEqual(r.returncode, 2)
+
+
+class Outputs(Base):
+    def test_existing_file_is_not_overwritten_without_flag(self):
+        study = self.write("ok.toml", SWEEP)
+        out = os.path.join(self.dir, "r.h5")
+        self.assertEqual(run("run", study, "-o", out, "-q").returncode, 0)
+        before = hashlib.sha256(open(out, "rb").read()).hexdigest()
+        r = run("run", study, "-o", out, "-q")
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("--overwrite", r.stderr)
+        self.assertEqual(hashlib.sha256(open(out, "rb").read()).hexdigest(), before)
+        self.assertEqual(run("run", study, "-o", out, "-q", "--overwrite").returncode, 0)
+
+    def test_unwritable_directory_is_a_clear_error(self):
+        study = self.write("ok.toml", SWEEP)
+        blocker = self.write("not_a_dir", "x")
+        r = run("run", study, "-o", os.path.join(blocker, "r.h5"), "-q")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("not_a_dir", r.stderr)
+
+    def test_dry_run_writes_nothing(self):
+        study = self.write("ok.toml", SWEEP)
+        out = os.path.join(self.dir, "r.h5")
+        r = run("run", study, "-o", out, "--dry-run")
+        self.assertEqual(r.returncode, 0)
+        self.assertIn("561 runs", r.stdout)   # 51 x 11
+        self.assertIn("441 runs", r.stdout)   # 21 x 21
+        self.assertIn("estimated size", r.stdout)
+        self.assertFalse(os.path.exists(out))
+
+
+class Reproducibility(Base):
+    def test_results_identical_whatever_the_thread_count(self):
+        study = self.write("ok.toml", SWEEP)
+        a, b = os.path.join(self.dir, "t1.h5"), os.path.join(self.dir, "t2.h5")
+        self.assertEqual(run("run", study, "-o", a, "--threads", "1", "-q").returncode, 0)
+        self.assertEqual(run("run", study, "-o", b, "--threads", "2", "-q").returncode, 0)
+        self.assertTrue(same_tables(runs_table(a), runs_table(b)))
+        with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
+            for g in ["000000", "000300", "000700"]:
+                for k in fa["histories"][g]:
+                    self.assertTrue(np.array_equal(fa["histories"][g][k][()], fb["histories"][g][k][()]))
+            self.assertEqual(fa.attrs["study_sha256"], hashlib.sha256(SWEEP.encode()).hexdigest())
+
+    def test_pandas_style_load_and_study_inside(self):
+        study = self.write("ok.toml", SWEEP)
+        out = os.path.join(self.dir, "r.h5")
+        self.assertEqual(run("run", study, "-o", out, "-q").returncode, 0)
+        with h5py.File(out, "r") as f:
+            table = {k: f["runs"][k][()] for k in f["runs"]}
+            self.assertEqual({len(v) for v in table.values()}, {561 + 441})
+            text = f["study"]["text"][()]
+            self.assertEqual(text.decode() if isinstance(text, bytes) else text, SWEEP)
+            self.assertIn("engine_version", f.attrs)
+            self.assertTrue(all(s in (b"ok", b"diverged", b"singular", b"unreachable_start") for s in table["status"][:561]))
+            E = table["E"][:561]
+            ok = table["status"][:561] == b"ok"
+            self.assertTrue(np.all(np.isfinite(E[ok])))
+            land = f["landscapes"]["weighted"]
+            self.assertEqual(land["E"].shape, (51, 11))
+            self.assertEqual(land["converged"].shape if "converged" in land else (51, 11), (51, 11))
+            self.assertEqual(f["landscapes"]["newton_basin"]["converged"].shape, (21, 21))
+
+
+class CrashAndResume(Base):
+    def reference(self, study):
+        ref = os.path.join(self.dir, "ref.h5")
+        self.assertEqual(run("run", study, "-o", ref, "-q").returncode, 0)
+        return runs_table(ref)
+
+    def test_sigkill_then_resume_gives_the_uninterrupted_table(self):
+        study = self.write("ok.toml", SWEEP)
+        ref = self.reference(study)
+        for i, delay in enumerate([0.15, 0.4, 0.8]):
+            out = os.path.join(self.dir, f"k{i}.h5")
+            p = subprocess.Popen([KS, "run", study, "-o", out, "-q", "--histories", "full"],
+                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            time.sleep(delay)
+            p.send_signal(signal.SIGKILL)
+            p.wait()
+            if os.path.exists(out):  # the file opens and its done runs are intact
+                with h5py.File(out, "r") as f:
+                    done = f["runs"]["done"][()].astype(bool)
+                    for k in ("E", "iterations", "alpha1A"):
+                        x, y = f["runs"][k][()][done], ref[k][done]
+                        self.assertTrue(np.array_equal(x.view(np.uint64) if x.dtype.kind == "f" else x,
+                                                       y.view(np.uint64) if y.dtype.kind == "f" else y))
+            r = run("run", study, "-o", out, "--resume", "-q", "--histories", "full")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertTrue(same_tables(runs_table(out), ref))
+
+    def test_sigint_finishes_in_flight_runs_and_says_how_to_resume(self):
+        study = self.write("ok.toml", SWEEP)
+        ref = self.reference(study)
+        out = os.path.join(self.dir, "int.h5")
+        p = subprocess.Popen([KS, "run", study, "-o", out, "-q", "--histories", "full", "--threads", "1"],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        time.sleep(0.3)
+        p.send_signal(signal.SIGINT)
+        stdout, _ = p.communicate()
+        if p.returncode == 130:
+            self.assertIn("--resume", stdout)
+        else:
+            self.assertEqual(p.returncode, 0)  # finished before the signal arrived
+        r = run("run", study, "-o", out, "--resume", "-q")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertTrue(same_tables(runs_table(out), ref))
+
+    def test_resume_refuses_a_different_study(self):
+        study = self.write("ok.toml", SWEEP)
+        out = os.path.join(self.dir, "r.h5")
+        self.assertEqual(run("run", study, "-o", out, "-q").returncode, 0)
+        other = self.write("other.toml", SWEEP.replace("count = 11", "count = 12"))
+        r = run("run", other, "-o", out, "--resume", "-q")
+        self.assertNotEqual(r.returncode, 0)
+
+
+class ShippedStudies(Base):
+    def test_table4_main_job(self):
+        out = os.path.join(self.dir, "t4.h5")
+        r = run("run", os.path.join(STUDIES, "thesis_table4.toml"), "-o", out, "-q")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("thesis vs kinesweep", r.stdout)
+        for case in ("1a", "2h", "5c"):
+            self.assertIn("\n" + case + " ", r.stdout)
+        with h5py.File(out, "r") as f:
+            self.assertEqual(len(f["runs"]["E"]), 21)
+
+    def test_every_shipped_study_dry_runs(self):
+        for name in sorted(os.listdir(STUDIES)):
+            if name.endswith(".toml"):
+                with self.subTest(name):
+                    r = run("run", os.path.join(STUDIES, name), "--dry-run")
+                    self.assertEqual(r.returncode, 0, r.stderr)
+
+
+if __name__ == "__main__":
+    KS, STUDIES = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+    unittest.main(argv=[sys.argv[0], "-v"])

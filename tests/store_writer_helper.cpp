@@ -1,0 +1,77 @@
+// Test helper: writes the deterministic test study (store_testgen.cpp) into a results file, slowly
+// if asked, so that tests can kill it (SIGKILL) or read the file while it is being written.
+//   store_writer_helper PATH N [--delay-us D] [--flush-every K] [--no-shuffle] [--landscape]
+// Creates PATH, or resumes it when it exists. Prints "resumed <k>" / "created", then "finished".
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "store/store.hpp"
+
+namespace ks::store_test {
+std::vector<ColumnSpec> test_columns();
+Record test_record(std::int64_t id);
+RunHistory test_history(std::int64_t id);
+store::StoreMeta test_meta();
+store::LandscapeSpec test_landscape();
+}  // namespace ks::store_test
+
+int main(int argc, char** argv) {
+  using namespace ks;
+  if (argc < 3) {
+    std::cerr << "usage: store_writer_helper PATH N [--delay-us D] [--flush-every K] [--no-shuffle] [--landscape]\n";
+    return 2;
+  }
+  const std::string path = argv[1];
+  const std::int64_t n = std::atoll(argv[2]);
+  long delay_us = 0;
+  bool shuffle = true, landscape = false;
+  store::StoreOptions opt;
+  opt.flush_every_seconds = 0.05;
+  for (int i = 3; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a == "--delay-us" && i + 1 < argc) delay_us = std::atol(argv[++i]);
+    else if (a == "--flush-every" && i + 1 < argc) opt.flush_every_runs = static_cast<std::size_t>(std::atol(argv[++i]));
+    else if (a == "--no-shuffle") shuffle = false;
+    else if (a == "--landscape") landscape = true;
+  }
+  try {
+    std::unique_ptr<store::ResultsWriter> w;
+    std::vector<char> done(static_cast<std::size_t>(n), 0);
+    if (access(path.c_str(), F_OK) == 0) {
+      auto r = store::ResultsWriter::open_for_resume(path, store_test::test_meta().study_sha256, opt);
+      for (auto id : r.done) done[static_cast<std::size_t>(id)] = 1;
+      std::cout << "resumed " << r.done.size() << std::endl;
+      w = std::move(r.writer);
+    } else {
+      w = store::ResultsWriter::create(path, store_test::test_meta(), store_test::test_columns(), n, opt);
+      std::cout << "created" << std::endl;
+    }
+    std::vector<std::int64_t> order(static_cast<std::size_t>(n));
+    for (std::int64_t i = 0; i < n; ++i) order[static_cast<std::size_t>(i)] = i;
+    if (shuffle) {  // mostly in order, with local disorder (as a pool of worker threads produces)
+      std::mt19937_64 rng(12345);
+      for (std::size_t i = 0; i + 1 < order.size(); i += 2)
+        if (rng() % 2) std::swap(order[i], order[i + 1]);
+    }
+    for (auto id : order) {
+      if (done[static_cast<std::size_t>(id)]) continue;
+      w->write_run(id, store_test::test_record(id), store::encode_history(store_test::test_history(id), 4));
+      if (delay_us > 0) usleep(static_cast<useconds_t>(delay_us));
+    }
+    w->flush();
+    if (landscape) w->write_landscape(store_test::test_landscape());
+    w->close();
+    std::cout << "finished" << std::endl;
+  } catch (const store::StoreError& e) {
+    std::cerr << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
