@@ -114,7 +114,7 @@ struct Summary {
   int iterations = 0;             ///< updates made
   int rejected = 0;               ///< lm_adaptive: rejected trial steps
   int solution = -1;              ///< index into problem.known_solutions() matched by q, -1 if none
-  double min_rcond = 1.0;         ///< smallest reciprocal condition met during the solve
+  double min_rcond = 1.0;         ///< smallest reciprocal condition of a matrix solved (inf: none was)
   History<N, M> history;
 
   bool converged() const { return status == Status::converged; }
