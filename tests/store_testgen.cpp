@@ -60,7 +60,7 @@ store::StoreMeta test_meta() {
 
 store::LandscapeSpec test_landscape() {
   store::LandscapeSpec s;
-  s.block = "A";
+  s.block.assign(1, 'A');
   s.axes = {{"alpha1A", "rad", {0.0, 0.5, 1.0}}, {"alpha2A", "rad", {-1.0, 1.0}}};
   store::LandscapeMetric E{"E", "Nm", "mean energy", {}};
   for (int i = 0; i < 3; ++i)

@@ -1,6 +1,6 @@
 // Test helper: writes the deterministic test study (store_testgen.cpp) into a results file, slowly
 // if asked, so that tests can kill it (SIGKILL) or read the file while it is being written.
-//   store_writer_helper PATH N [--delay-us D] [--flush-every K] [--no-shuffle] [--landscape]
+//   store_writer_helper PATH N [--delay-us D] [--flush-every K] [--flush-seconds S] [--no-shuffle] [--landscape]
 // Creates PATH, or resumes it when it exists. Prints "resumed <k>" / "created", then "finished".
 #include <unistd.h>
 
@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
     std::string a = argv[i];
     if (a == "--delay-us" && i + 1 < argc) delay_us = std::atol(argv[++i]);
     else if (a == "--flush-every" && i + 1 < argc) opt.flush_every_runs = static_cast<std::size_t>(std::atol(argv[++i]));
+    else if (a == "--flush-seconds" && i + 1 < argc) opt.flush_every_seconds = std::atof(argv[++i]);
     else if (a == "--no-shuffle") shuffle = false;
     else if (a == "--landscape") landscape = true;
   }

@@ -18,12 +18,16 @@ namespace ks::store {
 class StoreError : public std::runtime_error {
  public:
   StoreError(std::string path, std::string cause)
-      : std::runtime_error("results store: " + (path.empty() ? std::string() : path + ": ") + cause),
-        path_(std::move(path)), cause_(std::move(cause)) {}
+      : std::runtime_error(message(path, cause)), path_(std::move(path)), cause_(std::move(cause)) {}
   const std::string& path() const { return path_; }
   const std::string& cause() const { return cause_; }
 
  private:
+  static std::string message(const std::string& path, const std::string& cause) {
+    std::string m("results store: ");
+    if (!path.empty()) m.append(path).append(": ");
+    return m.append(cause);
+  }
   std::string path_, cause_;
 };
 
