@@ -83,8 +83,9 @@ int dry_run(const Study& study, const StudySchema& schema, const HistoryPolicy& 
     const auto params = study.blocks[ref.block].params(ref.local);
     const auto t0 = std::chrono::steady_clock::now();
     const RunOutcome o = execute_run(study, ref.block, params, stride, ws);
+    const store::EncodedHistory encoded = store::encode_history(o.history);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    for (const auto& a : store::encode_history(o.history).arrays) bytes += static_cast<double>(a.bytes.size()) + 600;
+    for (const auto& a : encoded.arrays) bytes += static_cast<double>(a.bytes.size()) + 600;
   }
   const double per_run_s = samples ? seconds / samples : 0, per_run_b = samples ? bytes / samples : 0;
   const int n = threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency());
