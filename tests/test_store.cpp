@@ -139,6 +139,8 @@ std::string slurp(const std::string& p) {
 }
 
 // ------------------------------------------------------------------------------------------------
+// The bytes are what HDF5's filter pipeline stores: zlib(shuffle(data)); inflating and unshuffling
+// (byte j of element i at j * n + i) gives the array back.
 TEST(StoreEncode, DeflateStreamDecodesToTheRawArray) {
   auto h = test_history(3);
   auto e = encode_history(h, 6);
@@ -147,12 +149,18 @@ TEST(StoreEncode, DeflateStreamDecodesToTheRawArray) {
     const auto& a = h.arrays[k];
     EXPECT_EQ(e.arrays[k].rows, a.rows);
     if (a.data.empty()) { EXPECT_TRUE(e.arrays[k].bytes.empty()); continue; }
-    std::vector<double> back(a.data.size());
-    uLongf n = static_cast<uLongf>(back.size() * sizeof(double));
-    ASSERT_EQ(uncompress(reinterpret_cast<Bytef*>(back.data()), &n, e.arrays[k].bytes.data(), e.arrays[k].bytes.size()),
-              Z_OK);
+    std::vector<unsigned char> shuffled(a.data.size() * sizeof(double));
+    uLongf n = static_cast<uLongf>(shuffled.size());
+    ASSERT_EQ(uncompress(shuffled.data(), &n, e.arrays[k].bytes.data(), e.arrays[k].bytes.size()), Z_OK);
     EXPECT_EQ(n, a.data.size() * sizeof(double));
+    std::vector<double> back(a.data.size());
+    auto* b = reinterpret_cast<unsigned char*>(back.data());
+    for (std::size_t i = 0; i < back.size(); ++i)
+      for (std::size_t j = 0; j < 8; ++j) b[i * 8 + j] = shuffled[j * back.size() + i];
     EXPECT_EQ(0, std::memcmp(back.data(), a.data.data(), n));
+    auto raw = encode_history(RunHistory{{a}}, 0);  // level 0: the raw array, no filter
+    ASSERT_EQ(raw.arrays[0].bytes.size(), n);
+    EXPECT_EQ(0, std::memcmp(raw.arrays[0].bytes.data(), a.data.data(), n));
   }
   HistoryArray bad{"x", "", 3, 2, {1.0, 2.0}};
   EXPECT_THROW(encode_history(RunHistory{{bad}}), StoreError);

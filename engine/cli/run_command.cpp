@@ -62,7 +62,7 @@ std::string human_time(double s) {
   return buf;
 }
 
-int dry_run(const Study& study, const StudySchema& schema, const HistoryPolicy& h, int threads) {
+int dry_run(const Study& study, const StudySchema& schema, const HistoryPolicy& h, int threads, int level) {
   std::cout << "study " << study.name << " (" << study.file << "), sha256 " << study.sha256 << '\n';
   for (const Block& b : study.blocks) {
     std::cout << "  block " << b.name() << " (" << to_string(b.kind()) << "): " << b.run_count() << " runs =";
@@ -83,7 +83,7 @@ int dry_run(const Study& study, const StudySchema& schema, const HistoryPolicy& 
     const auto params = study.blocks[ref.block].params(ref.local);
     const auto t0 = std::chrono::steady_clock::now();
     const RunOutcome o = execute_run(study, ref.block, params, stride, ws);
-    const store::EncodedHistory encoded = store::encode_history(o.history);
+    const store::EncodedHistory encoded = store::encode_history(o.history, level);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const auto& a : encoded.arrays) bytes += static_cast<double>(a.bytes.size()) + 600;
   }
@@ -138,6 +138,8 @@ RunArgs& add_run_command(CLI::App& app) {
   c->add_flag("--overwrite", a.overwrite, "replace an existing results file");
   c->add_flag("--dry-run", a.dry_run, "print runs per block and estimated size and time; write nothing");
   c->add_option("--histories", a.histories, "full | every=N | none (default: the study's)");
+  c->add_option("--compression", a.compression, "deflate level of the histories, after HDF5's shuffle (default 1; 0: raw chunks, no filter)")
+      ->check(CLI::Range(0, 9));
   c->add_flag("-q,--quiet", a.quiet, "no progress display");
   return a;
 }
@@ -160,7 +162,7 @@ int run_command(const RunArgs& a) {
     return 2;
   }
   const StudySchema schema = make_schema(study);
-  if (a.dry_run) return dry_run(study, schema, histories, a.threads);
+  if (a.dry_run) return dry_run(study, schema, histories, a.threads, a.compression);
 
   const std::string out = a.output.empty() ? study.output : a.output;
   try {
@@ -188,6 +190,7 @@ int run_command(const RunArgs& a) {
     SweepOptions o;
     o.threads = a.threads;
     o.histories = histories;
+    o.compression = a.compression;
     o.stop = &g_stop;
     ProgressDisplay progress(a.quiet);
     o.on_progress = [&](const SweepProgress& p) { progress(p); };

@@ -1,6 +1,6 @@
 #pragma once
 // `kinesweep run STUDY.toml [-o FILE] [--threads N] [--resume] [--overwrite] [--dry-run]
-//  [--histories full|every=N|none]`
+//  [--histories full|every=N|none] [--compression 0..9] [-q]`
 #include <string>
 
 namespace CLI {
@@ -16,6 +16,7 @@ struct RunArgs {
   bool resume = false, overwrite = false, dry_run = false;
   std::string histories;   ///< empty: the study's policy
   bool quiet = false;      ///< no progress display
+  int compression = 1;     ///< history deflate level (0: raw chunks, no filter)
 };
 
 /// Register the subcommand; returns the argument struct it fills.

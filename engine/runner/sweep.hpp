@@ -28,7 +28,7 @@ struct SweepProgress {
 struct SweepOptions {
   int threads = 0;                   ///< worker threads (0: all cores)
   HistoryPolicy histories;           ///< what to keep of each run's history
-  int compression = 4;               ///< zlib level of the histories (0..9)
+  int compression = 1;               ///< deflate level of the histories (1..9; 0: raw, no filter)
   std::size_t batch = 8;             ///< runs per pipeline token
   const std::atomic<bool>* stop = nullptr;  ///< set (e.g. by SIGINT): finish the runs in flight and return
   std::function<void(const SweepProgress&)> on_progress;  ///< called by the writer after each batch

@@ -53,7 +53,8 @@ struct StoreOptions {
   bool durable = false;              ///< fsync around commits (power-loss safety; kill -9 safety needs none)
 };
 
-/// One history array compressed for HDF5's deflate filter (zlib stream of the row-major f64 data).
+/// One history array encoded for HDF5's filter pipeline (shuffle + deflate of the row-major f64 data;
+/// raw bytes when level is 0).
 struct EncodedArray {
   std::string name, unit;
   std::size_t rows = 0, cols = 1;
@@ -63,9 +64,10 @@ struct EncodedArray {
 struct EncodedHistory {
   std::vector<EncodedArray> arrays;
 };
-/// Compress a run's history in the calling thread (zlib compress2, `level` 0..9). Thread-safe,
+/// Compress a run's history in the calling thread: HDF5's shuffle then deflate (zlib format, by
+/// libdeflate, `level` 1..9), or raw chunks without filters for level 0. Thread-safe,
 /// no HDF5. Throws StoreError when an array's data size is not rows*cols.
-EncodedHistory encode_history(const RunHistory& history, int level = 4);
+EncodedHistory encode_history(const RunHistory& history, int level = 1);
 
 /// One axis of a block's grid, or one gridded metric (row-major over the axes, NaN = no value).
 struct LandscapeAxis {
@@ -105,7 +107,7 @@ class ResultsWriter {
   /// Store run `run_id` (0 <= run_id < n_runs, any order, rewriting allowed). The row becomes
   /// visible (done) at the next flush, automatic or explicit; its history is stored at once.
   void write_run(std::int64_t run_id, const Record& record, const EncodedHistory& history = {});
-  void write_run(std::int64_t run_id, const Record& record, const RunHistory& history, int level = 4);
+  void write_run(std::int64_t run_id, const Record& record, const RunHistory& history, int level = 1);
   /// Commit everything written so far (atomic: after a crash the file holds exactly the runs done
   /// at the last completed flush).
   void flush();

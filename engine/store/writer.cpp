@@ -3,9 +3,11 @@
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <libdeflate.h>
 #include <zlib.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -19,6 +21,7 @@
 #include "store/journal_vfd.hpp"
 #include "store/store.hpp"
 
+
 namespace ks::store {
 using namespace detail;
 
@@ -31,10 +34,33 @@ std::string history_group_name(std::int64_t run_id, std::int64_t n_runs) {
   return s;
 }
 
+namespace {
+/// HDF5's shuffle filter for 8-byte elements: byte j of element i goes to j * n + i.
+void shuffle8(const double* src, std::size_t n, unsigned char* dst) {
+  const unsigned char* s = reinterpret_cast<const unsigned char*>(src);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < 8; ++j) dst[j * n + i] = s[i * 8 + j];
+}
+/// One libdeflate compressor per thread and level (allocating one costs more than a small array).
+libdeflate_compressor* compressor(int level) {
+  struct Cache {
+    std::array<libdeflate_compressor*, 10> c{};
+    ~Cache() {
+      for (auto* p : c)
+        if (p) libdeflate_free_compressor(p);
+    }
+  };
+  thread_local Cache cache;
+  if (!cache.c[level]) cache.c[level] = libdeflate_alloc_compressor(level);
+  return cache.c[level];
+}
+}  // namespace
+
 EncodedHistory encode_history(const RunHistory& history, int level) {
   level = std::clamp(level, 0, 9);
   EncodedHistory out;
   out.arrays.reserve(history.arrays.size());
+  std::vector<unsigned char> shuffled;
   for (const auto& a : history.arrays) {
     if (a.data.size() != a.rows * a.cols)
       throw StoreError("", "history array '" + a.name + "' has " + std::to_string(a.data.size()) +
@@ -42,12 +68,20 @@ EncodedHistory encode_history(const RunHistory& history, int level) {
     EncodedArray e;
     e.name = a.name; e.unit = a.unit; e.rows = a.rows; e.cols = a.cols; e.level = level;
     if (!a.data.empty()) {
-      const uLong src = static_cast<uLong>(a.data.size() * sizeof(double));
-      uLongf dst = compressBound(src);
-      e.bytes.resize(dst);
-      if (compress2(e.bytes.data(), &dst, reinterpret_cast<const Bytef*>(a.data.data()), src, level) != Z_OK)
-        throw StoreError("", "zlib compress2 failed for history array '" + a.name + "'");
-      e.bytes.resize(dst);
+      const std::size_t src = a.data.size() * sizeof(double);
+      if (level == 0) {  // no filter: the chunk is the raw little-endian array
+        e.bytes.resize(src);
+        std::memcpy(e.bytes.data(), a.data.data(), src);
+      } else {  // shuffle, then deflate (zlib format, as HDF5's deflate filter writes it)
+        shuffled.resize(src);
+        shuffle8(a.data.data(), a.data.size(), shuffled.data());
+        libdeflate_compressor* c = compressor(level);
+        if (!c) throw StoreError("", "libdeflate: cannot allocate a compressor");
+        e.bytes.resize(libdeflate_zlib_compress_bound(c, src));
+        const std::size_t n = libdeflate_zlib_compress(c, shuffled.data(), src, e.bytes.data(), e.bytes.size());
+        if (n == 0) throw StoreError("", "libdeflate failed for history array '" + a.name + "'");
+        e.bytes.resize(n);
+      }
     }
     out.arrays.push_back(std::move(e));
   }
@@ -370,7 +404,10 @@ void ResultsWriter::Impl::write_history(std::int64_t id, const EncodedHistory& h
     const bool empty = a.rows == 0 || a.cols == 0;
     if (!empty) {
       H5Pset_chunk(dcpl, 2, dims);  // one chunk = the whole array
-      H5Pset_deflate(dcpl, static_cast<unsigned>(a.level));
+      if (a.level > 0) {            // the pipeline encode_history ran: shuffle, then deflate
+        H5Pset_shuffle(dcpl);
+        H5Pset_deflate(dcpl, static_cast<unsigned>(a.level));
+      }
     }
     Hid d(H5Dcreate2(g, a.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT));
     if (!d.ok()) fail("cannot create /histories/" + gname + "/" + a.name);
