@@ -169,7 +169,7 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
   const auto start = Clock::now();
   auto last_progress = start;
   std::uint64_t next = 0, written = 0;
-  const std::uint64_t todo = total - skipped;
+  const std::uint64_t todo = options.source ? options.source_runs : total - skipped;
   bool interrupted = false;
   auto is_done = [&](std::uint64_t id) { return previous && id < previous->done.size() && previous->done[id]; };
 
@@ -182,9 +182,15 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
             [&](tbb::flow_control& fc) -> std::shared_ptr<Batch> {
               if (options.stop && options.stop->load()) interrupted = true;
               auto b = std::make_shared<Batch>();
-              while (!interrupted && next < total && b->jobs.size() < options.batch) {
-                const std::uint64_t id = next++;
-                if (!is_done(id)) b->jobs.push_back(Job{id, study.locate(id), {}, {}});
+              if (options.source) {
+                std::vector<std::uint64_t> ids;
+                if (!interrupted && options.source(ids, options.batch))
+                  for (std::uint64_t id : ids) b->jobs.push_back(Job{id, study.locate(id), {}, {}});
+              } else {
+                while (!interrupted && next < total && b->jobs.size() < options.batch) {
+                  const std::uint64_t id = next++;
+                  if (!is_done(id)) b->jobs.push_back(Job{id, study.locate(id), {}, {}});
+                }
               }
               if (b->jobs.empty()) {
                 fc.stop();

@@ -32,6 +32,12 @@ struct SweepOptions {
   std::size_t batch = 8;             ///< runs per pipeline token
   const std::atomic<bool>* stop = nullptr;  ///< set (e.g. by SIGINT): finish the runs in flight and return
   std::function<void(const SweepProgress&)> on_progress;  ///< called by the writer after each batch
+  /// Where run ids come from: fill `ids` with up to `max` ids to run next (ascending within a call)
+  /// and return false when there are none left. Empty: every run id in order, skipping the done ones.
+  /// (A distributed runner hands out ids from a coordinator here.)
+  std::function<bool(std::vector<std::uint64_t>& ids, std::size_t max)> source;
+  /// The number of runs `source` will hand out (for progress); 0: all runs not done.
+  std::uint64_t source_runs = 0;
   double progress_interval_s = 0.25;  ///< minimum time between on_progress calls
 };
 
