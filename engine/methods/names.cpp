@@ -1,39 +1,20 @@
 // Names of methods, integrators and statuses: the one table shared by the CLI, study files and HDF5.
-#include <array>
-#include <utility>
+#include "common/name_table.hpp"
 
 #include "methods/trajectory.hpp"
 
 namespace ks {
 namespace {
-template <class E, std::size_t N>
-using Table = std::array<std::pair<E, std::string_view>, N>;
-
-constexpr Table<TrajectoryMethod, 3> kMethods{{{TrajectoryMethod::local_weighted, "local_weighted"},
+constexpr NameTable<TrajectoryMethod, 3> kMethods{{{TrajectoryMethod::local_weighted, "local_weighted"},
                                                {TrajectoryMethod::local_unweighted, "local_unweighted"},
                                                {TrajectoryMethod::vertex_alpha, "vertex_alpha"}}};
-constexpr Table<Integrator, 2> kIntegrators{
+constexpr NameTable<Integrator, 2> kIntegrators{
     {{Integrator::semi_implicit_euler, "semi_implicit_euler"}, {Integrator::rk4, "rk4"}}};
-constexpr Table<RunStatus, 4> kStatuses{{{RunStatus::ok, "ok"},
+constexpr NameTable<RunStatus, 4> kStatuses{{{RunStatus::ok, "ok"},
                                          {RunStatus::unreachable_start, "unreachable_start"},
                                          {RunStatus::singular, "singular"},
                                          {RunStatus::diverged, "diverged"}}};
 
-template <class E, std::size_t N>
-std::string_view name_of(const Table<E, N>& t, E e) {
-  for (const auto& [v, n] : t)
-    if (v == e) return n;
-  return "?";
-}
-template <class E, std::size_t N>
-bool value_of(const Table<E, N>& t, std::string_view name, E& out) {
-  for (const auto& [v, n] : t)
-    if (n == name) {
-      out = v;
-      return true;
-    }
-  return false;
-}
 }  // namespace
 
 std::string_view to_string(TrajectoryMethod m) { return name_of(kMethods, m); }

@@ -15,9 +15,10 @@ struct JointTrig {
 template <class Vec3>
 inline JointTrig joint_trig(const Vec3& q) {
   JointTrig t;
-  fast_sincos(q[0], t.s1, t.c1);
-  fast_sincos(q[1], t.s2, t.c2);
-  fast_sincos(q[2], t.s3, t.c3);
+  const double x[3] = {q[0], q[1], q[2]};
+  double s[3], c[3];
+  fast_sincos3(x, s, c);
+  t.s1 = s[0], t.c1 = c[0], t.s2 = s[1], t.c2 = c[1], t.s3 = s[2], t.c3 = c[2];
   t.s23 = t.s2 * t.c3 + t.c2 * t.s3;
   t.c23 = t.c2 * t.c3 - t.s2 * t.s3;
   t.s12 = t.s1 * t.c2 + t.c1 * t.s2;
