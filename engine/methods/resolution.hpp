@@ -30,9 +30,11 @@ inline Vec3 local_acceleration(Weighting w, const Ldlt3& llt, const Mat23& J, co
   const double a11 = J(1, 0) * y1[0] + J(1, 1) * y1[1] + J(1, 2) * y1[2];
   const double r0 = b[0] + J(0, 0) * v[0] + J(0, 1) * v[1] + J(0, 2) * v[2];
   const double r1 = b[1] + J(1, 0) * v[0] + J(1, 1) * v[1] + J(1, 2) * v[2];
+  // z = A^-1 r = adj(A) r / det(A): the division runs while Y adj(A) r is formed (shorter chain)
   const double inv_det = 1.0 / (a00 * a11 - a01 * a01);
-  const double z0 = (a11 * r0 - a01 * r1) * inv_det, z1 = (a00 * r1 - a01 * r0) * inv_det;
-  return {y0[0] * z0 + y1[0] * z1 - v[0], y0[1] * z0 + y1[1] * z1 - v[1], y0[2] * z0 + y1[2] * z1 - v[2]};
+  const double w0 = a11 * r0 - a01 * r1, w1 = a00 * r1 - a01 * r0;
+  const Vec3 yw(y0[0] * w0 + y1[0] * w1, y0[1] * w0 + y1[1] * w1, y0[2] * w0 + y1[2] * w1);
+  return {yw[0] * inv_det - v[0], yw[1] * inv_det - v[1], yw[2] * inv_det - v[2]};
 }
 
 /// Non-redundant resolution (vertex_alpha, seed cases 3-5): solve [J; 1 1 1] qdd = [b; alpha_dd]
