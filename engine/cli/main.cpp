@@ -2,6 +2,8 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "cli/info_command.hpp"
+#include "cli/query_command.hpp"
 #include "cli/run_command.hpp"
 #include "cli/table4.hpp"
 
@@ -10,6 +12,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("kinesweep ") + KINESWEEP_VERSION);
   app.require_subcommand(1);
   ks::cli::RunArgs& run = ks::cli::add_run_command(app);
+  ks::cli::InfoArgs& info = ks::cli::add_info_command(app);
+  ks::cli::QueryArgs& query = ks::cli::add_query_command(app);
   auto* table4 = app.add_subcommand("table4", "Print seed 000's Table 4 beside kinesweep's figures (no file)");
   try {
     app.parse(argc, argv);
@@ -22,5 +26,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (app.got_subcommand("run")) return ks::cli::run_command(run);
+  if (app.got_subcommand("info")) return ks::cli::info_command(info);
+  if (app.got_subcommand("query")) return ks::cli::query_command(query);
   return 0;
 }

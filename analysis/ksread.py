@@ -1,0 +1,336 @@
+"""Read kinesweep results files (HDF5, layout in engine/store/FORMAT.md) with h5py and numpy.
+
+    import ksread
+    r = ksread.open_results("results/thesis_table4.h5")
+    runs = r.runs()                      # dict of numpy arrays (done rows only), .units / .descriptions
+    runs["E"], runs.units["E"]           # array, "Nm"
+    df = r.runs(pandas=True)             # a pandas.DataFrame when pandas is installed (units in df.attrs)
+    h = r.history(3)                     # dict of 2-D arrays (rows x components) with .units
+    ls = r.landscape("local")            # axes (name, unit, values, labels) and gridded metrics
+
+Angles are stored in radians (unit "rad"); pass degrees=True to runs()/history()/landscape() to get
+them in degrees (their unit then reads "deg"). Run with Debian's interpreter: /usr/bin/python3.
+"""
+import os
+
+import h5py
+import numpy as np
+
+RAD2DEG = 180.0 / np.pi
+
+# Seed 000, Table 4 (copied from engine/methods/seed_cases.cpp, checked against it by the tests):
+# case -> (method, k, alpha1A [deg], thesis E [Nm], thesis (|tau1|inf, |tau2|inf, |tau3|inf) [Nm]).
+THESIS_TABLE4 = {
+    "1a": ("local_weighted", 0.0, 0.0, 51.03, (82.63, 32.31, 8.77)),
+    "1b": ("local_weighted", 0.0, 0.0, 51.03, (82.63, 32.31, 8.77)),
+    "1c": ("local_weighted", 0.0, 15.0, 55.77, (79.09, 33.26, 8.41)),
+    "1d": ("local_weighted", 0.57, 15.0, 51.70, (627.76, 111.32, 12.21)),
+    "1e": ("local_weighted", 0.0, 30.0, 62.27, (93.33, 42.30, 7.21)),
+    "1f": ("local_weighted", 0.16, 30.0, 54.32, (215.59, 50.28, 9.52)),
+    "1g": ("local_weighted", 0.0, -23.5, 38.63, (101.39, 45.40, 8.78)),
+    "1h": ("local_weighted", 0.13, -24.1, 37.79, (109.44, 48.33, 8.79)),
+    "2a": ("local_unweighted", 0.0, 0.0, 48.63, (50.33, 30.00, 8.71)),
+    "2b": ("local_unweighted", 0.0, 0.0, 48.63, (50.33, 30.00, 8.71)),
+    "2c": ("local_unweighted", 0.0, 15.0, 54.09, (57.32, 29.14, 8.61)),
+    "2d": ("local_unweighted", 0.75, 15.0, 54.07, (5301.60, 2135.90, 263.50)),
+    "2e": ("local_unweighted", 0.0, 30.0, 61.04, (387.90, 153.58, 22.35)),
+    "2f": ("local_unweighted", 0.18, 30.0, 54.83, (1076.50, 401.30, 49.40)),
+    "2g": ("local_unweighted", 0.0, -20.1, 39.41, (59.77, 51.65, 8.95)),
+    "2h": ("local_unweighted", 0.06, -23.5, 37.41, (90.23, 60.75, 10.30)),
+    "3": ("vertex_alpha", 0.0, -18.9, 53.58, (139.75, 35.49, 8.56)),
+    "4": ("vertex_alpha", 0.0, -18.3, 48.39, (116.40, 30.83, 8.58)),
+    "5a": ("vertex_alpha", 0.0, 0.0, 66.65, (178.82, 28.20, 8.26)),
+    "5b": ("vertex_alpha", 0.0, 15.0, 60.81, (121.11, 28.22, 8.26)),
+    "5c": ("vertex_alpha", 0.0, 30.0, 60.05, (107.88, 28.23, 8.26)),
+}
+# The thesis' optimised points on the (alpha1A, k) landscape of each local method:
+# the global optimum (1h / 2h) and the partial optima (k or alpha1A optimised alone).
+THESIS_OPTIMA = {
+    "local_weighted": {"global": "1h", "partial": ["1d", "1f", "1g"]},
+    "local_unweighted": {"global": "2h", "partial": ["2d", "2f", "2g"]},
+}
+
+TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged"]
+IK_STATUSES = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution"]
+
+
+def _s(v):
+    return v.decode() if isinstance(v, bytes) else str(v)
+
+
+class Table(dict):
+    """dict of column name -> 1-D numpy array, with .units and .descriptions dicts."""
+
+    def __init__(self, *a, **kw):
+        super().__init__(*a, **kw)
+        self.units = {}
+        self.descriptions = {}
+
+    def __len__(self):  # number of rows, as for a DataFrame
+        return len(next(iter(self.values()))) if dict.__len__(self) else 0
+
+    def columns(self):
+        return list(self.keys())
+
+    def to_pandas(self):
+        import pandas as pd  # optional dependency
+        df = pd.DataFrame(dict(self))
+        df.attrs["units"] = dict(self.units)
+        return df
+
+
+class Axis:
+    def __init__(self, name, unit, values, labels=None):
+        self.name, self.unit, self.values, self.labels = name, unit, values, labels
+
+    @property
+    def categorical(self):
+        return self.labels is not None
+
+    def __repr__(self):
+        return f"Axis({self.name!r}, {self.unit!r}, {len(self.values)} values)"
+
+
+class Landscape:
+    """A block's gridded metrics: .axes (list of Axis), .metrics (name -> N-D array, NaN = no value),
+    .units / .descriptions (name -> str). metrics[m][i, j, ...] is at axes[0].values[i], ..."""
+
+    def __init__(self, block, axes, metrics, units, descriptions):
+        self.block, self.axes, self.metrics, self.units, self.descriptions = block, axes, metrics, units, descriptions
+
+    def axis(self, name):
+        for a in self.axes:
+            if a.name == name:
+                return a
+        raise KeyError(f"landscape {self.block} has no axis {name!r}; axes: {', '.join(a.name for a in self.axes)}")
+
+    def axis_index(self, name):
+        return [a.name for a in self.axes].index(self.axis(name).name)
+
+    @property
+    def kind(self):
+        return "ik" if "converged" in self.metrics else "trajectory"
+
+    @property
+    def statuses(self):
+        return IK_STATUSES if self.kind == "ik" else TRAJECTORY_STATUSES
+
+
+class Results:
+    """An open results file (read-only). Safe on a file a sweep is writing: it sees the last commit."""
+
+    def __init__(self, path):
+        if not os.path.exists(path):
+            raise FileNotFoundError(path)
+        self.path = path
+        self.f = h5py.File(path, "r")
+        a = self.f.attrs
+        if _s(a.get("format", "")) != "kinesweep-results":
+            raise ValueError(f"{path}: not a kinesweep results file")
+        self.meta = {k: (_s(v) if isinstance(v, (bytes, str)) else v.item() if hasattr(v, "item") else v)
+                     for k, v in a.items()}
+        self.study_text = _s(self.f["study"]["text"][()])
+
+    def close(self):
+        self.f.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    @property
+    def n_runs(self):
+        return int(self.f["runs"].attrs.get("n_runs", len(self.f["runs"]["done"])))
+
+    def columns(self):
+        return [_s(c) for c in self.f["runs"].attrs["columns"]]
+
+    def units(self):
+        return {c: _s(self.f["runs"][c].attrs.get("unit", "")) for c in self.columns()}
+
+    def runs(self, columns=None, done_only=True, degrees=False, pandas=False):
+        """The /runs table: Table (dict of arrays; strings as str objects) or a pandas DataFrame."""
+        g = self.f["runs"]
+        done = g["done"][()].astype(bool)  # before the columns (a writer may be committing)
+        names = self.columns() if columns is None else list(columns)
+        t = Table()
+        for c in names:
+            if c not in g:
+                raise KeyError(f"no column {c!r}; columns: {', '.join(self.columns())}")
+            d = g[c]
+            v = d[()]
+            if v.dtype.kind in "OSU":
+                v = np.array([_s(x) for x in v], dtype=object)
+            unit = _s(d.attrs.get("unit", ""))
+            if degrees and unit == "rad":
+                v, unit = v * RAD2DEG, "deg"
+            t[c] = v[done] if done_only else v
+            t.units[c] = unit
+            t.descriptions[c] = _s(d.attrs.get("description", ""))
+        if not done_only:
+            t["done"] = done
+            t.units["done"] = ""
+        return t.to_pandas() if pandas else t
+
+    def has_history(self, run_id):
+        return "histories" in self.f and history_group_name(run_id, self.n_runs) in self.f["histories"]
+
+    def history(self, run_id, degrees=False):
+        """One run's history: Table of name -> 2-D array (rows x components), .units per array
+        (IK q: "rad, rad, mm" -- one unit per component)."""
+        name = history_group_name(run_id, self.n_runs)
+        if not self.has_history(run_id):
+            raise KeyError(f"run {run_id} has no history in {self.path}")
+        g = self.f["histories"][name]
+        h = Table()
+        order = [_s(x) for x in g.attrs["arrays"]] if "arrays" in g.attrs else list(g)
+        for a in order:
+            v = np.array(g[a][()], dtype=float)
+            if v.ndim == 1:
+                v = v[:, None]
+            unit = _s(g[a].attrs.get("unit", ""))
+            if degrees:
+                parts = [p.strip() for p in unit.split(",")]
+                if len(parts) == v.shape[1] and "rad" in parts:
+                    v = v.copy()
+                    for j, p in enumerate(parts):
+                        if p == "rad":
+                            v[:, j] *= RAD2DEG
+                            parts[j] = "deg"
+                    unit = ", ".join(parts)
+                elif unit == "rad":
+                    v, unit = v * RAD2DEG, "deg"
+            h[a] = v
+            h.units[a] = unit
+        return h
+
+    def landscapes(self):
+        return list(self.f["landscapes"]) if "landscapes" in self.f else []
+
+    def landscape(self, block=None, degrees=False):
+        names = self.landscapes()
+        if not names:
+            raise KeyError(f"{self.path} holds no landscapes")
+        if block is None:
+            block = names[0]
+        if block not in names:
+            raise KeyError(f"no landscape {block!r}; landscapes: {', '.join(names)}")
+        g = self.f["landscapes"][block]
+        axes = []
+        for a in (_s(x) for x in g.attrs["axes"]):
+            unit = _s(g[a].attrs.get("unit", ""))
+            vals = np.array(g[a][()], dtype=float)
+            labels = None
+            if unit.startswith("labels:"):
+                labels, unit = unit[len("labels:"):].split(","), ""
+            elif degrees and unit == "rad":
+                vals, unit = vals * RAD2DEG, "deg"
+            axes.append(Axis(a, unit, vals, labels))
+        metrics, units, desc = {}, {}, {}
+        for m in (_s(x) for x in g.attrs["metrics"]):
+            metrics[m] = np.array(g[m][()], dtype=float)
+            units[m] = _s(g[m].attrs.get("unit", ""))
+            desc[m] = _s(g[m].attrs.get("description", ""))
+        return Landscape(block, axes, metrics, units, desc)
+
+
+def open_results(path):
+    return Results(path)
+
+
+def read_runs(path, **kw):
+    with Results(path) as r:
+        return r.runs(**kw)
+
+
+def read_history(path, run_id, **kw):
+    with Results(path) as r:
+        return r.history(run_id, **kw)
+
+
+def read_landscape(path, block=None, **kw):
+    with Results(path) as r:
+        return r.landscape(block, **kw)
+
+
+def history_group_name(run_id, n_runs):
+    """Zero-padded group name under /histories: 6 digits, wider when n_runs needs it."""
+    width = max(6, len(str(max(int(n_runs) - 1, 0))))
+    return str(int(run_id)).zfill(width)
+
+
+# ------------------------------------------------------------------------------------------------
+# Shared by the plot scripts.
+
+def add_output_args(p, default_size="800x600"):
+    p.add_argument("file", help="results file (.h5) written by `kinesweep run`")
+    p.add_argument("-o", "--output", help="output picture (default: FILE's name + a suffix, .png); "
+                   "a .svg name writes SVG")
+    p.add_argument("--svg", action="store_true", help="write SVG instead of PNG")
+    p.add_argument("--size", default=default_size, help="picture size in pixels WxH (default %(default)s)")
+    p.add_argument("--dpi", type=float, default=100.0, help="dots per inch (default %(default)s)")
+    p.add_argument("--title", help="replace the title")
+    p.add_argument("--print-data", action="store_true",
+                   help="also print the plotted numbers as JSON on stdout (for tests and checking)")
+
+
+def figure(args):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    try:
+        w, h = (int(x) for x in args.size.lower().split("x"))
+    except ValueError:
+        raise SystemExit(f"--size {args.size!r}: expected WxH in pixels, e.g. 800x600")
+    return plt, (w / args.dpi, h / args.dpi)
+
+
+def output_path(args, suffix):
+    out = args.output
+    if not out:
+        base = os.path.splitext(args.file)[0]
+        out = f"{base}_{suffix}." + ("svg" if args.svg else "png")
+    elif args.svg and not out.lower().endswith(".svg"):
+        out = os.path.splitext(out)[0] + ".svg"
+    return out
+
+
+def save(fig, args, suffix):
+    out = output_path(args, suffix)
+    d = os.path.dirname(out)
+    if d:
+        os.makedirs(d, exist_ok=True)
+    fmt = "svg" if out.lower().endswith(".svg") else "png"
+    fig.savefig(out, dpi=args.dpi, format=fmt)
+    return out
+
+
+def print_json(obj):
+    import json
+
+    def clean(o):
+        if isinstance(o, dict):
+            return {str(k): clean(v) for k, v in o.items()}
+        if isinstance(o, (list, tuple)):
+            return [clean(v) for v in o]
+        if isinstance(o, np.ndarray):
+            return clean(o.tolist())
+        if isinstance(o, (np.floating, float)):
+            return None if not np.isfinite(o) else float(o)
+        if isinstance(o, np.integer):
+            return int(o)
+        return o
+
+    print(json.dumps(clean(obj)))
+
+
+def axis_label(name, unit):
+    pretty = {"alpha1A": "α1A", "q0_1": "θ1 initial guess (q0_1)", "q0_2": "θ2 initial guess (q0_2)",
+              "k": "k (gravity weight)", "lambda": "λ"}.get(name, name)
+    return f"{pretty} [{unit}]" if unit else pretty
+
+
+def fmt_num(v):
+    return f"{v:.4g}"

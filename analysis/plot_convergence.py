@@ -1,0 +1,110 @@
+#!/usr/bin/python3
+"""‖F_k‖ against iteration (log scale) per IK method and λ, from the runs' iteration histories.
+
+By default one line per (method, lambda) present among the IK runs with a history: the first such
+run (lowest id); --start Q1,Q2 picks the runs whose initial guess (degrees) is nearest instead, and
+--runs lists run ids explicitly.
+
+    /usr/bin/python3 analysis/plot_convergence.py results/ik_scara.h5 --start 60,45
+"""
+import argparse
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import ksread  # noqa: E402
+
+LAMBDA_METHODS = {"lm", "lm_adaptive"}
+
+
+def parse_args(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ksread.add_output_args(p)
+    p.add_argument("--runs", help="run ids, comma-separated")
+    p.add_argument("--start", help="initial guess q0_1,q0_2 in degrees: per (method, lambda) the nearest run")
+    p.add_argument("--methods", help="only these methods, comma-separated")
+    return p.parse_args(argv)
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    res = ksread.open_results(args.file)
+    need = ["run_id", "block", "method", "lambda", "q0_1", "q0_2", "status", "iterations"]
+    missing = [c for c in need if c not in res.columns()]
+    if missing:
+        raise SystemExit(f"{args.file}: not an IK study (no column {', '.join(missing)})")
+    runs = res.runs(columns=need, degrees=True)
+    ik = runs["iterations"] >= 0
+    if args.methods:
+        ik &= np.isin(runs["method"], [m.strip() for m in args.methods.split(",")])
+    if args.runs:
+        ids = [int(x) for x in args.runs.split(",")]
+    else:
+        groups = {}
+        for i in np.nonzero(ik)[0]:
+            m = runs["method"][i]
+            key = (m, float(runs["lambda"][i]) if m in LAMBDA_METHODS else None)
+            groups.setdefault(key, []).append(i)
+        ids = []
+        for key, rows in groups.items():
+            rows = [i for i in rows if res.has_history(int(runs["run_id"][i]))]
+            if not rows:
+                continue
+            if args.start:
+                q1, q2 = (float(v) for v in args.start.split(","))
+                d = [(runs["q0_1"][i] - q1) ** 2 + (runs["q0_2"][i] - q2) ** 2 for i in rows]
+                rows = [rows[int(np.argmin(d))]]
+            ids.append(int(runs["run_id"][rows[0]]))
+    if not ids:
+        raise SystemExit(f"{args.file}: no IK run with an iteration history (run the study with histories)")
+    rid = {int(r): i for i, r in enumerate(runs["run_id"])}
+    plt, size = ksread.figure(args)
+    fig, ax = plt.subplots(figsize=size, constrained_layout=True)
+    import matplotlib
+    cmap = matplotlib.colormaps["plasma"]
+    lams = sorted({float(runs["lambda"][rid[r]]) for r in ids if runs["method"][rid[r]] in LAMBDA_METHODS})
+    styles = {"lm": "-", "lm_adaptive": "--"}
+    other = iter(["#000000", "#1b9e77", "#7570b3", "#e7298a", "#66a61e"])
+    other_colour = {}
+    data = {}
+    floor = None
+    for r in ids:
+        i = rid[r]
+        h = res.history(r)
+        k, nf = h["k"][:, 0], h["norm_F"][:, 0]
+        m = runs["method"][i]
+        if m in LAMBDA_METHODS:
+            lam = float(runs["lambda"][i])
+            c = cmap(0.05 + 0.85 * (lams.index(lam) / max(1, len(lams) - 1)))
+            lab = f"{m}, λ = {lam:g}"
+            ls = styles[m]
+        else:
+            c = other_colour.setdefault(m, next(other, "#444444"))
+            lab, ls = m, "-"
+        lab += f" ({runs['status'][i]}, {int(runs['iterations'][i])} it.)"
+        pos = nf > 0
+        ax.semilogy(k[pos], nf[pos], ls, color=c, lw=1.4, marker="o" if len(k) < 40 else None, ms=3, label=lab)
+        floor = nf[pos].min() if floor is None or not pos.any() else min(floor, nf[pos].min())
+        data[r] = {"label": lab, "k": k, "norm_F": nf, "method": m,
+                   "lambda": float(runs["lambda"][i]) if m in LAMBDA_METHODS else None}
+    ax.set_xlabel("iteration k")
+    ax.set_ylabel("‖F_k‖ [problem units: mm for the SCARA]")
+    ax.grid(which="both", alpha=0.25)
+    if max(len(d["k"]) for d in data.values()) > 200:
+        ax.set_xscale("symlog", linthresh=10)
+        ax.set_xlabel("iteration k (linear to 10, then log)")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
+    q = f" from q0 = ({args.start}) deg" if args.start else ""
+    ax.set_title(args.title or f"Convergence ‖F_k‖ per method and λ{q}\n{os.path.basename(args.file)}", fontsize=10)
+    out = ksread.save(fig, args, "convergence")
+    if args.print_data:
+        ksread.print_json({"file": args.file, "runs": data, "output": out})
+    else:
+        print(out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,236 @@
+#include "cli/info_command.hpp"
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <iomanip>
+#include <map>
+#include <sstream>
+
+#include "cli/query_util.hpp"
+#include "store/store.hpp"
+
+namespace ks::cli {
+
+namespace {
+
+struct BlockSummary {
+  std::string name, kind;
+  std::vector<std::int64_t> rows;  ///< all rows of the block (done or not)
+  std::int64_t done = 0;
+  std::vector<std::pair<std::string, std::int64_t>> statuses;  ///< first-seen order
+};
+
+std::string cell_for_humans(const RunsColumn& c, std::int64_t r) {
+  switch (c.type) {
+    case CellType::str: return c.s[r];
+    case CellType::i64: return std::to_string(c.i[r]);
+    case CellType::f64: return format_double(c.angle() ? c.f[r] * kRadToDeg : c.f[r]) + (c.angle() ? " deg" : "");
+  }
+  return "";
+}
+
+bool same(const RunsColumn& c, std::int64_t a, std::int64_t b) {
+  switch (c.type) {
+    case CellType::str: return c.s[a] == c.s[b];
+    case CellType::i64: return c.i[a] == c.i[b];
+    case CellType::f64: return c.f[a] == c.f[b] || (std::isnan(c.f[a]) && std::isnan(c.f[b]));
+  }
+  return true;
+}
+
+std::string axis_text(const store::LandscapeAxis& a) {
+  std::ostringstream o;
+  o << a.name << " (" << a.values.size();
+  if (a.unit.rfind("labels:", 0) == 0) {
+    o << ": " << a.unit.substr(7);
+  } else if (!a.values.empty()) {
+    const bool deg = a.unit == "rad";
+    const double k = deg ? kRadToDeg : 1.0;
+    o << ", " << format_double(a.values.front() * k) << " .. " << format_double(a.values.back() * k);
+    if (deg) o << " deg";
+    else if (!a.unit.empty()) o << " " << a.unit;
+  }
+  o << ")";
+  return o.str();
+}
+
+int run_info(const InfoArgs& args) {
+  store::ResultsReader reader(args.file);
+  const RunsTable t = load_runs(reader);
+  const store::StoreMeta& m = t.meta;
+  std::ostream& os = std::cout;
+  const auto n_done = std::count(t.done.begin(), t.done.end(), std::uint8_t{1});
+  os << "file        " << args.file << '\n';
+  os << "study       " << m.study_name << (m.study_path.empty() ? "" : "  (source " + m.study_path + ")") << '\n';
+  os << "sha256      " << m.study_sha256 << "  (of the study file's text, stored in /study/text)\n";
+  os << "engine      kinesweep " << m.engine_version << "; format " << m.format << " v" << m.format_version
+     << "; created " << m.created << '\n';
+  os << "runs        " << n_done << " of " << t.n_runs << " done";
+  if (n_done < t.n_runs) os << " (" << (t.n_runs - n_done) << " pending: a sweep is running, was interrupted, or resume is needed)";
+  os << '\n';
+  if (!t.consistent) os << "note        the file kept changing while it was read (a sweep is writing it)\n";
+
+  // Blocks in run-id order.
+  std::vector<BlockSummary> blocks;
+  const RunsColumn* block = t.find("block");
+  const RunsColumn* status = t.find("status");
+  for (std::int64_t r = 0; r < t.n_runs; ++r) {
+    const std::string name = block ? block->s[r] : std::string("(all)");
+    const bool is_done = t.done[static_cast<std::size_t>(r)] != 0;
+    if (name.empty() && !is_done) {  // a pending row holds no block name: count it apart
+      if (blocks.empty() || blocks.back().name != "(pending)") blocks.push_back({"(pending)", "", {}, 0, {}});
+      blocks.back().rows.push_back(r);
+      continue;
+    }
+    auto it = std::find_if(blocks.begin(), blocks.end(), [&](const BlockSummary& b) { return b.name == name; });
+    if (it == blocks.end()) {
+      blocks.push_back({name, "", {}, 0, {}});
+      it = blocks.end() - 1;
+    }
+    it->rows.push_back(r);
+    if (!is_done) continue;
+    ++it->done;
+    if (it->kind.empty()) it->kind = t.kind(r);
+    const std::string st = status ? status->s[r] : "";
+    auto s = std::find_if(it->statuses.begin(), it->statuses.end(), [&](auto& p) { return p.first == st; });
+    if (s == it->statuses.end()) it->statuses.push_back({st, 1});
+    else ++s->second;
+  }
+  std::size_t wn = 5;
+  for (auto& b : blocks) wn = std::max(wn, b.name.size());
+  os << '\n' << std::left;
+  os << std::setw(static_cast<int>(wn)) << "block" << "  " << std::setw(10) << "kind" << std::right << std::setw(9)
+     << "runs" << std::setw(9) << "done" << "  status\n";
+  for (auto& b : blocks) {
+    os << std::left << std::setw(static_cast<int>(wn)) << b.name << "  " << std::setw(10) << b.kind << std::right
+       << std::setw(9) << b.rows.size() << std::setw(9) << b.done << "  ";
+    std::sort(b.statuses.begin(), b.statuses.end(), [](auto& x, auto& y) { return x.second > y.second; });
+    for (std::size_t i = 0; i < b.statuses.size(); ++i)
+      os << (i ? ", " : "") << b.statuses[i].first << " " << b.statuses[i].second;
+    os << '\n';
+  }
+
+  // Best rows per block.
+  os << "\nbest rows per block (trajectory: lowest E among ok runs; ik: fewest iterations among converged runs,\n"
+        "then smallest error)\n";
+  for (const auto& b : blocks) {
+    if (b.done == 0 || b.name == "(pending)") continue;
+    const bool ik = b.kind == "ik";
+    const RunsColumn* key = t.find(ik ? "iterations" : "E");
+    const RunsColumn* tie = ik ? t.find("error") : nullptr;
+    const std::string good = ik ? "converged" : "ok";
+    if (!key || !status) continue;
+    std::vector<std::int64_t> cand;
+    for (auto r : b.rows)
+      if (t.done[static_cast<std::size_t>(r)] && status->s[r] == good) cand.push_back(r);
+    auto val = [&](const RunsColumn* c, std::int64_t r) {
+      return c->type == CellType::i64 ? static_cast<double>(c->i[r]) : c->f[r];
+    };
+    std::stable_sort(cand.begin(), cand.end(), [&](std::int64_t x, std::int64_t y) {
+      const double u = val(key, x), v = val(key, y);
+      if (u != v) return u < v;
+      return tie ? val(tie, x) < val(tie, y) : false;
+    });
+    // Parameters that vary within the block identify a row.
+    std::vector<const RunsColumn*> varying;
+    for (const auto& c : t.cols) {
+      if (RunsTable::role(c.name) != ColumnRole::parameter) continue;
+      for (auto r : b.rows)
+        if (t.done[static_cast<std::size_t>(r)] && !same(c, r, b.rows.front())) {
+          varying.push_back(&c);
+          break;
+        }
+    }
+    if (cand.empty()) {
+      os << "  " << b.name << ": no " << good << " run\n";
+      continue;
+    }
+    for (std::size_t i = 0; i < cand.size() && i < static_cast<std::size_t>(std::max(0, args.best)); ++i) {
+      const auto r = cand[i];
+      os << "  " << std::left << std::setw(static_cast<int>(wn)) << b.name << std::right << "  run " << std::setw(6)
+         << r << "  " << key->name << " = " << cell_for_humans(*key, r) << (key->unit.empty() ? "" : " " + key->unit);
+      if (tie) os << ", error = " << cell_for_humans(*tie, r) << " " << tie->unit;
+      if (!varying.empty()) {
+        os << "   (";
+        for (std::size_t j = 0; j < varying.size(); ++j)
+          os << (j ? ", " : "") << varying[j]->name << " = " << cell_for_humans(*varying[j], r);
+        os << ")";
+      }
+      os << '\n';
+    }
+  }
+
+  // Histories: which runs hold one, and the arrays of each kind.
+  os << '\n';
+  std::int64_t with = 0, first = -1, last = -1;
+  std::map<std::string, std::int64_t> example;  // kind -> a run with a history
+  consistent_read(reader, [&] {
+    with = 0, first = last = -1;
+    example.clear();
+    for (std::int64_t r = 0; r < t.n_runs; ++r) {
+      if (!t.done[static_cast<std::size_t>(r)] || !reader.has_history(r)) continue;
+      ++with;
+      if (first < 0) first = r;
+      last = r;
+      example.emplace(t.kind(r), r);
+    }
+    return 0;
+  });
+  os << "histories   ";
+  if (with == 0) {
+    os << "none\n";
+  } else {
+    os << with << " of " << n_done << " done runs (run ids " << first << " .. " << last
+       << "); kinesweep query FILE --run ID --history NAME\n";
+    for (auto& [kind, r] : example) {
+      const RunHistory h = consistent_read(reader, [&] { return reader.read_history(r); });
+      os << "            " << kind << ": ";
+      for (std::size_t i = 0; i < h.arrays.size(); ++i) {
+        const auto& a = h.arrays[i];
+        os << (i ? ", " : "") << a.name;
+        if (a.cols > 1) os << "[" << a.cols << "]";
+        if (!a.unit.empty()) os << " (" << a.unit << ")";
+      }
+      os << "   (run " << r << ": " << (h.arrays.empty() ? 0 : h.arrays.front().rows) << " rows)\n";
+    }
+  }
+  // Landscapes.
+  const auto names = consistent_read(reader, [&] { return reader.landscapes(); });
+  os << "landscapes  " << (names.empty() ? "none" : "") << (names.empty() ? "\n" : "");
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const auto spec = consistent_read(reader, [&] { return reader.read_landscape(names[i]); });
+    os << (i ? "            " : "") << spec.block << ": ";
+    for (std::size_t j = 0; j < spec.axes.size(); ++j) os << (j ? " x " : "") << axis_text(spec.axes[j]);
+    os << "\n              metrics: ";
+    for (std::size_t j = 0; j < spec.metrics.size(); ++j) os << (j ? ", " : "") << spec.metrics[j].name;
+    os << '\n';
+  }
+  return 0;
+}
+
+}  // namespace
+
+InfoArgs& add_info_command(CLI::App& app) {
+  static InfoArgs a;
+  auto* s = app.add_subcommand("info", "Summarise a results file: study, runs by block and status, best rows, "
+                                       "histories, landscapes");
+  s->add_option("file", a.file, "results file (.h5); may be one a sweep is still writing")->required();
+  s->add_option("--best", a.best, "best rows shown per block (default 3)");
+  return a;
+}
+
+int info_command(const InfoArgs& args) {
+  try {
+    return run_info(args);
+  } catch (const store::StoreError& e) {
+    std::cerr << "kinesweep info: error: " << e.what() << '\n';
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "kinesweep info: error: " << e.what() << '\n';
+    return 1;
+  }
+}
+
+}  // namespace ks::cli

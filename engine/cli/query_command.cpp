@@ -1,0 +1,461 @@
+#include "cli/query_command.hpp"
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <numeric>
+#include <set>
+
+#include "cli/query_util.hpp"
+#include "store/store.hpp"
+
+namespace ks::cli {
+
+namespace {
+
+/// A bad argument (exit code 2).
+struct ArgError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
+}
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : s) {
+    if (c == sep) out.push_back(trim(cur)), cur.clear();
+    else cur += c;
+  }
+  out.push_back(trim(cur));
+  return out;
+}
+
+std::string unknown_column_message(const std::string& name, const RunsTable& t, const std::string& where) {
+  std::string m = "unknown column '" + name + "'" + where;
+  const std::string dym = did_you_mean(name, t.names());
+  if (!dym.empty()) m += "; did you mean '" + dym + "'?";
+  return m + "\nvalid columns: " + join(t.names(), ", ");
+}
+
+enum class Op { eq, ne, lt, le, gt, ge };
+
+std::optional<Op> parse_op(const std::string& s) {
+  if (s == "=" || s == "==") return Op::eq;
+  if (s == "!=") return Op::ne;
+  if (s == "<") return Op::lt;
+  if (s == "<=") return Op::le;
+  if (s == ">") return Op::gt;
+  if (s == ">=") return Op::ge;
+  return std::nullopt;
+}
+Op flip(Op o) {
+  switch (o) {
+    case Op::lt: return Op::gt;
+    case Op::le: return Op::ge;
+    case Op::gt: return Op::lt;
+    case Op::ge: return Op::le;
+    default: return o;
+  }
+}
+
+/// One condition on one column: `op` against each value (eq: any of them; ne: none of them).
+struct Condition {
+  const RunsColumn* col = nullptr;
+  Op op = Op::eq;
+  std::vector<double> nums;
+  std::vector<std::string> strs;
+  bool or_prev = false;  ///< OR with the previous condition (COL!=LO..HI: below LO or above HI)
+};
+
+bool num_eq(double x, double v) {
+  if (std::isnan(v)) return std::isnan(x);
+  return x == v || std::abs(x - v) <= 1e-9 * std::max(std::abs(x), std::abs(v));
+}
+
+struct Selector {
+  const RunsTable& t;
+  bool radians;
+
+  double value(const RunsColumn& c, std::int64_t r) const {
+    if (c.type == CellType::i64) return static_cast<double>(c.i[r]);
+    return c.angle() && !radians ? c.f[r] * kRadToDeg : c.f[r];
+  }
+
+  bool test(const Condition& k, std::int64_t r) const {
+    const RunsColumn& c = *k.col;
+    if (c.type == CellType::str) {
+      const std::string& x = c.s[r];
+      switch (k.op) {
+        case Op::eq: return std::find(k.strs.begin(), k.strs.end(), x) != k.strs.end();
+        case Op::ne: return std::find(k.strs.begin(), k.strs.end(), x) == k.strs.end();
+        case Op::lt: return x < k.strs[0];
+        case Op::le: return x <= k.strs[0];
+        case Op::gt: return x > k.strs[0];
+        case Op::ge: return x >= k.strs[0];
+      }
+    }
+    const double x = value(c, r);
+    switch (k.op) {
+      case Op::eq: return std::any_of(k.nums.begin(), k.nums.end(), [&](double v) { return num_eq(x, v); });
+      case Op::ne: return std::none_of(k.nums.begin(), k.nums.end(), [&](double v) { return num_eq(x, v); });
+      case Op::lt: return x < k.nums[0];
+      case Op::le: return x <= k.nums[0];
+      case Op::gt: return x > k.nums[0];
+      case Op::ge: return x >= k.nums[0];
+    }
+    return false;
+  }
+};
+
+double parse_number(const std::string& s, const RunsColumn& c, const std::string& expr) {
+  const std::string v = trim(s);
+  char* end = nullptr;
+  const double d = std::strtod(v.c_str(), &end);
+  if (v.empty() || end != v.c_str() + v.size())
+    throw ArgError("--where '" + expr + "': column " + c.name + " is numeric; '" + v + "' is not a number");
+  return d;
+}
+
+/// Parse one --where expression into conditions (a range gives two).
+///   COL OP VALUE          OP: = == != < <= > >=   (VALUE OP COL also works)
+///   COL=V1,V2,...         any of the values (!=: none of them)
+///   COL=LO..HI            LO <= COL <= HI (!=: outside)
+///   LO<COL<=HI            chained range (< or <=, or > / >= descending)
+std::vector<Condition> parse_where(const std::string& expr, const RunsTable& t) {
+  std::vector<std::string> operands, ops;
+  std::string cur;
+  for (std::size_t i = 0; i < expr.size();) {
+    if (std::string("<>=!").find(expr[i]) != std::string::npos) {
+      std::size_t j = i;
+      while (j < expr.size() && std::string("<>=!").find(expr[j]) != std::string::npos) ++j;
+      operands.push_back(trim(cur));
+      cur.clear();
+      ops.push_back(expr.substr(i, j - i));
+      i = j;
+    } else {
+      cur += expr[i++];
+    }
+  }
+  operands.push_back(trim(cur));
+  const std::string syntax =
+      "; expected COL OP VALUE (OP one of = != < <= > >=), COL=A,B,C, COL=LO..HI or LO<=COL<=HI";
+  if (ops.empty() || ops.size() > 2) throw ArgError("--where '" + expr + "': cannot parse" + syntax);
+  std::vector<Op> o;
+  for (auto& s : ops) {
+    auto p = parse_op(s);
+    if (!p) throw ArgError("--where '" + expr + "': unknown operator '" + s + "'" + syntax);
+    o.push_back(*p);
+  }
+  for (auto& s : operands)
+    if (s.empty()) throw ArgError("--where '" + expr + "': missing operand" + syntax);
+
+  auto make = [&](const RunsColumn* c, Op op, const std::string& rhs) {
+    std::vector<Condition> out;
+    const bool str = c->type == CellType::str;
+    const auto dots = rhs.find("..");
+    if (!str && dots != std::string::npos && (op == Op::eq || op == Op::ne)) {
+      const double lo = parse_number(rhs.substr(0, dots), *c, expr), hi = parse_number(rhs.substr(dots + 2), *c, expr);
+      if (op == Op::eq) {
+        out.push_back({c, Op::ge, {lo}, {}});
+        out.push_back({c, Op::le, {hi}, {}});
+      } else {
+        out.push_back({c, Op::lt, {lo}, {}});
+        out.push_back({c, Op::gt, {hi}, {}, true});
+      }
+      return out;
+    }
+    Condition k{c, op, {}, {}};
+    const auto values = (op == Op::eq || op == Op::ne) ? split(rhs, ',') : std::vector<std::string>{rhs};
+    for (auto& v : values) {
+      if (str) k.strs.push_back(v);
+      else k.nums.push_back(parse_number(v, *c, expr));
+    }
+    out.push_back(k);
+    return out;
+  };
+
+  if (o.size() == 1) {
+    if (const RunsColumn* c = t.find(operands[0])) return make(c, o[0], operands[1]);
+    if (const RunsColumn* c = t.find(operands[1]); c && o[0] != Op::eq && o[0] != Op::ne)
+      return make(c, flip(o[0]), operands[0]);
+    throw ArgError(unknown_column_message(operands[0], t, " in --where '" + expr + "'"));
+  }
+  const RunsColumn* c = t.find(operands[1]);
+  if (!c) throw ArgError(unknown_column_message(operands[1], t, " in --where '" + expr + "'"));
+  const bool up = (o[0] == Op::lt || o[0] == Op::le) && (o[1] == Op::lt || o[1] == Op::le);
+  const bool down = (o[0] == Op::gt || o[0] == Op::ge) && (o[1] == Op::gt || o[1] == Op::ge);
+  if (!up && !down) throw ArgError("--where '" + expr + "': a range needs two < / <= (or two > / >=)" + syntax);
+  auto a = make(c, flip(o[0]), operands[0]);
+  auto b = make(c, o[1], operands[2]);
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+struct SortKey {
+  const RunsColumn* col;
+  bool desc;
+};
+
+std::string plain_unit(const RunsColumn& c, bool radians) { return c.angle() && !radians ? "deg" : c.unit; }
+
+int history_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
+  const std::int64_t n = reader.n_runs();
+  if (a.run < 0 || a.run >= n)
+    throw ArgError("--run " + std::to_string(a.run) + ": the file has run ids 0.." + std::to_string(n - 1));
+  auto got = consistent_read(reader, [&] {
+    auto done = reader.done_mask();
+    return std::make_pair(done[static_cast<std::size_t>(a.run)] != 0, reader.read_history(a.run));
+  });
+  if (!got.first) throw ArgError("run " + std::to_string(a.run) + " is not done yet (no committed row or history)");
+  const RunHistory& h = got.second;
+  if (h.arrays.empty())
+    throw ArgError("run " + std::to_string(a.run) +
+                   " has no history (the study's histories = \"none\", or the run stopped before its first sample)");
+  std::vector<std::string> valid;
+  for (auto& arr : h.arrays) valid.push_back(arr.name);
+  std::vector<std::string> want;
+  const std::string spec = a.history.empty() ? "all" : a.history;
+  if (spec == "all") want = valid;
+  else want = split(spec, ',');
+  const HistoryArray* index = nullptr;
+  for (auto& arr : h.arrays)
+    if ((arr.name == "t" || arr.name == "k") && arr.cols == 1) index = &arr;
+  std::vector<const HistoryArray*> arrays;
+  if (index) arrays.push_back(index);
+  for (auto& w : want) {
+    const HistoryArray* found = nullptr;
+    for (auto& arr : h.arrays)
+      if (arr.name == w) found = &arr;
+    if (!found) {
+      std::string m = "run " + std::to_string(a.run) + " has no history array '" + w + "'";
+      const std::string dym = did_you_mean(w, valid);
+      if (!dym.empty()) m += "; did you mean '" + dym + "'?";
+      throw ArgError(m + "\nvalid arrays: " + join(valid, ", ") + " (or all)");
+    }
+    if (found != index) arrays.push_back(found);
+  }
+  OutTable out;
+  struct Src {
+    const HistoryArray* arr;
+    std::size_t col;
+    bool to_deg;
+  };
+  std::vector<Src> src;
+  std::size_t rows = SIZE_MAX;
+  for (const HistoryArray* arr : arrays) {
+    rows = std::min(rows, arr->rows);
+    auto units = split(arr->unit, ',');
+    if (units.size() != arr->cols) units.assign(arr->cols, arr->unit);
+    for (std::size_t c = 0; c < arr->cols; ++c) {
+      const bool deg = units[c] == "rad" && !a.radians;
+      const std::string name = arr->cols == 1 ? arr->name : arr->name + "_" + std::to_string(c + 1);
+      out.names.push_back(name);
+      out.units.push_back(deg ? "deg" : units[c]);
+      out.csv_names.push_back(deg ? name + " [deg]" : name);
+      src.push_back({arr, c, deg});
+    }
+  }
+  if (rows == SIZE_MAX) rows = 0;
+  if (a.limit >= 0) rows = std::min<std::size_t>(rows, static_cast<std::size_t>(a.limit));
+  for (std::size_t r = 0; r < rows; ++r) {
+    std::vector<OutCell> row;
+    for (const Src& s : src) {
+      const double v = s.arr->data[r * s.arr->cols + s.col];
+      if (s.arr->name == "k") row.emplace_back(static_cast<std::int64_t>(v));
+      else row.emplace_back(s.to_deg ? v * kRadToDeg : v);
+    }
+    out.rows.push_back(std::move(row));
+  }
+  print_out(out, fmt, std::cout);
+  return 0;
+}
+
+int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
+  const RunsTable t = load_runs(reader);
+  if (!t.consistent)
+    std::cerr << "kinesweep query: note: the file kept changing while it was read (a sweep is writing it)\n";
+  Selector sel{t, a.radians};
+  // Filters.
+  std::vector<Condition> conds;
+  std::set<const RunsColumn*> mentioned;
+  for (const auto& w : a.where)
+    for (auto& c : parse_where(w, t)) mentioned.insert(c.col), conds.push_back(std::move(c));
+  // Sort keys.
+  std::vector<SortKey> keys;
+  for (const auto& s : a.sort) {
+    for (auto& part : split(s, ',')) {
+      std::string name = part;
+      bool desc = false;
+      if (const auto colon = part.rfind(':'); colon != std::string::npos) {
+        const std::string dir = part.substr(colon + 1);
+        if (dir != "desc" && dir != "asc")
+          throw ArgError("--sort '" + part + "': expected COL, COL:asc or COL:desc");
+        desc = dir == "desc";
+        name = part.substr(0, colon);
+      }
+      const RunsColumn* c = t.find(name);
+      if (!c) throw ArgError(unknown_column_message(name, t, " in --sort"));
+      keys.push_back({c, desc});
+      mentioned.insert(c);
+    }
+  }
+  // Columns.
+  std::vector<const RunsColumn*> cols;
+  std::vector<std::int64_t> selected;
+  for (std::int64_t r = 0; r < t.n_runs; ++r) {
+    if (!a.include_pending && !t.done[static_cast<std::size_t>(r)]) continue;
+    bool ok = true;
+    for (std::size_t i = 0; i < conds.size() && ok; ++i) {
+      if (i + 1 < conds.size() && conds[i + 1].or_prev) {
+        ok = sel.test(conds[i], r) || sel.test(conds[i + 1], r);
+        ++i;
+      } else {
+        ok = sel.test(conds[i], r);
+      }
+    }
+    if (ok) selected.push_back(r);
+  }
+  const bool all = a.columns == "all" || (a.columns.empty() && fmt != Format::table);
+  if (all) {
+    for (auto& c : t.cols) cols.push_back(&c);
+  } else if (!a.columns.empty()) {
+    for (auto& name : split(a.columns, ',')) {
+      if (name.empty()) continue;
+      const RunsColumn* c = t.find(name);
+      if (!c) throw ArgError(unknown_column_message(name, t, " in --columns"));
+      cols.push_back(c);
+    }
+  } else {
+    // Compact default: id, block (when several), the parameters that vary, key metrics, status.
+    std::set<std::string> kinds;
+    for (auto r : selected) kinds.insert(t.kind(r));
+    std::set<std::string> key_metrics;
+    if (kinds.count("trajectory")) key_metrics.insert({"E", "E_M", "tau_inf"});
+    if (kinds.count("ik")) key_metrics.insert({"iterations", "error", "solution"});
+    auto varies = [&](const RunsColumn& c) {
+      for (std::size_t i = 1; i < selected.size(); ++i) {
+        const auto r0 = selected[0], r = selected[i];
+        if (c.type == CellType::str ? c.s[r] != c.s[r0]
+            : c.type == CellType::i64 ? c.i[r] != c.i[r0]
+                                      : !(c.f[r] == c.f[r0] || (std::isnan(c.f[r]) && std::isnan(c.f[r0]))))
+          return true;
+      }
+      return false;
+    };
+    for (auto& c : t.cols) {
+      const ColumnRole role = RunsTable::role(c.name);
+      bool take = mentioned.count(&c) > 0;
+      if (role == ColumnRole::id || role == ColumnRole::status) take = true;
+      if ((role == ColumnRole::block || role == ColumnRole::parameter) && varies(c)) take = true;
+      if (role == ColumnRole::metric && key_metrics.count(c.name)) take = true;
+      if (take) cols.push_back(&c);
+    }
+  }
+  // Sort (stable: ties stay in run-id order); NaN last in either direction.
+  if (!keys.empty()) {
+    std::stable_sort(selected.begin(), selected.end(), [&](std::int64_t x, std::int64_t y) {
+      for (const SortKey& k : keys) {
+        const RunsColumn& c = *k.col;
+        if (c.type == CellType::str) {
+          if (c.s[x] == c.s[y]) continue;
+          return k.desc ? c.s[x] > c.s[y] : c.s[x] < c.s[y];
+        }
+        const double u = sel.value(c, x), v = sel.value(c, y);
+        const bool nu = std::isnan(u), nv = std::isnan(v);
+        if (nu || nv) {
+          if (nu && nv) continue;
+          return nv;  // the non-NaN one first
+        }
+        if (u == v) continue;
+        return k.desc ? u > v : u < v;
+      }
+      return false;
+    });
+  }
+  const std::size_t matching = selected.size();
+  if (a.limit >= 0 && selected.size() > static_cast<std::size_t>(a.limit)) selected.resize(static_cast<std::size_t>(a.limit));
+
+  OutTable out;
+  std::vector<std::string> converted;
+  for (const RunsColumn* c : cols) {
+    out.names.push_back(c->name);
+    out.units.push_back(plain_unit(*c, a.radians));
+    const bool deg = c->angle() && !a.radians;
+    out.csv_names.push_back(deg ? c->name + " [deg]" : c->name);
+    if (deg) converted.push_back(c->name);
+  }
+  for (auto r : selected) {
+    std::vector<OutCell> row;
+    for (const RunsColumn* c : cols) {
+      switch (c->type) {
+        case CellType::f64: row.emplace_back(sel.value(*c, r)); break;
+        case CellType::i64: row.emplace_back(c->i[r]); break;
+        case CellType::str: row.emplace_back(c->s[r]); break;
+      }
+    }
+    out.rows.push_back(std::move(row));
+  }
+  print_out(out, fmt, std::cout);
+  if (fmt == Format::table) {
+    const auto done = std::count(t.done.begin(), t.done.end(), std::uint8_t{1});
+    std::cout << "(" << out.rows.size() << " of " << matching << " matching rows; " << done << " of " << t.n_runs
+              << " runs done";
+    if (!converted.empty()) std::cout << "; angles in degrees (stored in radians): " << join(converted, ", ");
+    if (a.columns.empty()) std::cout << "; --columns all shows every column";
+    std::cout << ")\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+QueryArgs& add_query_command(CLI::App& app) {
+  static QueryArgs a;
+  auto* q = app.add_subcommand("query", "Print rows of a results file's /runs (filtered, sorted) or one run's history");
+  q->add_option("file", a.file, "results file (.h5); may be one a sweep is still writing")->required();
+  q->add_option("-w,--where", a.where,
+                "filter, repeatable (ANDed): COL OP VALUE with OP = != < <= > >=, COL=A,B,C (any of), "
+                "COL=LO..HI or LO<=COL<=HI (range); angles in degrees unless --radians")
+      ->allow_extra_args(false);
+  q->add_option("-c,--columns", a.columns, "comma-separated columns, or 'all' (default: table: a compact set; csv/json: all)");
+  q->add_option("-s,--sort", a.sort, "sort by COL or COL:desc (repeatable or comma list; NaN last)")->allow_extra_args(false);
+  q->add_option("-n,--limit", a.limit, "print at most N rows");
+  q->add_option("-f,--format", a.format, "table | csv | json (default: table; csv for --history)")
+      ->check(CLI::IsMember({"table", "csv", "json"}));
+  q->add_flag("--radians", a.radians, "show and filter angles in radians (as stored) instead of degrees");
+  q->add_flag("--include-pending", a.include_pending, "also rows not done yet (missing values)");
+  q->add_option("--run", a.run, "history mode: the run id");
+  q->add_option("--history", a.history, "history mode: array name(s), comma list, or 'all' (default all)");
+  a.format.clear();
+  return a;
+}
+
+int query_command(const QueryArgs& a) {
+  try {
+    if (!a.history.empty() && a.run < 0) throw ArgError("--history needs --run ID");
+    const bool history = a.run >= 0;
+    if (history && (!a.where.empty() || !a.sort.empty() || !a.columns.empty()))
+      throw ArgError("--run/--history prints one run's history; --where, --sort and --columns apply to rows only");
+    const Format fmt = *parse_format(a.format.empty() ? (history ? "csv" : "table") : a.format);
+    store::ResultsReader reader(a.file);
+    return history ? history_mode(a, reader, fmt) : rows_mode(a, reader, fmt);
+  } catch (const ArgError& e) {
+    std::cerr << "kinesweep query: error: " << e.what() << '\n';
+    return 2;
+  } catch (const store::StoreError& e) {
+    std::cerr << "kinesweep query: error: " << e.what() << '\n';
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "kinesweep query: error: " << e.what() << '\n';
+    return 1;
+  }
+}
+
+}  // namespace ks::cli

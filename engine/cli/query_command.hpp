@@ -1,0 +1,33 @@
+#pragma once
+// `kinesweep query FILE [--where EXPR]... [--columns a,b,c|all] [--sort COL[:desc]]... [--limit N]
+//  [--format table|csv|json] [--radians] [--include-pending]`
+// `kinesweep query FILE --run ID --history NAME[,NAME...]|all [--format table|csv|json] [--limit N]`
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace CLI {
+class App;
+}
+
+namespace ks::cli {
+
+struct QueryArgs {
+  std::string file;
+  std::vector<std::string> where;  ///< ANDed filter expressions
+  std::string columns;             ///< comma list, "all", or empty (a compact default)
+  std::vector<std::string> sort;   ///< COL or COL:desc, first key first
+  std::int64_t limit = -1;         ///< -1: every row
+  std::string format = "table";
+  bool radians = false;            ///< show (and filter) angles in radians, as stored
+  bool include_pending = false;    ///< also rows not done yet (missing values)
+  std::int64_t run = -1;           ///< history mode: the run id
+  std::string history;             ///< history mode: array name(s)
+};
+
+/// Register the subcommand; returns the argument struct it fills.
+QueryArgs& add_query_command(CLI::App& app);
+/// Exit codes: 0 ok, 1 file or I/O problem, 2 bad arguments (unknown column, bad expression, ...).
+int query_command(const QueryArgs& args);
+
+}  // namespace ks::cli

@@ -1,0 +1,227 @@
+#include "cli/query_util.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ostream>
+#include <set>
+
+#include "runner/execute.hpp"
+
+namespace ks::cli {
+
+const RunsColumn* RunsTable::find(const std::string& name) const {
+  for (const auto& c : cols)
+    if (c.name == name) return &c;
+  return nullptr;
+}
+
+std::vector<std::string> RunsTable::names() const {
+  std::vector<std::string> out;
+  for (const auto& c : cols) out.push_back(c.name);
+  return out;
+}
+
+ColumnRole RunsTable::role(const std::string& name) {
+  if (name == "run_id") return ColumnRole::id;
+  if (name == "block") return ColumnRole::block;
+  if (name == "status") return ColumnRole::status;
+  if (name == "wall_time" || name == "done") return ColumnRole::other;
+  static const std::set<std::string> metrics = [] {
+    std::set<std::string> m;
+    for (const auto& c : metric_columns(BlockKind::trajectory)) m.insert(c.name);
+    for (const auto& c : metric_columns(BlockKind::ik)) m.insert(c.name);
+    return m;
+  }();
+  return metrics.count(name) ? ColumnRole::metric : ColumnRole::parameter;
+}
+
+std::string RunsTable::kind(std::int64_t row) const {
+  if (const RunsColumn* it = find("iterations"); it && it->type == CellType::i64 && it->i[row] >= 0) return "ik";
+  if (const RunsColumn* p = find("problem"); p && p->type == CellType::str && !p->s[row].empty()) return "ik";
+  return "trajectory";
+}
+
+RunsTable load_runs(store::ResultsReader& reader) {
+  return consistent_read(reader, [&] {
+    RunsTable t;
+    t.meta = reader.meta();
+    t.n_runs = reader.n_runs();
+    t.done = reader.done_mask();  // before the columns: a row done here is complete in them
+    for (const ColumnSpec& spec : reader.columns()) {
+      RunsColumn c;
+      c.name = spec.name;
+      c.unit = spec.unit;
+      c.description = spec.description;
+      c.type = spec.type;
+      switch (spec.type) {
+        case CellType::f64: c.f = reader.read_f64(spec.name); break;
+        case CellType::i64: c.i = reader.read_i64(spec.name); break;
+        case CellType::str: c.s = reader.read_str(spec.name); break;
+      }
+      t.cols.push_back(std::move(c));
+    }
+    t.consistent = reader.unchanged_since_open();
+    return t;
+  });
+}
+
+std::optional<Format> parse_format(const std::string& s) {
+  if (s == "table") return Format::table;
+  if (s == "csv") return Format::csv;
+  if (s == "json") return Format::json;
+  return std::nullopt;
+}
+
+std::string format_double(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+namespace {
+std::string full_double(double v) {  // csv/json: round-trip precision
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[40];
+  for (int prec = 15; prec <= 17; ++prec) {  // shortest text that reads back to the same double
+    std::snprintf(buf, sizeof buf, "%.*g", prec, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  return buf;
+}
+std::string cell_text(const OutCell& c, bool full) {
+  if (const double* d = std::get_if<double>(&c)) return full ? full_double(*d) : format_double(*d);
+  if (const std::int64_t* i = std::get_if<std::int64_t>(&c)) return std::to_string(*i);
+  if (const std::string* s = std::get_if<std::string>(&c)) return *s;
+  return "";
+}
+}  // namespace
+
+std::string json_string(const std::string& s) {
+  std::string o = "\"";
+  for (unsigned char ch : s) {
+    switch (ch) {
+      case '"': o += "\\\""; break;
+      case '\\': o += "\\\\"; break;
+      case '\n': o += "\\n"; break;
+      case '\t': o += "\\t"; break;
+      case '\r': o += "\\r"; break;
+      default:
+        if (ch < 0x20) {
+          char b[8];
+          std::snprintf(b, sizeof b, "\\u%04x", ch);
+          o += b;
+        } else {
+          o += static_cast<char>(ch);
+        }
+    }
+  }
+  return o + "\"";
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string o = "\"";
+  for (char ch : s) o += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return o + "\"";
+}
+
+std::string join(const std::vector<std::string>& v, const std::string& sep) {
+  std::string o;
+  for (std::size_t i = 0; i < v.size(); ++i) o += (i ? sep : "") + v[i];
+  return o;
+}
+
+std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates) {
+  auto lower = [](std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+  };
+  const std::string w = lower(word);
+  std::string best;
+  std::size_t best_d = std::max<std::size_t>(2, w.size() / 3) + 1;
+  for (const auto& cand : candidates) {
+    const std::string c = lower(cand);
+    std::vector<std::size_t> prev(c.size() + 1), cur(c.size() + 1);
+    for (std::size_t j = 0; j <= c.size(); ++j) prev[j] = j;
+    for (std::size_t i = 1; i <= w.size(); ++i) {
+      cur[0] = i;
+      for (std::size_t j = 1; j <= c.size(); ++j)
+        cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (w[i - 1] == c[j - 1] ? 0 : 1)});
+      std::swap(prev, cur);
+    }
+    if (prev[c.size()] < best_d) best_d = prev[c.size()], best = cand;
+  }
+  return best;
+}
+
+void print_out(const OutTable& t, Format f, std::ostream& os) {
+  const std::size_t nc = t.names.size();
+  const std::vector<std::string>& hdr = t.csv_names.size() == nc ? t.csv_names : t.names;
+  if (f == Format::csv) {
+    for (std::size_t c = 0; c < nc; ++c) os << (c ? "," : "") << csv_field(hdr[c]);
+    os << '\n';
+    for (const auto& r : t.rows) {
+      for (std::size_t c = 0; c < nc; ++c) os << (c ? "," : "") << csv_field(cell_text(r[c], true));
+      os << '\n';
+    }
+    return;
+  }
+  if (f == Format::json) {
+    const std::vector<std::string>& keys = t.names;  // plain names; the units say what was converted
+    os << "{\"columns\": [";
+    for (std::size_t c = 0; c < nc; ++c) os << (c ? ", " : "") << json_string(keys[c]);
+    os << "],\n \"units\": {";
+    for (std::size_t c = 0; c < nc; ++c)
+      os << (c ? ", " : "") << json_string(keys[c]) << ": " << json_string(c < t.units.size() ? t.units[c] : "");
+    os << "},\n \"rows\": [";
+    for (std::size_t r = 0; r < t.rows.size(); ++r) {
+      os << (r ? ",\n  {" : "\n  {");
+      for (std::size_t c = 0; c < nc; ++c) {
+        os << (c ? ", " : "") << json_string(keys[c]) << ": ";
+        const OutCell& cell = t.rows[r][c];
+        if (const double* d = std::get_if<double>(&cell)) os << (std::isfinite(*d) ? full_double(*d) : "null");
+        else if (const std::string* s = std::get_if<std::string>(&cell)) os << json_string(*s);
+        else if (std::holds_alternative<std::monostate>(cell)) os << "null";
+        else os << cell_text(cell, true);
+      }
+      os << "}";
+    }
+    os << (t.rows.empty() ? "]}\n" : "\n ]}\n");
+    return;
+  }
+  // Aligned table: header "name [unit]", strings left-aligned, numbers right-aligned.
+  std::vector<std::string> head(nc);
+  std::vector<std::size_t> w(nc);
+  std::vector<bool> left(nc, false);
+  for (std::size_t c = 0; c < nc; ++c) {
+    head[c] = t.names[c];
+    if (c < t.units.size() && !t.units[c].empty()) head[c] += " [" + t.units[c] + "]";
+    w[c] = head[c].size();
+  }
+  std::vector<std::vector<std::string>> text(t.rows.size(), std::vector<std::string>(nc));
+  for (std::size_t r = 0; r < t.rows.size(); ++r)
+    for (std::size_t c = 0; c < nc; ++c) {
+      text[r][c] = cell_text(t.rows[r][c], false);
+      if (std::holds_alternative<std::string>(t.rows[r][c])) left[c] = true;
+      w[c] = std::max(w[c], text[r][c].size());
+    }
+  auto put = [&](const std::string& s, std::size_t c) {
+    const std::string pad(w[c] - std::min(w[c], s.size()), ' ');
+    os << (c ? "  " : "") << (left[c] ? s + (c + 1 < nc ? pad : "") : pad + s);
+  };
+  for (std::size_t c = 0; c < nc; ++c) put(head[c], c);
+  os << '\n';
+  for (std::size_t c = 0; c < nc; ++c) put(std::string(w[c], '-'), c);
+  os << '\n';
+  for (const auto& row : text) {
+    for (std::size_t c = 0; c < nc; ++c) put(row[c], c);
+    os << '\n';
+  }
+}
+
+}  // namespace ks::cli

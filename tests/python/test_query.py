@@ -1,0 +1,298 @@
+"""End-to-end tests of `kinesweep query` and `kinesweep info` against the file as read by h5py.
+
+usage: /usr/bin/python3 test_query.py KINESWEEP_BINARY REPO_ROOT
+"""
+import csv
+import io
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+import h5py
+import numpy as np
+
+KS = None
+ROOT = None
+D = 180.0 / math.pi
+
+STUDY = """
+[study]
+name = "query_e2e"
+histories = "every=10"
+
+[[block]]
+name = "weighted"
+kind = "trajectory"
+method = "local_weighted"
+[block.axes]
+alpha1A = { from = -25, to = 35, step = 5 }
+k = { from = 0, to = 1, count = 6 }
+
+[[block]]
+name = "basin"
+kind = "ik"
+problem = "scara"
+[block.axes]
+method = ["newton", "lm"]
+q0_1 = { from = -180, to = 180, count = 9 }
+q0_2 = { from = -180, to = 180, count = 9 }
+"""
+
+LIVE = """
+[study]
+name = "query_live"
+histories = "full"
+
+[[block]]
+name = "sweep"
+kind = "trajectory"
+[block.axes]
+method = ["local_weighted", "local_unweighted"]
+alpha1A = { from = -20, to = 30, step = 0.5 }
+k = { from = 0, to = 1, count = 11 }
+"""
+
+
+def ks(*args):
+    return subprocess.run([KS, *args], capture_output=True, text=True)
+
+
+def h5table(path):
+    with h5py.File(path, "r") as f:
+        out = {}
+        for k in f["runs"]:
+            v = f["runs"][k][()]
+            if v.dtype.kind == "O":
+                v = np.array([x.decode() if isinstance(x, bytes) else x for x in v], dtype=object)
+            out[k] = v
+        units = {k: f["runs"][k].attrs.get("unit", "") for k in f["runs"]}
+        units = {k: (u.decode() if isinstance(u, bytes) else u) for k, u in units.items()}
+        return out, units
+
+
+def read_csv(text):
+    rows = list(csv.reader(io.StringIO(text)))
+    return rows[0], rows[1:]
+
+
+class QueryTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        study = os.path.join(cls.tmp.name, "q.toml")
+        with open(study, "w") as f:
+            f.write(STUDY)
+        cls.h5 = os.path.join(cls.tmp.name, "q.h5")
+        r = ks("run", study, "-o", cls.h5, "-q")
+        assert r.returncode == 0, r.stderr
+        cls.t, cls.units = h5table(cls.h5)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_filter_range_sort_csv_equal_h5py(self):
+        r = ks("query", self.h5, "--where", "block=weighted", "--where", "status=ok", "--where", "k<=0.4",
+               "--where", "-20<=alpha1A<=10", "--sort", "E:desc", "--columns", "run_id,alpha1A,k,E", "--format", "csv")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        head, rows = read_csv(r.stdout)
+        self.assertEqual(head, ["run_id", "alpha1A [deg]", "k", "E"])
+        t = self.t
+        a = t["alpha1A"] * D
+        m = (t["done"] == 1) & (t["block"] == "weighted") & (t["status"] == "ok") & (t["k"] <= 0.4) & \
+            (a >= -20 - 1e-9) & (a <= 10 + 1e-9)
+        idx = np.nonzero(m)[0]
+        idx = idx[np.argsort(-t["E"][idx], kind="stable")]
+        self.assertGreater(len(idx), 5)
+        self.assertEqual([int(x[0]) for x in rows], t["run_id"][idx].tolist())
+        np.testing.assert_array_equal([float(x[3]) for x in rows], t["E"][idx])  # exact: round-trip text
+        np.testing.assert_allclose([float(x[1]) for x in rows], t["alpha1A"][idx] * D, rtol=1e-14)
+        np.testing.assert_array_equal([float(x[2]) for x in rows], t["k"][idx])
+
+    def test_json_all_columns_equal_h5py(self):
+        r = ks("query", self.h5, "-w", "block=basin", "-w", "iterations<10", "-w", "method=newton,lm",
+               "-f", "json")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        j = json.loads(r.stdout)
+        t = self.t
+        m = (t["done"] == 1) & (t["block"] == "basin") & (t["iterations"] < 10)
+        idx = np.nonzero(m)[0]
+        self.assertEqual([row["run_id"] for row in j["rows"]], t["run_id"][idx].tolist())
+        cols = [c for c in t if c != "done"]
+        self.assertEqual(set(j["columns"]), set(cols))
+        for c in cols:
+            angle = self.units[c] == "rad"
+            self.assertEqual(j["units"][c], "deg" if angle else self.units[c], c)
+            for row, i in zip(j["rows"], idx):
+                v, want = row[c], t[c][i]
+                if t[c].dtype.kind == "f":
+                    want = want * D if angle else want
+                    if math.isnan(want):
+                        self.assertIsNone(v, c)
+                    else:
+                        self.assertAlmostEqual(v, want, delta=1e-12 * max(1, abs(want)), msg=c)
+                else:
+                    self.assertEqual(v, want.item() if hasattr(want, "item") else want, c)
+
+    def test_not_in_range_and_not_equal(self):
+        r = ks("query", self.h5, "-w", "block=basin", "-w", "q0_1!=-180..0", "-w", "status!=converged",
+               "-c", "run_id", "-f", "csv")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        _, rows = read_csv(r.stdout)
+        t = self.t
+        q = t["q0_1"] * D
+        m = (t["block"] == "basin") & ((q < -180 - 1e-9) | (q > 0 + 1e-9)) & (t["status"] != "converged")
+        self.assertEqual([int(x[0]) for x in rows], t["run_id"][m].tolist())
+        self.assertGreater(len(rows), 0)
+
+    def test_limit_and_multi_key_sort(self):
+        r = ks("query", self.h5, "-w", "block=basin", "--sort", "iterations,error:desc", "--limit", "4",
+               "-c", "run_id,iterations,error", "-f", "csv")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        _, rows = read_csv(r.stdout)
+        t = self.t
+        idx = np.nonzero(t["block"] == "basin")[0]
+        order = sorted(idx, key=lambda i: (t["iterations"][i], -t["error"][i]))
+        self.assertEqual([int(x[0]) for x in rows], [int(t["run_id"][i]) for i in order[:4]])
+
+    def test_table_says_degrees(self):
+        r = ks("query", self.h5, "-w", "block=weighted", "--limit", "3")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("alpha1A [deg]", r.stdout)
+        self.assertIn("E [Nm]", r.stdout)
+        self.assertIn("angles in degrees", r.stdout)
+        r = ks("query", self.h5, "-w", "block=weighted", "--radians", "-c", "run_id,alpha1A", "-f", "csv")
+        head, rows = read_csv(r.stdout)
+        self.assertEqual(head, ["run_id", "alpha1A"])
+        ids = [int(x[0]) for x in rows]
+        np.testing.assert_array_equal([float(x[1]) for x in rows], self.t["alpha1A"][ids])
+
+    def test_unknown_column_names_valid_ones(self):
+        for args in (["-w", "Ee<3"], ["--sort", "Ee"], ["--columns", "run_id,Ee"]):
+            r = ks("query", self.h5, *args)
+            self.assertEqual(r.returncode, 2, args)
+            self.assertIn("unknown column 'Ee'", r.stderr)
+            self.assertIn("did you mean 'E'", r.stderr)
+            self.assertIn("valid columns:", r.stderr)
+            self.assertIn("alpha1A", r.stderr)
+            self.assertIn("iterations", r.stderr)
+
+    def test_bad_arguments(self):
+        for args in (["-w", "E<<3"], ["-w", "E<abc"], ["-w", "E"], ["--format", "xml"], ["--sort", "E:down"],
+                     ["--run", "100000", "--history", "tau"]):
+            r = ks("query", self.h5, *args)
+            self.assertEqual(r.returncode, 2, (args, r.stderr))
+
+    def test_file_errors(self):
+        self.assertEqual(ks("query", os.path.join(self.tmp.name, "missing.h5")).returncode, 1)
+        bogus = os.path.join(self.tmp.name, "bogus.h5")
+        with open(bogus, "w") as f:
+            f.write("not hdf5")
+        self.assertEqual(ks("query", bogus).returncode, 1)
+        self.assertEqual(ks("info", bogus).returncode, 1)
+
+    def _group(self, f, run):
+        return f["histories"][str(run).zfill(max(6, len(str(len(f["runs"]["done"]) - 1))))]
+
+    def test_trajectory_history_csv(self):
+        t = self.t
+        run = int(np.nonzero((t["block"] == "weighted") & (t["status"] == "ok"))[0][3])
+        r = ks("query", self.h5, "--run", str(run), "--history", "tau,q")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        head, rows = read_csv(r.stdout)
+        self.assertEqual(head, ["t", "tau_1", "tau_2", "tau_3", "q_1 [deg]", "q_2 [deg]", "q_3 [deg]"])
+        a = np.array(rows, dtype=float)
+        with h5py.File(self.h5, "r") as f:
+            g = self._group(f, run)
+            np.testing.assert_array_equal(a[:, 0], g["t"][()][:, 0])
+            np.testing.assert_array_equal(a[:, 1:4], g["tau"][()])
+            np.testing.assert_allclose(a[:, 4:7], g["q"][()] * D, rtol=1e-14, atol=1e-12)
+
+    def test_ik_history_json(self):
+        t = self.t
+        run = int(np.nonzero((t["block"] == "basin") & (t["iterations"] > 5))[0][0])
+        r = ks("query", self.h5, "--run", str(run), "--history", "norm_F", "--format", "json")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        j = json.loads(r.stdout)
+        self.assertEqual(j["columns"], ["k", "norm_F"])
+        with h5py.File(self.h5, "r") as f:
+            g = self._group(f, run)
+            self.assertEqual([row["k"] for row in j["rows"]], g["k"][()][:, 0].astype(int).tolist())
+            np.testing.assert_array_equal([row["norm_F"] for row in j["rows"]], g["norm_F"][()][:, 0])
+        r = ks("query", self.h5, "--run", str(run), "--history", "tau")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("valid arrays", r.stderr)
+
+    def test_info(self):
+        r = ks("info", self.h5)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        out = r.stdout
+        t = self.t
+        with h5py.File(self.h5, "r") as f:
+            a = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f.attrs.items()}
+            landscapes = list(f["landscapes"])
+        for key in ("study_name", "study_sha256", "engine_version"):
+            self.assertIn(str(a[key]), out)
+        self.assertIn(f"{int(t['done'].sum())} of {len(t['done'])} done", out)
+        lines = out.splitlines()
+        for b in ("weighted", "basin"):
+            line = next(x for x in lines if x.startswith(b + " "))
+            m = t["block"] == b
+            self.assertIn(f" {int(m.sum())} ", line)
+            for st in set(t["status"][m]):
+                self.assertIn(f"{st} {int((t['status'][m] == st).sum())}", line)
+        ok = np.nonzero((t["block"] == "weighted") & (t["status"] == "ok"))[0]
+        best = ok[np.argmin(t["E"][ok])]
+        best_line = next(x for x in lines if x.strip().startswith("weighted") and " run " in x)
+        self.assertIn(f"run {best:>6}", best_line)
+        self.assertIn(f"E = {t['E'][best]:.6g}", best_line)
+        for name in landscapes:
+            self.assertIn(name + ":", out)
+        self.assertIn("histories", out)
+
+    def test_live_file_while_sweep_writes(self):
+        study = os.path.join(self.tmp.name, "live.toml")
+        with open(study, "w") as f:
+            f.write(LIVE)
+        out = os.path.join(self.tmp.name, "live.h5")
+        p = subprocess.Popen([KS, "run", study, "-o", out, "--threads", "1", "-q"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        seen = []
+        try:
+            deadline = time.time() + 120
+            while p.poll() is None and time.time() < deadline:
+                if not os.path.exists(out):
+                    time.sleep(0.02)
+                    continue
+                r = ks("query", out, "-c", "run_id,E", "-f", "csv")
+                self.assertEqual(r.returncode, 0, r.stderr)
+                _, rows = read_csv(r.stdout)
+                seen.append(rows)
+                i = ks("info", out)
+                self.assertEqual(i.returncode, 0, i.stderr)
+                if rows:
+                    h = ks("query", out, "--run", rows[-1][0], "--history", "tau", "--limit", "2")
+                    self.assertEqual(h.returncode, 0, h.stderr)
+        finally:
+            p.wait(timeout=300)
+        self.assertEqual(p.returncode, 0)
+        final, _ = h5table(out)
+        for rows in seen:  # every row seen during the sweep is the final row
+            ids = [int(x[0]) for x in rows]
+            self.assertTrue(np.all(final["done"][ids] == 1))
+            np.testing.assert_array_equal([float(x[1]) for x in rows], final["E"][ids])
+        self.assertGreater(len(seen), 0)
+        partial = [len(s) for s in seen if len(s) < len(final["done"])]
+        print(f"\n  live: {len(seen)} reads during the sweep, {len(partial)} of a partial file "
+              f"({min(partial) if partial else '-'}..{max(partial) if partial else '-'} of {len(final['done'])} rows)",
+              file=sys.stderr)
+
+
+if __name__ == "__main__":
+    KS, ROOT = sys.argv[1], sys.argv[2]
+    unittest.main(argv=[sys.argv[0]] + sys.argv[3:], verbosity=2)
