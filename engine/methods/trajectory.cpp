@@ -52,7 +52,11 @@ class Resolver {
   /// Joint accelerations of the method at (t, q, qd); fills every intermediate in `e`.
   /// Returns false when the Jacobian is singular.
   bool evaluate(double t, std::size_t segment, const Vec3& q, const Vec3& qd, Evaluation& e) const {
-    e.trig = joint_trig(q);
+    return evaluate(t, segment, joint_trig(q), qd, e);
+  }
+  /// The same with the joint trig of q given (see TrigTracker).
+  bool evaluate(double t, std::size_t segment, const JointTrig& trig, const Vec3& qd, Evaluation& e) const {
+    e.trig = trig;
     e.M = mass_matrix(dyn_, e.trig);
     e.c = coriolis(dyn_, e.trig, qd);
     e.g = gravity(dyn_, e.trig);
@@ -111,6 +115,7 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const Traje
   Vec3 q = *q0, qd = Vec3::Zero();
   const Resolver resolver(arm, path, o, alpha_profile);
   Evaluation e, s;  // e: at the sample; s: RK4 stages
+  TrigTracker trig(q);  // the sample's trig, carried from step to step (semi-implicit Euler)
   double sumE = 0, sumEM = 0, min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0;
   double f5 = 0, f6 = 0, prev5 = 0, prev6 = 0;
   Vec3 tau_inf = Vec3::Zero();
@@ -121,7 +126,7 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const Traje
   for (std::size_t i = 0; i < n; ++i) {
     const double t = static_cast<double>(i) * dt;
     const std::size_t seg = path.segment_at(t);
-    if (!resolver.evaluate(t, seg, q, qd, e)) {
+    if (!resolver.evaluate(t, seg, trig.trig(), qd, e)) {
       out.status = RunStatus::singular;
       break;
     }
@@ -164,7 +169,9 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const Traje
     // integrate to the next sample
     if (o.integrator == Integrator::semi_implicit_euler) {
       qd += dt * e.qdd;
-      q += dt * qd;
+      const Vec3 dq = dt * qd;
+      q += dq;
+      trig.advance(q, dq);
     } else {
       const double th = t + 0.5 * dt, t1 = t + dt;
       const std::size_t sh = path.segment_at(th), s1 = path.segment_at(t1);
@@ -181,6 +188,7 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const Traje
       const Vec3 k4q = qd + dt * k3v, k4v = s.qdd;
       q += dt / 6.0 * (k1q + 2.0 * k2q + 2.0 * k3q + k4q);
       qd += dt / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+      trig.reset(q);
     }
   }
   out.samples = done;

@@ -10,6 +10,16 @@ struct JointTrig {
   double s2, c2, s3, c3, s23, c23;      // relative: theta2, theta3, theta2+theta3
 };
 
+/// The sums (12, 23, 123) from the sines and cosines of the three joint angles.
+inline void complete_trig(JointTrig& t) {
+  t.s23 = t.s2 * t.c3 + t.c2 * t.s3;
+  t.c23 = t.c2 * t.c3 - t.s2 * t.s3;
+  t.s12 = t.s1 * t.c2 + t.c1 * t.s2;
+  t.c12 = t.c1 * t.c2 - t.s1 * t.s2;
+  t.s123 = t.s1 * t.c23 + t.c1 * t.s23;
+  t.c123 = t.c1 * t.c23 - t.s1 * t.s23;
+}
+
 /// Input: joint angles [rad]. Output: all sines and cosines. Cost: three sincos and a few products,
 /// so that the three calls can run in parallel (no dependency between them).
 template <class Vec3>
@@ -19,13 +29,52 @@ inline JointTrig joint_trig(const Vec3& q) {
   double s[3], c[3];
   fast_sincos3(x, s, c);
   t.s1 = s[0], t.c1 = c[0], t.s2 = s[1], t.c2 = c[1], t.s3 = s[2], t.c3 = c[2];
-  t.s23 = t.s2 * t.c3 + t.c2 * t.s3;
-  t.c23 = t.c2 * t.c3 - t.s2 * t.s3;
-  t.s12 = t.s1 * t.c2 + t.c1 * t.s2;
-  t.c12 = t.c1 * t.c2 - t.s1 * t.s2;
-  t.s123 = t.s1 * t.c23 + t.c1 * t.s23;
-  t.c123 = t.c1 * t.c23 - t.s1 * t.s23;
+  complete_trig(t);
   return t;
 }
+
+/// Joint trig carried along a time-stepping loop: after a step q += dq, the new sines and cosines
+/// follow by rotating the old ones by dq (sin and cos of a small angle are short polynomials),
+/// which takes the three sincos calls off the step's dependency chain. Every `resync` steps, or when
+/// a step is not small (|dq_i| >= 0.05 rad), they are evaluated directly, so rounding cannot drift:
+/// the values stay within ~1e-14 of joint_trig(q) (tested).
+class TrigTracker {
+ public:
+  static constexpr int resync = 64;
+  template <class V>
+  explicit TrigTracker(const V& q) {
+    reset(q);
+  }
+  template <class V>
+  void reset(const V& q) {
+    t_ = joint_trig(q);
+    steps_ = 0;
+  }
+  /// After q has become q + dq.
+  template <class V, class D>
+  void advance(const V& q, const D& dq) {
+    if (++steps_ >= resync || !(std::abs(dq[0]) < 0.05 && std::abs(dq[1]) < 0.05 && std::abs(dq[2]) < 0.05)) {
+      reset(q);
+      return;
+    }
+    rotate(t_.s1, t_.c1, dq[0]);
+    rotate(t_.s2, t_.c2, dq[1]);
+    rotate(t_.s3, t_.c3, dq[2]);
+    complete_trig(t_);
+  }
+  const JointTrig& trig() const { return t_; }
+
+ private:
+  static void rotate(double& s, double& c, double d) {
+    const double z = d * d;  // Taylor series to d^9 and d^10: error < 1e-21 for |d| < 0.05
+    const double sd = d * (1.0 + z * (-1.0 / 6 + z * (1.0 / 120 + z * (-1.0 / 5040 + z * (1.0 / 362880)))));
+    const double cd = 1.0 + z * (-0.5 + z * (1.0 / 24 + z * (-1.0 / 720 + z * (1.0 / 40320 + z * (-1.0 / 3628800)))));
+    const double sn = s * cd + c * sd;
+    c = c * cd - s * sd;
+    s = sn;
+  }
+  JointTrig t_;
+  int steps_ = 0;
+};
 
 }  // namespace ks
