@@ -12,7 +12,11 @@
 #include <optional>
 #include <thread>
 
+#include "runner/optimize_blocks.hpp"
 #include "runner/sweep.hpp"
+#ifdef KINESWEEP_HAVE_MPI
+#include "runner/mpi_sweep.hpp"
+#endif
 #include "store/store.hpp"
 #include "study/study.hpp"
 
@@ -93,6 +97,14 @@ int dry_run(const Study& study, const StudySchema& schema, const HistoryPolicy& 
             << human_bytes(total * (per_run_b + 9.0 * schema.columns.size())) << "; estimated time: "
             << human_time(total * per_run_s / std::max(1, n)) << " on " << n << " threads (from " << samples
             << " sample runs)\n";
+  for (const OptimizeBlock& ob : study.optimizations) {  // issue 6: run after the sweep
+    std::cout << "  optimization " << ob.name << ": minimise " << ob.objective_text << " over";
+    for (const auto& v : ob.variables) std::cout << ' ' << v.name;
+    if (!ob.polish_block.empty()) std::cout << "; sweep " << ob.polish_block << " (best " << ob.polish_best << ")";
+    if (ob.global) std::cout << "; global " << opt::to_string(ob.global->algorithm) << " (max_evals " << ob.global->max_evals << ")";
+    if (ob.local) std::cout << "; local " << opt::to_string(ob.local->algorithm) << " (max_evals " << ob.local->max_evals << ")";
+    std::cout << '\n';
+  }
   return 0;
 }
 
@@ -165,6 +177,27 @@ int run_command(const RunArgs& a) {
   if (a.dry_run) return dry_run(study, schema, histories, a.threads, a.compression);
 
   const std::string out = a.output.empty() ? study.output : a.output;
+#ifdef KINESWEEP_HAVE_MPI
+  if (launched_under_mpi()) {  // mpirun / srun: shards per rank, merged by rank 0 (runner/mpi_sweep.hpp)
+    DistributedRun d;
+    d.output = out;
+    d.study_arg = a.study;
+    d.resume = a.resume;
+    d.overwrite = a.overwrite;
+    d.quiet = a.quiet;
+    d.options.threads = a.threads;
+    d.options.histories = histories;
+    d.options.compression = a.compression;
+    d.options.stop = &g_stop;
+    ProgressDisplay progress(a.quiet);
+    d.options.on_progress = [&](const SweepProgress& p) { progress(p); };
+    std::signal(SIGINT, on_sigint);
+    std::signal(SIGTERM, on_sigint);
+    const int code = run_distributed(study, schema, d, std::cout, std::cerr);
+    std::signal(SIGINT, SIG_DFL);
+    return code;
+  }
+#endif
   try {
     std::unique_ptr<store::ResultsWriter> writer;
     std::optional<PreviousRuns> previous;
@@ -197,9 +230,21 @@ int run_command(const RunArgs& a) {
     std::signal(SIGINT, on_sigint);
     std::signal(SIGTERM, on_sigint);
     const SweepReport report = run_sweep(study, schema, *writer, o, previous ? &*previous : nullptr);
+    if (!report.interrupted && !study.optimizations.empty()) {  // issue 6: [[optimize]] blocks, after the sweep
+      print_report(std::cout, study, report);
+      std::optional<store::ResultsReader> cells;  // the landscape cells for polish_from, as just written
+      try {
+        cells.emplace(out);
+      } catch (const store::StoreError&) {
+      }
+      OptimizeRunOptions oo;
+      oo.threads = a.threads;
+      oo.cells = cells ? &*cells : nullptr;
+      run_optimizations(study, writer.get(), oo, &std::cout);
+    }
     writer->close();
     std::signal(SIGINT, SIG_DFL);
-    print_report(std::cout, study, report);
+    if (report.interrupted || study.optimizations.empty()) print_report(std::cout, study, report);
     if (report.interrupted) {
       std::cout << "interrupted: " << report.written + report.skipped << " of " << report.total
                 << " runs are in " << out << "\nresume with: kinesweep run " << a.study << " -o " << out

@@ -230,6 +230,9 @@ herr_t collect_names(hid_t, const char* name, const H5L_info_t*, void* data) {
 }
 }  // namespace
 
+std::int64_t ResultsReader::raw_file_id() const { return impl_->file; }  // for optimizations_read.cpp
+const std::string& ResultsReader::raw_path() const { return impl_->path; }
+
 std::vector<std::string> ResultsReader::landscapes() const {
   QuietHdf5 quiet;
   std::vector<std::string> out;

@@ -84,6 +84,50 @@ struct LandscapeSpec {
   std::vector<LandscapeMetric> metrics;
 };
 
+/// One stage of an optimisation (/optimizations/<name>/stages, FORMAT.md).
+struct OptimizationStage {
+  std::string name;         ///< "sweep", "global", "local"
+  std::string algorithm;    ///< NLopt name ("" for sweep)
+  std::string result;       ///< NLopt's result code name
+  double wall_time_s = 0.0;
+  std::int64_t evaluations = 0;
+  double best_objective = 0.0;
+  std::vector<double> best_x;  ///< one value per variable
+  std::string best_status;
+};
+
+/// An optimisation block's results: every evaluation, the stages, the best point and its run's
+/// history (/optimizations/<name>/, FORMAT.md). Plain data: filled by the runner, read by info/query.
+struct OptimizationRecord {
+  std::string name;       ///< group name (the block's; the preset's for a seed row)
+  std::string kind;       ///< "trajectory" | "ik"
+  std::string preset;     ///< seed 000 row, "" when none
+  std::string objective;  ///< e.g. "E", "E + 0.01*tau_inf"
+  std::string settings;   ///< the pipeline's options, human-readable (one "key = value" per line)
+  std::vector<std::string> variables, units;  ///< d variables, their stored units
+  std::vector<double> lower, upper;           ///< bounds (stored units)
+  // Every evaluation, in order (n rows).
+  std::vector<double> x;                 ///< n x d, row-major
+  std::vector<double> value;             ///< objective (penalised when the run failed)
+  std::vector<double> constraint;        ///< reach margin c(x) <= 0 feasible (NaN when none)
+  std::vector<std::string> stage;        ///< "sweep", "global", "local"
+  std::vector<std::string> status;       ///< the run's status
+  std::vector<std::int64_t> start;       ///< local: index of its start; sweep: the cell's run id; global: -1
+  std::vector<OptimizationStage> stages;
+  std::vector<double> local_from, local_to;  ///< per local start: m x d, row-major
+  std::vector<double> local_value;           ///< per local start: the best value it reached
+  double best_objective = 0.0;
+  std::vector<double> best_x;
+  std::string best_status, best_stage;
+  std::vector<std::pair<std::string, double>> best_metrics;  ///< the best point's run metrics (first run of the set)
+  std::vector<std::pair<std::string, double>> reference;     ///< e.g. thesis_E, thesis_alpha1A [rad] for presets
+  RunHistory history;                                        ///< the best point's run (first run of the set)
+  double wall_time_s = 0.0;
+  std::int64_t seed = 0;
+  std::size_t dims() const { return variables.size(); }
+  std::size_t size() const { return value.size(); }
+};
+
 class ResultsWriter {
  public:
   struct Impl;
@@ -113,6 +157,8 @@ class ResultsWriter {
   void flush();
   /// Write /landscapes/<block>/ (replacing an existing one) and flush.
   void write_landscape(const LandscapeSpec& spec);
+  /// Write /optimizations/<record.name>/ (replacing an existing one) and flush (optimizations.cpp).
+  void write_optimization(const OptimizationRecord& record);
   /// Flush and close; further calls throw.
   void close();
 
@@ -166,8 +212,13 @@ class ResultsReader {
   RunHistory read_history(std::int64_t run_id) const;  ///< empty when the run has none
   std::vector<std::string> landscapes() const;
   LandscapeSpec read_landscape(const std::string& block) const;
+  /// Names of the groups under /optimizations (empty when none), and one of them (optimizations_read.cpp).
+  std::vector<std::string> optimizations() const;
+  OptimizationRecord read_optimization(const std::string& name) const;
 
  private:
+  std::int64_t raw_file_id() const;          ///< the open HDF5 file id (reader.cpp)
+  const std::string& raw_path() const;       ///< the file's path (reader.cpp)
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -4,6 +4,8 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -11,6 +13,7 @@
 
 #include "methods/trajectory.hpp"
 #include "model/arm.hpp"
+#include "optimize/optimize.hpp"
 #include "space/space.hpp"
 #include "task/quintic_path.hpp"
 
@@ -51,6 +54,35 @@ struct StudyTask {
   Path2 path() const { return Path2(vertices, durations); }
 };
 
+/// An optimisation block ([[optimize]] in a study file; syntax in studies/README.md, issue 6).
+/// One evaluation = the runs of `base` (its fixed parameters, and its axes as an evaluation set, e.g.
+/// the IK start set) with the variables' columns replaced by x; the objective is the weighted sum of
+/// metrics averaged over those runs (failure_rate: the fraction of runs not converged).
+struct OptimizeVariable {
+  std::string name;  ///< a f64 run parameter of the block's kind
+  std::string unit;  ///< stored unit ("rad", "", ...)
+  double lower = 0.0, upper = 0.0;  ///< stored units
+  double start = std::numeric_limits<double>::quiet_NaN();  ///< NaN: the block's value of the parameter
+};
+struct OptimizeBlock {
+  std::string name;    ///< the HDF5 group /optimizations/<name> (default: the preset's name)
+  std::string preset;  ///< seed 000 Table 4 row, "" when none
+  std::vector<Block> base;  ///< exactly one: the runs one evaluation executes (vector: Block has no default)
+  std::vector<OptimizeVariable> variables;                  ///< file order
+  std::vector<std::pair<std::string, double>> objective;    ///< metric -> weight (a weighted sum)
+  std::string objective_text;                               ///< as the file wrote it, e.g. "E" or "E + 0.01*tau_inf"
+  std::optional<opt::StageOptions> global, local;
+  int local_starts = 1;     ///< best distinct global points polished by the local stage
+  double distinct = 1e-2;   ///< range-normalised distance that makes two points distinct
+  std::string polish_block; ///< sweep then polish: the [[block]] whose best cells start the local stage
+  int polish_best = 0;      ///< ... how many of its best cells
+  std::uint64_t seed = 42;  ///< nlopt::srand before the global stage
+  opt::ConstraintMode constraint = opt::ConstraintMode::automatic;
+  double penalty = 1.0e7;   ///< deterministic penalty scale of failed runs (larger than any feasible objective)
+  int line = 0;             ///< of the [[optimize]] table
+  const Block& block() const { return base.front(); }
+};
+
 struct Study {
   std::string file;         ///< the path or name it was parsed from
   std::string name;
@@ -63,6 +95,7 @@ struct Study {
   std::string text;         ///< the study file's text, verbatim
   std::string sha256;       ///< lower-case hex SHA-256 of text
   std::vector<Block> blocks;  ///< file order; global run ids concatenate them
+  std::vector<OptimizeBlock> optimizations;  ///< [[optimize]] tables, file order (run after the blocks)
 
   std::uint64_t run_count() const { return total_runs(blocks); }
   RunRef locate(std::uint64_t global) const { return locate_run(blocks, global); }

@@ -1,0 +1,448 @@
+// Optimisation blocks (see optimize_blocks.hpp).
+#include "runner/optimize_blocks.hpp"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <numbers>
+#include <numeric>
+#include <ostream>
+#include <sstream>
+
+#include "methods/seed_cases.hpp"
+#include "runner/execute.hpp"
+
+namespace ks {
+
+namespace {
+constexpr double kRad2Deg = 180.0 / std::numbers::pi;
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double cell_num(const Cell& c) {
+  if (const double* d = std::get_if<double>(&c)) return *d;
+  if (const std::int64_t* i = std::get_if<std::int64_t>(&c)) return static_cast<double>(*i);
+  return kNaN;
+}
+
+std::size_t metric_index(BlockKind kind, const std::string& name) {
+  const auto& cols = metric_columns(kind);
+  for (std::size_t i = 0; i < cols.size(); ++i)
+    if (cols[i].name == name) return i;
+  return cols.size();
+}
+
+/// Everything an evaluation needs, shared by the objective's copies (thread-safe: per-thread workspaces).
+struct Evaluator {
+  Study study;  // the study with blocks = {the optimisation's base block}
+  const OptimizeBlock* ob = nullptr;
+  BlockKind kind = BlockKind::trajectory;
+  std::vector<std::vector<Cell>> set;       // parameters of the evaluation set's runs
+  std::vector<std::size_t> var_col;         // variable -> parameter column
+  std::vector<std::pair<std::size_t, double>> terms;  // metric index (or npos for failure_rate), weight
+  bool failure_rate = false;
+  double duration = 0.0;
+  bool reach_varies = false;
+  tbb::enumerable_thread_specific<RunWorkspace> workspaces;
+  int threads = 0;
+
+  std::vector<Cell> params_at(std::size_t run, std::span<const double> x) const {
+    std::vector<Cell> p = set[run];
+    for (std::size_t i = 0; i < var_col.size(); ++i) p[var_col[i]] = x[i];
+    return p;
+  }
+  const Block& block() const { return study.blocks.front(); }
+
+  /// Reach margin of one run's parameters: the start (local methods) or every vertex (vertex_alpha).
+  double margin_of(const std::vector<Cell>& p) const {
+    const Block& b = block();
+    const auto& verts = study.task.vertices;
+    const std::string& method = std::get<std::string>(p[b.column_index("method")]);
+    double m = reach_margin(study.robot, verts.front(), cell_num(p[b.column_index("alpha1A")]));
+    if (method == "vertex_alpha")
+      for (std::size_t v = 2; v <= verts.size(); ++v)
+        m = std::max(m, reach_margin(study.robot, verts[v - 1], cell_num(p[b.column_index("vertex_alpha_" + std::to_string(v))])));
+    return m;
+  }
+  double constraint(std::span<const double> x) const {
+    double m = -std::numeric_limits<double>::infinity();
+    for (std::size_t r = 0; r < set.size(); ++r) m = std::max(m, margin_of(params_at(r, x)));
+    return m;
+  }
+
+  /// One run's objective (penalised when it failed) and status.
+  std::pair<double, std::string> run_value(std::size_t run, std::span<const double> x, int stride, RunOutcome* keep) {
+    const std::vector<Cell> p = params_at(run, x);
+    RunOutcome o = execute_run(study, 0, p, stride, workspaces.local());
+    double v = 0.0;
+    if (kind == BlockKind::trajectory) {
+      if (o.status == "ok") {
+        for (const auto& [i, w] : terms) v += w * cell_num(o.metrics[i]);
+      } else if (o.status == "unreachable_start") {
+        v = ob->penalty * (2.0 + std::max(0.0, margin_of(p)));
+      } else {  // singular / diverged: the earlier it stopped, the worse
+        const double t = cell_num(o.metrics[metric_index(kind, "stop_time")]);
+        v = ob->penalty * (1.0 + std::clamp(1.0 - (std::isfinite(t) ? t : 0.0) / duration, 0.0, 1.0));
+      }
+    } else {
+      const bool conv = o.status == "converged";
+      for (const auto& [i, w] : terms) {
+        if (i == std::size_t(-1)) v += w * (conv ? 0.0 : 1.0);
+        else if (i == metric_index(kind, "iterations") && !conv) v += w * cell_num(p[block().column_index("max_iter")]);
+        else v += w * cell_num(o.metrics[i]);
+      }
+    }
+    if (!std::isfinite(v)) v = ob->penalty * 3.0;
+    std::string status = o.status;
+    if (keep) *keep = std::move(o);
+    return {v, std::move(status)};
+  }
+
+  opt::Evaluation evaluate(std::span<const double> x) {
+    const std::size_t n = set.size();
+    if (n == 1) {
+      auto [v, s] = run_value(0, x, 0, nullptr);
+      return {v, s};
+    }
+    std::vector<std::pair<double, std::string>> r(n);
+    const std::vector<double> xc(x.begin(), x.end());
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { r[i] = run_value(i, xc, 0, nullptr); });
+    double sum = 0.0;
+    std::size_t bad = 0;
+    std::string first_bad;
+    for (const auto& [v, s] : r) {
+      sum += v;
+      const bool good = kind == BlockKind::trajectory ? s == "ok" : s == "converged";
+      if (!good && bad++ == 0) first_bad = s;
+    }
+    std::string status = bad == 0 ? (kind == BlockKind::trajectory ? "ok" : "converged")
+                                  : first_bad + " (" + std::to_string(bad) + "/" + std::to_string(n) + " runs)";
+    return {sum / static_cast<double>(n), status};
+  }
+};
+
+std::shared_ptr<Evaluator> make_evaluator(const Study& study, std::size_t index) {
+  const OptimizeBlock& ob = study.optimizations.at(index);
+  auto e = std::make_shared<Evaluator>();
+  e->study = study;
+  e->study.blocks = ob.base;
+  e->study.optimizations.clear();
+  e->ob = &study.optimizations[index];
+  e->kind = ob.block().kind();
+  const Block& b = e->block();
+  for (std::uint64_t r = 0; r < b.run_count(); ++r) e->set.push_back(b.params(r));
+  for (const auto& v : ob.variables) {
+    const std::size_t c = b.column_index(v.name);
+    if (c == Block::npos) throw std::invalid_argument("optimization " + ob.name + ": no parameter " + v.name);
+    e->var_col.push_back(c);
+    if (v.name == "alpha1A" || v.name.starts_with("vertex_alpha_")) e->reach_varies = true;
+  }
+  for (const auto& [m, w] : ob.objective) {
+    if (m == "failure_rate") e->terms.emplace_back(std::size_t(-1), w);
+    else {
+      const std::size_t i = metric_index(e->kind, m);
+      if (i >= metric_columns(e->kind).size()) throw std::invalid_argument("optimization " + ob.name + ": no metric " + m);
+      e->terms.emplace_back(i, w);
+    }
+  }
+  for (double d : study.task.durations) e->duration += d;
+  if (e->duration <= 0) e->duration = 1.0;
+  return e;
+}
+
+std::string fmt_x(const std::vector<std::string>& names, const std::vector<std::string>& units, std::span<const double> x) {
+  std::ostringstream os;
+  os.precision(6);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (i) os << ", ";
+    if (units[i] == "rad") os << names[i] << " = " << x[i] * kRad2Deg << " deg";
+    else os << names[i] << " = " << x[i] << (units[i].empty() ? "" : " " + units[i]);
+  }
+  return os.str();
+}
+
+std::string stage_text(const char* what, const opt::StageOptions& s) {
+  std::ostringstream os;
+  os << what << ".algorithm = " << opt::to_string(s.algorithm) << '\n';
+  auto put = [&](const char* k, double v) {
+    if (v > 0) os << what << '.' << k << " = " << v << '\n';
+  };
+  put("max_evals", s.max_evals);
+  put("population", s.population);
+  if (s.islands > 1) put("islands", s.islands);
+  put("max_time", s.max_time_s);
+  put("xtol_rel", s.xtol_rel);
+  put("xtol_abs", s.xtol_abs);
+  put("ftol_rel", s.ftol_rel);
+  put("ftol_abs", s.ftol_abs);
+  if (s.algorithm == opt::Algorithm::LD_SLSQP) put("fd_step", s.fd_step);
+  put("initial_step", s.initial_step);
+  if (std::isfinite(s.stopval)) os << what << ".stopval = " << s.stopval << '\n';
+  return os.str();
+}
+}  // namespace
+
+double reach_margin(const PlanarArm3& a, const Eigen::Vector2d& p, double alpha) {
+  const double x2 = p.x() - a.l[2] * std::cos(alpha), y2 = p.y() - a.l[2] * std::sin(alpha);
+  const double c2 = (x2 * x2 + y2 * y2 - a.l[0] * a.l[0] - a.l[1] * a.l[1]) / (2.0 * a.l[0] * a.l[1]);
+  return std::abs(c2) - 1.0;
+}
+
+opt::Problem make_problem(const Study& study, std::size_t index) {
+  const OptimizeBlock& ob = study.optimizations.at(index);
+  auto e = make_evaluator(study, index);
+  opt::Problem p;
+  const std::vector<Cell>& base = e->set.front();
+  for (std::size_t i = 0; i < ob.variables.size(); ++i) {
+    const auto& v = ob.variables[i];
+    opt::Variable var{v.name, v.unit, v.lower, v.upper, v.start};
+    if (std::isnan(var.start)) var.start = cell_num(base[e->var_col[i]]);  // the block's value (the preset's)
+    p.variables.push_back(std::move(var));
+  }
+  p.objective = [e](std::span<const double> x) { return e->evaluate(x); };
+  if (e->kind == BlockKind::trajectory && e->reach_varies)
+    p.constraint = [e](std::span<const double> x) { return e->constraint(x); };
+  return p;
+}
+
+std::vector<opt::Start> best_cells(const Study& study, std::size_t index, const OptimizeRunOptions& options) {
+  const OptimizeBlock& ob = study.optimizations.at(index);
+  std::vector<opt::Start> out;
+  if (ob.polish_block.empty() || ob.polish_best <= 0) return out;
+  const std::size_t bi = study.block_index(ob.polish_block);
+  if (bi == Block::npos) throw std::invalid_argument("optimization " + ob.name + ": no block " + ob.polish_block);
+  const Block& lb = study.blocks[bi];
+  const std::uint64_t n = lb.run_count(), first = study.first_run(bi);
+  // The cells' objective: same weighting and penalties as the optimisation, from the cells' metrics.
+  Study one = study;
+  one.blocks = {lb};
+  one.optimizations = study.optimizations;
+  one.optimizations[index].base = {lb};
+  auto e = make_evaluator(one, index);
+  e->var_col.clear();  // cells keep their own parameters
+  std::vector<double> value(n, kNaN);
+  std::vector<std::string> status(n);
+  bool from_file = false;
+  if (options.cells) {
+    try {
+      const auto done = options.cells->done_mask();
+      bool all = done.size() >= first + n;
+      for (std::uint64_t r = 0; all && r < n; ++r) all = done[first + r] != 0;
+      if (all) {
+        std::vector<std::vector<double>> metric;
+        for (const auto& [i, w] : e->terms)
+          metric.push_back(i == std::size_t(-1) ? std::vector<double>() : options.cells->read_f64(metric_columns(e->kind)[i].name));
+        const auto st = options.cells->read_str("status");
+        const auto stop = e->kind == BlockKind::trajectory ? options.cells->read_f64("stop_time") : std::vector<double>();
+        for (std::uint64_t r = 0; r < n; ++r) {
+          const std::size_t g = first + r;
+          status[r] = st[g];
+          const std::vector<Cell> p = lb.params(r);
+          double v = 0;
+          if (e->kind == BlockKind::trajectory) {
+            if (st[g] == "ok")
+              for (std::size_t t = 0; t < e->terms.size(); ++t) v += e->terms[t].second * metric[t][g];
+            else if (st[g] == "unreachable_start") v = ob.penalty * (2.0 + std::max(0.0, e->margin_of(p)));
+            else v = ob.penalty * (1.0 + std::clamp(1.0 - stop[g] / e->duration, 0.0, 1.0));
+          } else {
+            const bool conv = st[g] == "converged";
+            for (std::size_t t = 0; t < e->terms.size(); ++t) {
+              const auto [i, w] = e->terms[t];
+              if (i == std::size_t(-1)) v += w * (conv ? 0.0 : 1.0);
+              else if (metric_columns(e->kind)[i].name == "iterations" && !conv) v += w * cell_num(p[lb.column_index("max_iter")]);
+              else v += w * metric[t][g];
+            }
+          }
+          value[r] = v;
+        }
+        from_file = true;
+      }
+    } catch (const std::exception&) {
+      from_file = false;
+    }
+  }
+  if (!from_file) {  // evaluate the cells here, in parallel (indexed: deterministic)
+    tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+    arena.execute([&] {
+      tbb::parallel_for(std::uint64_t(0), n, [&](std::uint64_t r) {
+        const std::vector<double> none;
+        auto [v, s] = e->run_value(static_cast<std::size_t>(r), none, 0, nullptr);
+        value[r] = v;
+        status[r] = s;
+      });
+    });
+  }
+  std::vector<std::uint64_t> idx(n);
+  std::iota(idx.begin(), idx.end(), 0);
+  std::stable_sort(idx.begin(), idx.end(), [&](auto a, auto b) { return value[a] < value[b]; });
+  for (std::uint64_t r : idx) {
+    if (static_cast<int>(out.size()) >= ob.polish_best) break;
+    const std::vector<Cell> p = lb.params(r);
+    opt::Start s;
+    for (const auto& v : ob.variables) s.x.push_back(cell_num(p[lb.column_index(v.name)]));
+    s.value = value[r];
+    s.status = status[r];
+    s.run = static_cast<std::int64_t>(first + r);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+OptimizeResult run_optimization(const Study& study, std::size_t index, const OptimizeRunOptions& options) {
+  const OptimizeBlock& ob = study.optimizations.at(index);
+  auto e = make_evaluator(study, index);
+  opt::Problem problem = make_problem(study, index);
+  opt::PipelineOptions po;
+  po.global = ob.global;
+  po.local = ob.local;
+  po.local_starts = ob.local_starts;
+  po.distinct = ob.distinct;
+  po.threads = options.threads;
+  po.seed = ob.seed;
+  po.constraint = ob.constraint;
+  po.starts = best_cells(study, index, options);
+
+  OptimizeResult res;
+  {
+    tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+    arena.execute([&] { res.summary = opt::optimize(problem, po); });
+  }
+  const opt::Summary& s = res.summary;
+  store::OptimizationRecord& r = res.record;
+  r.name = ob.name;
+  r.kind = std::string(to_string(ob.block().kind()));
+  r.preset = ob.preset;
+  r.objective = ob.objective_text;
+  r.variables = s.variables;
+  r.units = s.units;
+  for (const auto& v : problem.variables) {
+    r.lower.push_back(v.lower);
+    r.upper.push_back(v.upper);
+  }
+  const std::size_t d = r.variables.size();
+  for (const auto& ev : s.evaluations) {
+    r.x.insert(r.x.end(), ev.x.begin(), ev.x.end());
+    r.value.push_back(ev.value);
+    r.constraint.push_back(ev.constraint);
+    r.stage.push_back(ev.stage);
+    r.status.push_back(ev.status);
+    r.start.push_back(ev.start);
+  }
+  for (const auto& st : s.stages) {
+    store::OptimizationStage x;
+    x.name = st.name;
+    x.algorithm = st.algorithm;
+    x.result = st.result;
+    x.wall_time_s = st.wall_time_s;
+    x.evaluations = static_cast<std::int64_t>(st.evaluations);
+    x.best_objective = st.best_value;
+    x.best_x = st.best_x.empty() ? std::vector<double>(d, kNaN) : st.best_x;
+    x.best_status = st.best_status;
+    r.stages.push_back(std::move(x));
+  }
+  for (std::size_t i = 0; i < s.local_from.size(); ++i) {
+    r.local_from.insert(r.local_from.end(), s.local_from[i].begin(), s.local_from[i].end());
+    r.local_to.insert(r.local_to.end(), s.local_to[i].begin(), s.local_to[i].end());
+    r.local_value.push_back(s.local_values[i]);
+  }
+  r.best_objective = s.best_value;
+  r.best_x = s.best_x;
+  r.best_status = s.best_status;
+  r.best_stage = s.best_stage;
+  r.wall_time_s = s.wall_time_s;
+  r.seed = static_cast<std::int64_t>(ob.seed);
+  {
+    std::ostringstream os;
+    os << "objective = " << ob.objective_text << "\nconstraint = "
+       << (ob.constraint == opt::ConstraintMode::automatic ? "auto" : "penalty") << "\npenalty = " << ob.penalty
+       << "\nseed = " << ob.seed << '\n';
+    if (ob.global) os << stage_text("global", *ob.global);
+    if (ob.local) os << stage_text("local", *ob.local) << "local.starts = " << ob.local_starts << '\n';
+    if (!ob.polish_block.empty()) os << "polish_from = " << ob.polish_block << ", best " << ob.polish_best << '\n';
+    os << "evaluation_set = " << e->set.size() << " run(s)\n";
+    r.settings = os.str();
+  }
+  // The best point's run (first of the set): metrics and full history.
+  if (!s.best_x.empty()) {
+    RunOutcome o;
+    e->run_value(0, s.best_x, 1, &o);
+    const auto& cols = metric_columns(e->kind);
+    for (std::size_t i = 0; i < cols.size() && i < o.metrics.size(); ++i) r.best_metrics.emplace_back(cols[i].name, cell_num(o.metrics[i]));
+    r.history = std::move(o.history);
+  }
+  // A seed row: the thesis' optimum and figures, and this objective at the thesis' printed point.
+  res.value_at_thesis = kNaN;
+  if (const SeedCase* c = ob.preset.empty() ? nullptr : find_seed_case(ob.preset)) {
+    r.reference = {{"thesis_E", c->E}, {"thesis_tau1_inf", c->tau_inf[0]}, {"thesis_tau2_inf", c->tau_inf[1]},
+                   {"thesis_tau3_inf", c->tau_inf[2]}};
+    const TrajectoryOptions to = c->options();
+    std::vector<double> xt;
+    for (const auto& v : ob.variables) {
+      double t = kNaN;
+      if (v.name == "k") t = to.k;
+      else if (v.name == "alpha1A") t = to.alpha1A;
+      else if (v.name.starts_with("vertex_alpha_")) {
+        const std::size_t k = std::stoul(v.name.substr(13));
+        if (k >= 2 && k - 2 < to.vertex_alpha.size()) t = to.vertex_alpha[k - 2];
+      }
+      r.reference.emplace_back("thesis_" + v.name, t);
+      xt.push_back(t);
+    }
+    bool ok = true;
+    for (double t : xt) ok = ok && std::isfinite(t);
+    if (ok && !xt.empty()) {
+      res.value_at_thesis = e->evaluate(xt).value;
+      r.reference.emplace_back("objective_at_thesis_x", res.value_at_thesis);
+    }
+  }
+  return res;
+}
+
+void print_optimization(std::ostream& os, const Study& study, std::size_t index, const OptimizeResult& res) {
+  const OptimizeBlock& ob = study.optimizations.at(index);
+  const auto& r = res.record;
+  os << "optimization " << ob.name << " (" << r.kind << (ob.preset.empty() ? "" : ", preset " + ob.preset)
+     << "): minimise " << ob.objective_text << " over " << r.variables.size() << " variable(s), "
+     << r.size() << " evaluations, " << res.summary.wall_time_s << " s\n";
+  res.summary.print(os);
+  char line[512];
+  std::snprintf(line, sizeof line, "  kinesweep: %s = %.6g at %s [%s]\n", ob.objective_text.c_str(), r.best_objective,
+                fmt_x(r.variables, r.units, r.best_x).c_str(), r.best_status.c_str());
+  os << line;
+  for (const auto& [k, v] : r.best_metrics)
+    if (k == "E" || k == "tau1_inf" || k == "tau2_inf" || k == "tau3_inf") {
+      std::snprintf(line, sizeof line, "    %s = %.2f", k.c_str(), v);
+      os << line;
+    }
+  if (!r.best_metrics.empty() && r.kind == "trajectory") os << '\n';
+  if (const SeedCase* c = ob.preset.empty() ? nullptr : find_seed_case(ob.preset)) {
+    std::vector<double> xt;
+    for (const auto& [k, v] : r.reference)
+      if (k.starts_with("thesis_") && k != "thesis_E" && !k.starts_with("thesis_tau")) xt.push_back(v);
+    std::snprintf(line, sizeof line, "  thesis:    E = %.2f at %s; kinesweep's %s there = %.6g\n", c->E,
+                  xt.size() == r.variables.size() ? fmt_x(r.variables, r.units, xt).c_str() : "?",
+                  ob.objective_text.c_str(), res.value_at_thesis);
+    os << line;
+  }
+}
+
+std::vector<OptimizeResult> run_optimizations(const Study& study, store::ResultsWriter* writer,
+                                              const OptimizeRunOptions& options, std::ostream* os) {
+  std::vector<OptimizeResult> out;
+  for (std::size_t i = 0; i < study.optimizations.size(); ++i) {
+    OptimizeResult r = run_optimization(study, i, options);
+    if (writer) writer->write_optimization(r.record);
+    if (os) {
+      if (i == 0) *os << '\n';
+      print_optimization(*os, study, i, r);
+    }
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+}  // namespace ks

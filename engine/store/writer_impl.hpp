@@ -1,0 +1,42 @@
+#pragma once
+// Internal: the state of a ResultsWriter, shared by writer.cpp and optimizations.cpp. Only store/*.cpp.
+#include <chrono>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "store/h5util.hpp"
+#include "store/journal_vfd.hpp"
+#include "store/store.hpp"
+
+namespace ks::store {
+
+struct ResultsWriter::Impl {
+  std::string path;
+  StoreOptions opt;
+  std::vector<ColumnSpec> columns;
+  std::int64_t n_runs = 0;
+  detail::Hid file, runs, histories, landscapes, done_dset;
+  std::vector<detail::Hid> col_dsets;
+  std::vector<std::uint8_t> done;       // committed or pending
+  std::map<std::int64_t, Record> pending;
+  std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
+  bool closed = false, broken = false;
+
+  void fail(const std::string& what) {
+    broken = true;
+    std::string cause = what + ": " + detail::h5_error_text();
+    std::string j = detail::journal_last_error();
+    if (!j.empty()) cause += " (" + j + ")";
+    throw StoreError(path, cause);
+  }
+  void usable() const {
+    if (closed) throw StoreError(path, "writer is closed");
+    if (broken) throw StoreError(path, "writer failed earlier; the file holds the runs of the last successful flush");
+  }
+  void open_objects();
+  void write_history(std::int64_t id, const EncodedHistory& h);
+  void do_flush();
+};
+
+}  // namespace ks::store

@@ -1,0 +1,210 @@
+"""End-to-end tests of distributed sweeps: `mpirun -np 2 kinesweep run` gives the single-process
+file (every /runs column but wall_time bitwise, every history, every landscape); a rank killed with
+SIGKILL mid-run loses nothing done, and `--resume` completes the study.
+
+usage: /usr/bin/python3 test_mpi.py KINESWEEP_BINARY
+"""
+import glob
+import os
+import re
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+import h5py
+import numpy as np
+
+KS = None
+MPIRUN = ["mpirun", "--oversubscribe", "--allow-run-as-root", "--bind-to", "none", "-np", "2"]
+
+SWEEP = """
+[study]
+name = "mpi_e2e"
+histories = "every=5"
+
+[[block]]
+name = "weighted"
+kind = "trajectory"
+method = "local_weighted"
+[block.axes]
+alpha1A = { from = -20, to = 30, step = 1 }
+k = { from = 0, to = 1, count = 11 }
+
+[[block]]
+name = "newton_basin"
+kind = "ik"
+problem = "scara"
+method = "newton"
+[block.axes]
+q0_1 = { from = -180, to = 180, count = 21 }
+q0_2 = { from = -180, to = 180, count = 21 }
+"""
+
+# Long enough (several seconds on 2 ranks) to kill a rank in the middle.
+LONG = SWEEP.replace('name = "mpi_e2e"', 'name = "mpi_kill"').replace("step = 1 }", "step = 0.1 }")
+
+
+def run(*args):
+    return subprocess.run([KS, *args], capture_output=True, text=True, timeout=600)
+
+
+def mpirun(*args):
+    return subprocess.run([*MPIRUN, KS, *args], capture_output=True, text=True, timeout=600)
+
+
+def bitwise_equal(x, y):
+    if x.shape != y.shape:
+        return False
+    if x.dtype.kind == "f":
+        return np.array_equal(x.view(np.uint64), y.view(np.uint64))  # NaN included
+    return np.array_equal(x, y)
+
+
+def runs_table(path):
+    with h5py.File(path, "r") as f:
+        return {k: f["runs"][k][()] for k in f["runs"] if k != "wall_time"}
+
+
+def descendants(root):
+    """pids of every process below `root` (by /proc/*/stat ppid)."""
+    children = {}
+    for d in os.listdir("/proc"):
+        if d.isdigit():
+            try:
+                with open(f"/proc/{d}/stat") as f:
+                    ppid = int(f.read().rsplit(")", 1)[1].split()[1])
+                children.setdefault(ppid, []).append(int(d))
+            except OSError:
+                pass
+    out, todo = [], [root]
+    while todo:
+        for c in children.get(todo.pop(), []):
+            out.append(c)
+            todo.append(c)
+    return out
+
+
+def rank_pid(mpirun_pid, rank):
+    for pid in descendants(mpirun_pid):
+        try:
+            with open(f"/proc/{pid}/environ", "rb") as f:
+                env = f.read().split(b"\0")
+            with open(f"/proc/{pid}/comm") as f:
+                comm = f.read().strip()
+        except OSError:
+            continue
+        if comm == "kinesweep" and f"OMPI_COMM_WORLD_RANK={rank}".encode() in env:
+            return pid
+    return None
+
+
+class Base(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def write(self, name, text):
+        p = os.path.join(self.dir, name)
+        with open(p, "w") as f:
+            f.write(text)
+        return p
+
+    def assertSameFile(self, a, b):
+        ta, tb = runs_table(a), runs_table(b)
+        self.assertEqual(ta.keys(), tb.keys())
+        for k in ta:
+            self.assertTrue(bitwise_equal(ta[k], tb[k]), k)
+        with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
+            self.assertTrue(np.all(fb["runs"]["done"][()] == 1))
+            self.assertEqual(set(fa["histories"]), set(fb["histories"]))
+            for g in fa["histories"]:
+                self.assertEqual(list(fa["histories"][g].attrs["arrays"]), list(fb["histories"][g].attrs["arrays"]))
+                for k in fa["histories"][g]:
+                    self.assertTrue(bitwise_equal(fa["histories"][g][k][()], fb["histories"][g][k][()]), g + "/" + k)
+            self.assertEqual(set(fa["landscapes"]), set(fb["landscapes"]))
+            for l in fa["landscapes"]:
+                self.assertEqual(set(fa["landscapes"][l]), set(fb["landscapes"][l]))
+                for k in fa["landscapes"][l]:
+                    self.assertTrue(bitwise_equal(fa["landscapes"][l][k][()], fb["landscapes"][l][k][()]), l + "/" + k)
+            self.assertEqual(fa.attrs["study_sha256"], fb.attrs["study_sha256"])
+
+
+class Merged(Base):
+    def test_two_ranks_give_the_single_process_file(self):
+        study = self.write("s.toml", SWEEP)
+        ref, out = os.path.join(self.dir, "ref.h5"), os.path.join(self.dir, "mpi.h5")
+        r = run("run", study, "-o", ref, "-q")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        r = mpirun("run", study, "-o", out, "-q", "--threads", "1")
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        self.assertIn("distributed: 2 ranks", r.stdout)
+        self.assertIn("1002 runs (1002 computed now, 0 already in the file)", r.stdout)
+        self.assertSameFile(ref, out)
+        self.assertEqual(glob.glob(out + ".rank*"), [])  # shards deleted after the merge
+        # the file exists: refused without --resume / --overwrite, replaced with --overwrite
+        r = mpirun("run", study, "-o", out, "-q")
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("--overwrite", r.stderr)
+        r = mpirun("run", study, "-o", out, "-q", "--overwrite")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertSameFile(ref, out)
+        # resuming a complete file computes nothing
+        r = mpirun("run", study, "-o", out, "-q", "--resume")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("(0 computed now, 1002 already in the file)", r.stdout)
+        self.assertSameFile(ref, out)
+
+
+class KillOneRank(Base):
+    def test_sigkill_of_one_rank_then_resume_completes_the_study(self):
+        study = self.write("long.toml", LONG)
+        ref, out = os.path.join(self.dir, "ref.h5"), os.path.join(self.dir, "killed.h5")
+        r = run("run", study, "-o", ref, "-q")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        p = subprocess.Popen([*MPIRUN, KS, "run", study, "-o", out, "-q", "--threads", "1"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        victim, deadline = None, time.time() + 60
+        while time.time() < deadline and p.poll() is None:
+            victim = rank_pid(p.pid, 1)
+            if victim and os.path.exists(out + ".rank1.h5"):
+                break
+            time.sleep(0.05)
+        self.assertIsNotNone(victim, "rank 1 not found")
+        time.sleep(1.5)  # let it commit some runs (shards commit every 512 runs or 2 s)
+        self.assertIsNone(p.poll(), "the job finished before the kill: make LONG longer")
+        os.kill(victim, signal.SIGKILL)
+        try:
+            p.wait(timeout=60)
+        except subprocess.TimeoutExpired:  # mpirun should abort the job by itself
+            p.kill()
+            p.wait()
+        self.assertNotEqual(p.returncode, 0)
+        self.assertFalse(os.path.exists(out))  # no merge happened
+        shards = sorted(glob.glob(out + ".rank*.h5"))
+        self.assertEqual([os.path.basename(s) for s in shards], ["killed.h5.rank0.h5", "killed.h5.rank1.h5"])
+
+        r = mpirun("run", study, "-o", out, "-q", "--threads", "1")  # no silent restart over the shards
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("--resume", r.stderr)
+
+        r = mpirun("run", study, "-o", out, "-q", "--threads", "1", "--resume")
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        m = re.search(r"(\d+) runs \((\d+) computed now, (\d+) already in the file\)", r.stdout)
+        self.assertIsNotNone(m, r.stdout)
+        total, now, before = map(int, m.groups())
+        self.assertEqual(total, 501 * 11 + 441)
+        self.assertGreater(before, 0)  # both ranks' committed runs were kept (rank 1's included)
+        self.assertGreater(now, 0)
+        self.assertSameFile(ref, out)
+        self.assertEqual(glob.glob(out + ".rank*"), [])
+
+
+if __name__ == "__main__":
+    KS = os.path.abspath(sys.argv[1])
+    unittest.main(argv=[sys.argv[0], "-v"])
