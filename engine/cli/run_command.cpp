@@ -202,12 +202,8 @@ int run_command(const RunArgs& a) {
     std::unique_ptr<store::ResultsWriter> writer;
     std::optional<PreviousRuns> previous;
     const bool exists = std::filesystem::exists(out);
-    store::StoreOptions so;
+    store::StoreOptions so;  // commits every second (see StoreOptions)
     so.overwrite = a.overwrite;
-    // Commit by time, not every 64 runs: a commit journals every changed page, which for
-    // microsecond IK runs costs more than the runs. A kill -9 loses at most ~1 s of runs.
-    so.flush_every_runs = 1 << 16;
-    so.flush_every_seconds = 1.0;
     if (exists && a.resume) {
       previous = read_previous(out, schema);
       writer = std::move(store::ResultsWriter::open_for_resume(out, study.sha256, so).writer);

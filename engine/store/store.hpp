@@ -48,8 +48,11 @@ struct StoreMeta {
 
 struct StoreOptions {
   bool overwrite = false;            ///< replace an existing file at the path
-  std::size_t flush_every_runs = 64; ///< automatic flush after this many written runs (0: never)
-  double flush_every_seconds = 10.0; ///< ... or when this much time passed since the last flush (0: never)
+  /// Automatic flush after this many written runs (0: never). A commit journals every changed page,
+  /// so committing by time (below) keeps its cost small whatever the runs cost; a kill -9 loses at
+  /// most the runs of the last flush_every_seconds.
+  std::size_t flush_every_runs = 65536;
+  double flush_every_seconds = 1.0;  ///< ... or when this much time passed since the last flush (0: never)
   bool durable = false;              ///< fsync around commits (power-loss safety; kill -9 safety needs none)
 };
 
