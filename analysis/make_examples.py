@@ -3,8 +3,9 @@
 
     /usr/bin/python3 analysis/make_examples.py [--kinesweep build/kinesweep] [--work /tmp/ks_examples]
 
-Runs the small studies studies/examples_*.toml and studies/thesis_table4.toml (seconds), then every
-plot script at 800x600 (basins 1200x500), dpi 100.
+Runs the small studies studies/examples_*.toml and studies/thesis_table4.toml (seconds), and the small
+optimisation study below (OPTIMIZATION_STUDY, written to the work directory), then every plot script at
+800x600 (basins 1200x500), dpi 100.
 """
 import argparse
 import os
@@ -13,6 +14,41 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
+
+# Sweep then polish for Table 4's row 1h on a 0.25 deg x 0.02 landscape near the reach boundary (where
+# the optimum is), with a small GA-like global stage too (the picture shows all three stages):
+# analysis/plot_landscape.py --optimization 1h overlays it. 49 x 26 runs + ~500 evaluations, < 1 s.
+OPTIMIZATION_STUDY = """
+[study]
+name = "examples_optimization"
+description = "E(alpha1A, k) of local_weighted, then an optimisation of row 1h (example picture)"
+histories = "none"
+
+[robot]
+inertia = "thesis_m11"
+
+[[block]]
+name = "local_weighted"
+kind = "trajectory"
+method = "local_weighted"
+[block.axes]
+alpha1A = { from = -26, to = -14, step = 0.25 }
+k = { from = 0, to = 0.5, step = 0.02 }
+
+[[optimize]]
+name = "1h"
+preset = "1h"
+variables = { alpha1A = [-26, -14], k = [0, 0.5] }
+polish_from = { block = "local_weighted", best = 3 }
+[optimize.global]
+algorithm = "GN_ESCH"
+population = 20
+max_evals = 150
+[optimize.local]
+algorithm = "LN_BOBYQA"
+max_evals = 100
+xtol_rel = 1e-10
+"""
 
 
 def main():
@@ -28,6 +64,12 @@ def main():
         h5[s] = os.path.join(a.work, s + ".h5")
         subprocess.run([a.kinesweep, "run", os.path.join(ROOT, "studies", s + ".toml"), "-o", h5[s],
                         "--overwrite", "-q"], check=True, stdout=subprocess.DEVNULL)
+    study = os.path.join(a.work, "examples_optimization.toml")
+    with open(study, "w") as f:
+        f.write(OPTIMIZATION_STUDY)
+    h5["examples_optimization"] = os.path.join(a.work, "examples_optimization.h5")
+    subprocess.run([a.kinesweep, "run", study, "-o", h5["examples_optimization"], "--overwrite", "-q"], check=True,
+                   stdout=subprocess.DEVNULL)
     py = sys.executable
     jobs = [
         ("plot_landscape.py", h5["examples_landscape"], "landscape_E_weighted.png",
@@ -40,6 +82,8 @@ def main():
         ("plot_cases.py", h5["thesis_table4"], "cases_E.png", []),
         ("plot_basins.py", h5["examples_basins"], "basins.png", ["--size", "1200x500"]),
         ("plot_convergence.py", h5["examples_convergence"], "convergence.png", []),
+        ("plot_landscape.py", h5["examples_optimization"], "landscape_optimization.png",
+         ["--optimization", "1h", "--log"]),
     ]
     for script, f, out, extra in jobs:
         subprocess.run([py, os.path.join(HERE, script), f, "-o", os.path.join(a.out, out), *extra], check=True)

@@ -3,11 +3,13 @@
 
 Contour lines, the minimum marked and labelled, cells whose runs failed (unreachable start, singular,
 diverged; IK failures) masked in their own colours with a legend, optional log colour scale, and the
-thesis' optimum points overlaid (--thesis). Dims other than --x/--y are fixed (--fix AXIS=VALUE) or
-reduced (--reduce min|mean over them; the title says which).
+thesis' optimum points overlaid (--thesis), an [[optimize]] block's evaluations, local paths and best
+point overlaid (--optimization NAME, when its variables are the plotted axes). Dims other than --x/--y
+are fixed (--fix AXIS=VALUE) or reduced (--reduce min|mean over them; the title says which).
 
     /usr/bin/python3 analysis/plot_landscape.py results/landscape_alpha_k.h5 --fix method=local_weighted --log --thesis
     /usr/bin/python3 analysis/plot_landscape.py results/ik_basins.h5 --metric convergence --x q0_1 --y q0_2
+    /usr/bin/python3 analysis/plot_landscape.py results/optimize_polish.h5 --block alpha_k_1h --optimization 1h_polish --log
 """
 import argparse
 import os
@@ -46,7 +48,34 @@ def parse_args(argv=None):
     p.add_argument("--levels", type=int, default=8, help="number of contour lines (0: none; default %(default)s)")
     p.add_argument("--thesis", action="store_true",
                    help="overlay seed 000's optimum points (Table 4 rows 1d-1h / 2d-2h) on an (alpha1A, k) plane")
+    p.add_argument("--optimization", metavar="NAME",
+                   help="overlay /optimizations/NAME: its evaluations (dots coloured by stage), the local stage's "
+                   "paths (arrows start -> best) and the final best point; its variables must be the --x/--y axes")
     return p.parse_args(argv)
+
+
+STAGE_COLOURS = {"sweep": "#ffffff", "global": "#ff9f1c", "local": "#2ec4f6"}
+
+
+def optimization_overlay(res, name, xa, ya):
+    """The optimisation's points in plot coordinates (x = xa's variable, y = ya's), or SystemExit when its
+    variables are not the plotted axes."""
+    names = res.optimizations()
+    if name not in names:
+        raise SystemExit(f"--optimization {name}: not in {res.path}; optimizations: {', '.join(names) or 'none'}")
+    o = res.optimization(name, degrees=True)
+    if xa.categorical or ya.categorical or sorted(o.variables) != sorted([xa.name, ya.name]):
+        raise SystemExit(f"--optimization {name}: its variables ({', '.join(o.variables)}) are not the plotted axes "
+                         f"({xa.name}, {ya.name}); pick them with --x/--y (and --fix/--block)")
+    ix, iy = o.variable_index(xa.name), o.variable_index(ya.name)
+    ev = o.evaluations
+    return {"name": name, "objective": o.objective, "variables": o.variables, "units": o.units,
+            "points": {"x": ev["x"][:, ix], "y": ev["x"][:, iy], "stage": list(ev["stage"]),
+                       "objective": ev["objective"], "status": list(ev["status"])},
+            "paths": [{"from": [f[ix], f[iy]], "to": [t[ix], t[iy]], "objective": v}
+                      for f, t, v in zip(o.local["from"], o.local["to"], o.local["objective"])],
+            "best": {"x": o.best["x"][ix], "y": o.best["x"][iy], "objective": o.best["objective"],
+                     "status": o.best["status"], "stage": o.best["stage"]}}
 
 
 def pick_index(axis, value):
@@ -154,7 +183,10 @@ def edges(v):
 def main(argv=None):
     args = parse_args(argv)
     res = ksread.open_results(args.file)
-    ls = res.landscape(args.block, degrees=True)
+    try:
+        ls = res.landscape(args.block, degrees=True)
+    except KeyError as e:
+        raise SystemExit(f"plot_landscape: {e.args[0]}")
     d = reduce_grid(ls, args)
     xa, ya, z, cat, metric = d["x"], d["y"], d["z"], d["cat"], d["metric"]
     unit = "" if metric == "convergence" else ls.units.get(metric, "")
@@ -245,6 +277,35 @@ def main(argv=None):
                             path_effects=[patheffects.withStroke(linewidth=2.5, foreground="black")])
                 thesis.append({"case": case, "x": px, "y": py, "E": e, "value": tv})
             ax.plot([], [], ls="none", marker="D", mfc="none", mec="#ff66ff", label="thesis partial optima")
+    # Optimisation overlay (kept inside the landscape's extent: the bounds may be wider than the grid).
+    opt = None
+    if args.optimization:
+        opt = optimization_overlay(res, args.optimization, xa, ya)
+        xlim, ylim = ax.get_xlim(), ax.get_ylim()
+        pt = opt["points"]
+        stages = np.array(pt["stage"], dtype=object)
+        for st in dict.fromkeys(pt["stage"]):
+            m = stages == st
+            ax.scatter(np.asarray(pt["x"])[m], np.asarray(pt["y"])[m], s=9, c=STAGE_COLOURS.get(st, "#cccccc"),
+                       edgecolors="black", linewidths=0.3, zorder=7, alpha=0.85,
+                       label=f"{opt['name']}: {st} evaluations ({int(m.sum())})")
+        for path in opt["paths"]:
+            ax.annotate("", xy=path["to"], xytext=path["from"], zorder=8,
+                        arrowprops=dict(arrowstyle="-|>", color="#2ec4f6", lw=1.4, mutation_scale=10,
+                                        path_effects=[patheffects.withStroke(linewidth=2.6, foreground="black")]))
+        if opt["paths"]:
+            ax.plot([], [], color="#2ec4f6", lw=1.4, label=f"{opt['name']}: local paths (start → best)")
+        b = opt["best"]
+        bu = ["°" if u == "deg" else "" for u in (opt["units"][opt["variables"].index(xa.name)],
+                                                 opt["units"][opt["variables"].index(ya.name)])]
+        ax.plot([b["x"]], [b["y"]], marker="o", ms=10, mfc="none", mec="#ff3030", mew=2.2, zorder=9, ls="none",
+                label=f"{opt['name']} best: {opt['objective']} = {ksread.fmt_num(b['objective'])} at "
+                      f"{xa.name} = {ksread.fmt_num(b['x'])}{bu[0]}, {ya.name} = {ksread.fmt_num(b['y'])}{bu[1]}")
+        ax.annotate(f"{opt['name']} best {ksread.fmt_num(b['objective'])}", (b["x"], b["y"]), xytext=(8, -14),
+                    textcoords="offset points", color="#ff3030", fontsize=8, fontweight="bold", zorder=9,
+                    path_effects=[patheffects.withStroke(linewidth=2.5, foreground="white")])
+        ax.set_xlim(xlim)
+        ax.set_ylim(ylim)
     for a, setlim, setticks, setlab in ((xa, ax.set_xlim, ax.set_xticks, ax.set_xlabel),
                                         (ya, ax.set_ylim, ax.set_yticks, ax.set_ylabel)):
         setlab(ksread.axis_label(a.name, a.unit))
@@ -265,7 +326,7 @@ def main(argv=None):
                            "x": {"name": xa.name, "unit": xa.unit, "values": xa.values, "labels": xa.labels},
                            "y": {"name": ya.name, "unit": ya.unit, "values": ya.values, "labels": ya.labels},
                            "z": z, "masked_status": [[(ls.statuses[c] if c >= 0 else None) for c in row] for row in cat],
-                           "best": best, "thesis": thesis, "output": out})
+                           "best": best, "thesis": thesis, "optimization": opt, "output": out})
     else:
         print(out)
     return 0

@@ -40,6 +40,110 @@ bool same(const RunsColumn& c, std::int64_t a, std::int64_t b) {
   return true;
 }
 
+/// A value of variable `unit` for humans: angles (stored "rad") in degrees.
+std::string var_value(double v, const std::string& unit) {
+  if (unit == "rad") return format_double(v * kRadToDeg) + " deg";
+  return format_double(v) + (unit.empty() ? "" : " " + unit);
+}
+
+std::string point_text(const store::OptimizationRecord& o, const std::vector<double>& x) {
+  std::string s;
+  for (std::size_t i = 0; i < o.variables.size() && i < x.size(); ++i)
+    s += (i ? ", " : "") + o.variables[i] + " = " + var_value(x[i], i < o.units.size() ? o.units[i] : "");
+  return s;
+}
+
+std::string seconds(double s) {
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(s < 10 ? 3 : 1) << s << " s";
+  return o.str();
+}
+
+/// The /optimizations section (nothing when the file has none).
+void print_optimizations(store::ResultsReader& reader, std::ostream& os) {
+  const auto names = consistent_read(reader, [&] { return reader.optimizations(); });
+  if (names.empty()) return;
+  os << "optimizations " << names.size() << "  (kinesweep query FILE --optimization NAME: every evaluation)\n";
+  for (const auto& name : names) {
+    const store::OptimizationRecord o = consistent_read(reader, [&] { return reader.read_optimization(name); });
+    const auto unit = [&](std::size_t i) { return i < o.units.size() ? o.units[i] : std::string(); };
+    os << "  " << o.name << ": " << (o.kind.empty() ? "trajectory" : o.kind)
+       << (o.preset.empty() ? "" : ", preset " + o.preset) << ", minimise " << o.objective << '\n';
+    os << "    variables   ";
+    for (std::size_t i = 0; i < o.variables.size(); ++i) {
+      const bool deg = unit(i) == "rad";
+      const double k = deg ? kRadToDeg : 1.0;
+      os << (i ? ", " : "") << o.variables[i] << " in [" << format_double(o.lower.at(i) * k) << ", "
+         << format_double(o.upper.at(i) * k) << "]";
+      if (deg) os << " deg";
+      else if (!unit(i).empty()) os << ' ' << unit(i);
+    }
+    os << '\n';
+    os << "    evaluations " << o.size() << " in " << seconds(o.wall_time_s) << " (seed " << o.seed << ")\n";
+    std::size_t wa = 9;
+    for (const auto& st : o.stages) wa = std::max(wa, st.algorithm.size());
+    for (std::size_t i = 0; i < o.stages.size(); ++i) {
+      const auto& st = o.stages[i];
+      os << (i ? "                " : "    stages      ") << std::left << std::setw(7) << st.name
+         << std::setw(static_cast<int>(wa)) << (st.algorithm.empty() ? "-" : st.algorithm) << std::right
+         << std::setw(8) << st.evaluations << " evals" << std::setw(11) << seconds(st.wall_time_s) << "  best "
+         << std::left << std::setw(12) << format_double(st.best_objective) << std::right << " [" << st.best_status
+         << "]  " << st.result << '\n';
+    }
+    os << "    best        " << o.objective << " = " << format_double(o.best_objective) << " [" << o.best_status
+       << ", stage " << o.best_stage << "] at " << point_text(o, o.best_x) << '\n';
+    if (!o.best_metrics.empty()) {
+      auto metric = [&](const std::string& k) -> const double* {
+        for (const auto& [n, v] : o.best_metrics)
+          if (n == k) return &v;
+        return nullptr;
+      };
+      std::vector<std::string> parts;
+      if (const double* e = metric("E")) parts.push_back("E = " + format_double(*e) + " Nm");
+      if (o.objective.find("E_M") != std::string::npos)
+        if (const double* e = metric("E_M")) parts.push_back("E_M = " + format_double(*e));
+      if (const double* t = metric("tau_inf")) {
+        std::string s = "|tau|inf = " + format_double(*t) + " Nm";
+        std::vector<std::string> taus;
+        for (const char* k : {"tau1_inf", "tau2_inf", "tau3_inf"})
+          if (const double* p = metric(k)) taus.push_back(format_double(*p));
+        if (!taus.empty()) s += " (joints " + join(taus, ", ") + ")";
+        parts.push_back(s);
+      }
+      if (parts.empty())  // IK: the key metrics (as query's compact default), else every metric of the run
+        for (const char* k : {"iterations", "error", "solution"})
+          if (const double* p = metric(k)) parts.push_back(std::string(k) + " = " + format_double(*p));
+      if (parts.empty())
+        for (const auto& [k, v] : o.best_metrics) parts.push_back(k + " = " + format_double(v));
+      os << "    best run    " << join(parts, ", ") << '\n';
+    }
+    if (!o.reference.empty()) {
+      auto ref = [&](const std::string& k) -> const double* {
+        for (const auto& [n, v] : o.reference)
+          if (n == k) return &v;
+        return nullptr;
+      };
+      os << "    thesis      ";
+      if (const double* e = ref("thesis_E")) os << "E = " << format_double(*e);
+      std::vector<double> tx;
+      bool all = true;
+      for (const auto& v : o.variables) {
+        const double* p = ref("thesis_" + v);
+        if (!p) all = false;
+        tx.push_back(p ? *p : std::nan(""));
+      }
+      if (all && !o.variables.empty()) os << " at " << point_text(o, tx);
+      std::vector<std::string> taus;
+      for (const char* t : {"thesis_tau1_inf", "thesis_tau2_inf", "thesis_tau3_inf"})
+        if (const double* p = ref(t)) taus.push_back(format_double(*p));
+      if (!taus.empty()) os << "; |tau|inf per joint " << join(taus, ", ");
+      if (const double* ob = ref("objective_at_thesis_x"))
+        os << "\n                kinesweep's " << o.objective << " at the thesis point = " << format_double(*ob);
+      os << '\n';
+    }
+  }
+}
+
 std::string axis_text(const store::LandscapeAxis& a) {
   std::ostringstream o;
   o << a.name << " (" << a.values.size();
@@ -207,6 +311,7 @@ int run_info(const InfoArgs& args) {
     for (std::size_t j = 0; j < spec.metrics.size(); ++j) os << (j ? ", " : "") << spec.metrics[j].name;
     os << '\n';
   }
+  print_optimizations(reader, os);
   return 0;
 }
 
@@ -215,7 +320,7 @@ int run_info(const InfoArgs& args) {
 InfoArgs& add_info_command(CLI::App& app) {
   static InfoArgs a;
   auto* s = app.add_subcommand("info", "Summarise a results file: study, runs by block and status, best rows, "
-                                       "histories, landscapes");
+                                       "histories, landscapes, optimisations");
   s->add_option("file", a.file, "results file (.h5); may be one a sweep is still writing")->required();
   s->add_option("--best", a.best, "best rows shown per block (default 3)");
   return a;

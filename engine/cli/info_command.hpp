@@ -1,6 +1,7 @@
 #pragma once
 // `kinesweep info FILE [--best N]`: the study (name, source hash, engine version), runs by block and
-// status, the best rows per block, and which histories and landscapes the file holds.
+// status, the best rows per block, which histories and landscapes the file holds, and each optimisation
+// (/optimizations/<name>: variables, stages, best point, the thesis' reference for a preset).
 #include <string>
 
 namespace CLI {

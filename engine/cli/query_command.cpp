@@ -277,6 +277,66 @@ int history_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
   return 0;
 }
 
+/// Every evaluation of one /optimizations group: index, stage, start, the variables (angles in degrees
+/// unless --radians), objective, constraint, status.
+int optimization_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
+  const auto names = consistent_read(reader, [&] { return reader.optimizations(); });
+  if (std::find(names.begin(), names.end(), a.optimization) == names.end()) {
+    if (names.empty()) throw ArgError("--optimization " + a.optimization + ": the file holds no optimizations");
+    std::string m = "no optimization '" + a.optimization + "'";
+    const std::string dym = did_you_mean(a.optimization, names);
+    if (!dym.empty()) m += "; did you mean '" + dym + "'?";
+    throw ArgError(m + "\nvalid optimizations: " + join(names, ", "));
+  }
+  const store::OptimizationRecord o = consistent_read(reader, [&] { return reader.read_optimization(a.optimization); });
+  const std::size_t d = o.dims(), n = o.size();
+  OutTable out;
+  auto col = [&](const std::string& name, const std::string& unit, const std::string& csv) {
+    out.names.push_back(name);
+    out.units.push_back(unit);
+    out.csv_names.push_back(csv);
+  };
+  col("index", "", "index");
+  col("stage", "", "stage");
+  col("start", "", "start");
+  std::vector<bool> deg(d, false);
+  std::vector<std::string> converted;
+  for (std::size_t j = 0; j < d; ++j) {
+    const std::string unit = j < o.units.size() ? o.units[j] : "";
+    deg[j] = unit == "rad" && !a.radians;
+    col(o.variables[j], deg[j] ? "deg" : unit, deg[j] ? o.variables[j] + " [deg]" : o.variables[j]);
+    if (deg[j]) converted.push_back(o.variables[j]);
+  }
+  col("objective", "", "objective");
+  col("constraint", "", "constraint");
+  col("status", "", "status");
+  std::size_t rows = n;
+  if (a.limit >= 0) rows = std::min<std::size_t>(rows, static_cast<std::size_t>(a.limit));
+  for (std::size_t i = 0; i < rows; ++i) {
+    std::vector<OutCell> row;
+    row.emplace_back(static_cast<std::int64_t>(i));
+    row.emplace_back(i < o.stage.size() ? o.stage[i] : std::string());
+    row.emplace_back(i < o.start.size() ? o.start[i] : std::int64_t{-1});
+    for (std::size_t j = 0; j < d; ++j) {
+      const double v = i * d + j < o.x.size() ? o.x[i * d + j] : std::nan("");
+      row.emplace_back(deg[j] ? v * kRadToDeg : v);
+    }
+    row.emplace_back(o.value[i]);
+    row.emplace_back(i < o.constraint.size() ? o.constraint[i] : std::nan(""));
+    row.emplace_back(i < o.status.size() ? o.status[i] : std::string());
+    out.rows.push_back(std::move(row));
+  }
+  print_out(out, fmt, std::cout);
+  if (fmt == Format::table) {
+    std::cout << "(" << out.rows.size() << " of " << n << " evaluations of optimization " << o.name << ": minimise "
+              << o.objective << "; best " << format_double(o.best_objective) << " [" << o.best_status << ", stage "
+              << o.best_stage << "]";
+    if (!converted.empty()) std::cout << "; angles in degrees (stored in radians): " << join(converted, ", ");
+    std::cout << ")\n";
+  }
+  return 0;
+}
+
 int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
   const RunsTable t = load_runs(reader);
   if (!t.consistent)
@@ -418,7 +478,7 @@ int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
 
 QueryArgs& add_query_command(CLI::App& app) {
   static QueryArgs a;
-  auto* q = app.add_subcommand("query", "Print rows of a results file's /runs (filtered, sorted) or one run's history");
+  auto* q = app.add_subcommand("query", "Print rows of a results file's /runs (filtered, sorted), one run's history, or one optimisation's evaluations");
   q->add_option("file", a.file, "results file (.h5); may be one a sweep is still writing")->required();
   q->add_option("-w,--where", a.where,
                 "filter, repeatable (ANDed): COL OP VALUE with OP = != < <= > >=, COL=A,B,C (any of), "
@@ -433,6 +493,9 @@ QueryArgs& add_query_command(CLI::App& app) {
   q->add_flag("--include-pending", a.include_pending, "also rows not done yet (missing values)");
   q->add_option("--run", a.run, "history mode: the run id");
   q->add_option("--history", a.history, "history mode: array name(s), comma list, or 'all' (default all)");
+  q->add_option("--optimization", a.optimization,
+                "optimisation mode: print every evaluation of /optimizations/NAME (index, stage, start, the "
+                "variables, objective, constraint, status)");
   a.format.clear();
   return a;
 }
@@ -443,8 +506,13 @@ int query_command(const QueryArgs& a) {
     const bool history = a.run >= 0;
     if (history && (!a.where.empty() || !a.sort.empty() || !a.columns.empty()))
       throw ArgError("--run/--history prints one run's history; --where, --sort and --columns apply to rows only");
+    const bool optimization = !a.optimization.empty();
+    if (optimization && (history || !a.where.empty() || !a.sort.empty() || !a.columns.empty() || a.include_pending))
+      throw ArgError("--optimization prints one optimisation's evaluations; --run, --history, --where, --sort, "
+                     "--columns and --include-pending do not apply to it (--format, --limit and --radians do)");
     const Format fmt = *parse_format(a.format.empty() ? (history ? "csv" : "table") : a.format);
     store::ResultsReader reader(a.file);
+    if (optimization) return optimization_mode(a, reader, fmt);
     return history ? history_mode(a, reader, fmt) : rows_mode(a, reader, fmt);
   } catch (const ArgError& e) {
     std::cerr << "kinesweep query: error: " << e.what() << '\n';

@@ -2,6 +2,7 @@
 // `kinesweep query FILE [--where EXPR]... [--columns a,b,c|all] [--sort COL[:desc]]... [--limit N]
 //  [--format table|csv|json] [--radians] [--include-pending]`
 // `kinesweep query FILE --run ID --history NAME[,NAME...]|all [--format table|csv|json] [--limit N]`
+// `kinesweep query FILE --optimization NAME [--format table|csv|json] [--limit N] [--radians]`
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -23,6 +24,7 @@ struct QueryArgs {
   bool include_pending = false;    ///< also rows not done yet (missing values)
   std::int64_t run = -1;           ///< history mode: the run id
   std::string history;             ///< history mode: array name(s)
+  std::string optimization;        ///< optimisation mode: the /optimizations group whose evaluations to print
 };
 
 /// Register the subcommand; returns the argument struct it fills.

@@ -50,6 +50,41 @@ q0_1 = { from = -180, to = 180, count = 15 }
 q0_2 = { from = -180, to = 180, count = 13 }
 """
 
+# A coarse alpha1A x k landscape and an [[optimize]] block over the same two variables (seconds).
+OPTIMIZE = """
+[study]
+name = "ana_optimize"
+histories = "none"
+[robot]
+inertia = "thesis_m11"
+[[block]]
+name = "grid"
+kind = "trajectory"
+method = "local_weighted"
+[block.axes]
+alpha1A = { from = -30, to = 10, step = 5 }
+k = { from = 0, to = 1, step = 0.25 }
+[[optimize]]
+name = "h1"
+preset = "1h"
+variables = { alpha1A = [-30, 10], k = [0, 1] }
+polish_from = { block = "grid", best = 2 }
+[optimize.global]
+algorithm = "GN_ESCH"
+population = 10
+max_evals = 40
+[optimize.local]
+algorithm = "LN_BOBYQA"
+max_evals = 30
+[[optimize]]
+name = "k_only"
+preset = "1d"
+variables = { k = [0, 1] }
+[optimize.local]
+algorithm = "LN_BOBYQA"
+max_evals = 10
+"""
+
 
 def h5str(v):
     return v.decode() if isinstance(v, bytes) else str(v)
@@ -60,7 +95,7 @@ class AnalysisTest(unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.files = {}
-        for name, text in (("landscape", LANDSCAPE), ("basins", BASINS)):
+        for name, text in (("landscape", LANDSCAPE), ("basins", BASINS), ("optimize", OPTIMIZE)):
             path = os.path.join(cls.tmp.name, name + ".toml")
             with open(path, "w") as f:
                 f.write(text)
@@ -157,6 +192,73 @@ class AnalysisTest(unittest.TestCase):
                             self.files["landscape"], "--fix", "method=nope"], capture_output=True, text=True)
         self.assertNotEqual(r.returncode, 0)
         self.assertIn("local_weighted", r.stderr)
+
+    def test_landscape_optimization_overlay(self):
+        d = self.plot("plot_landscape.py", self.files["optimize"], "--optimization", "h1")
+        o = d["optimization"]
+        with h5py.File(self.files["optimize"], "r") as f:
+            g = f["optimizations"]["h1"]
+            self.assertEqual([h5str(v) for v in g.attrs["variables"]], ["alpha1A", "k"])
+            x, stage = g["evaluations"]["x"][()], [h5str(v) for v in g["evaluations"]["stage"][()]]
+            obj = g["evaluations"]["objective"][()]
+            lf, lt = g["local"]["from"][()], g["local"]["to"][()]
+            bx, bobj = g.attrs["best_x"], g.attrs["best_objective"]
+        self.assertEqual((d["x"]["name"], d["y"]["name"]), ("alpha1A", "k"))
+        np.testing.assert_allclose(o["points"]["x"], x[:, 0] * D, rtol=1e-13)  # degrees, as the plot's x
+        np.testing.assert_array_equal(o["points"]["y"], x[:, 1])
+        self.assertEqual(o["points"]["stage"], stage)
+        self.assertEqual(set(stage), {"sweep", "global", "local"})
+        np.testing.assert_array_equal(o["points"]["objective"], obj)
+        self.assertEqual(len(o["paths"]), len(lf))
+        np.testing.assert_allclose([p["from"] for p in o["paths"]], lf * [D, 1.0], rtol=1e-13)
+        np.testing.assert_allclose([p["to"] for p in o["paths"]], lt * [D, 1.0], rtol=1e-13)
+        self.assertAlmostEqual(o["best"]["x"], bx[0] * D, delta=1e-12)
+        self.assertEqual(o["best"]["y"], bx[1])
+        self.assertEqual(o["best"]["objective"], bobj)
+        # Swapped axes: the overlay follows them.
+        d = self.plot("plot_landscape.py", self.files["optimize"], "--optimization", "h1", "--x", "k", "--y", "alpha1A")
+        np.testing.assert_array_equal(d["optimization"]["points"]["x"], x[:, 1])
+        # Without --optimization: no overlay; a name that is not there, or other variables: an error.
+        self.assertIsNone(self.plot("plot_landscape.py", self.files["optimize"])["optimization"])
+        for name, want in (("nope", "h1, k_only"), ("k_only", "not the plotted axes")):
+            r = subprocess.run([sys.executable, os.path.join(ROOT, "analysis", "plot_landscape.py"),
+                                self.files["optimize"], "--optimization", name, "-o",
+                                os.path.join(self.tmp.name, "bad.png")], capture_output=True, text=True)
+            self.assertNotEqual(r.returncode, 0)
+            self.assertIn(want, r.stderr)
+
+    def test_reader_optimization(self):
+        sys.path.insert(0, os.path.join(ROOT, "analysis"))
+        import ksread
+        with h5py.File(self.files["optimize"], "r") as f:
+            g = f["optimizations"]["h1"]
+            x = g["evaluations"]["x"][()]
+            st = g["stages"]
+            stages = [h5str(v) for v in st["name"][()]]
+            sbx, sev = st["best_x"][()], st["evaluations"][()]
+            a = dict(g.attrs)
+            metrics = {h5str(m): g["best"].attrs[h5str(m)] for m in g["best"].attrs["metrics"]}
+        with ksread.open_results(self.files["optimize"]) as r:
+            self.assertEqual(r.optimizations(), ["h1", "k_only"])
+            o = r.optimization("h1")
+            self.assertEqual(o.units, ["rad", ""])
+            np.testing.assert_array_equal(o.evaluations["x"], x)
+            od = r.optimization("h1", degrees=True)
+            self.assertEqual(od.units, ["deg", ""])
+            np.testing.assert_allclose(od.evaluations["x"], x * [D, 1.0], rtol=1e-14)
+            np.testing.assert_allclose(od.lower, [-30, 0], rtol=1e-14)
+            np.testing.assert_allclose(od.best["x"], a["best_x"] * [D, 1.0], rtol=1e-14)
+            self.assertEqual(od.best["objective"], a["best_objective"])
+            self.assertEqual(od.best["metrics"], metrics)
+            self.assertEqual(list(od.stages["name"]), stages)
+            np.testing.assert_array_equal(od.stages["evaluations"], sev)
+            np.testing.assert_allclose(od.stages["best_x"], sbx * [D, 1.0], rtol=1e-14)
+            self.assertEqual(int(sev.sum()), od.n_evaluations)
+            self.assertAlmostEqual(od.references["thesis_alpha1A"], -24.1, places=10)
+            self.assertEqual(od.references["thesis_E"], 37.79)
+            self.assertEqual(od.objective, "E")
+            with self.assertRaises(KeyError):
+                r.optimization("nope")
 
     def test_histories(self):
         d = self.plot("plot_histories.py", self.files["table4"], "--preset", "1a,2d", "--what", "tau,q,qd")

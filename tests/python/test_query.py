@@ -57,6 +57,34 @@ alpha1A = { from = -20, to = 30, step = 0.5 }
 k = { from = 0, to = 1, count = 11 }
 """
 
+# A coarse landscape and an [[optimize]] block polishing from it (sweep, global and local stages; seconds).
+OPTIMIZE = """
+[study]
+name = "query_opt"
+histories = "none"
+[robot]
+inertia = "thesis_m11"
+[[block]]
+name = "grid"
+kind = "trajectory"
+method = "local_weighted"
+[block.axes]
+alpha1A = { from = -30, to = 10, step = 5 }
+k = { from = 0, to = 1, step = 0.25 }
+[[optimize]]
+name = "h1"
+preset = "1h"
+variables = { alpha1A = [-30, 10], k = [0, 1] }
+polish_from = { block = "grid", best = 2 }
+[optimize.global]
+algorithm = "GN_ESCH"
+population = 10
+max_evals = 40
+[optimize.local]
+algorithm = "LN_BOBYQA"
+max_evals = 30
+"""
+
 
 def ks(*args):
     return subprocess.run([KS, *args], capture_output=True, text=True)
@@ -254,6 +282,7 @@ class QueryTest(unittest.TestCase):
         for name in landscapes:
             self.assertIn(name + ":", out)
         self.assertIn("histories", out)
+        self.assertNotIn("optimizations", out)  # the file has none: no section
 
     def test_live_file_while_sweep_writes(self):
         study = os.path.join(self.tmp.name, "live.toml")
@@ -291,6 +320,104 @@ class QueryTest(unittest.TestCase):
         print(f"\n  live: {len(seen)} reads during the sweep, {len(partial)} of a partial file "
               f"({min(partial) if partial else '-'}..{max(partial) if partial else '-'} of {len(final['done'])} rows)",
               file=sys.stderr)
+
+
+def h5s(v):
+    return v.decode() if isinstance(v, bytes) else str(v)
+
+
+class OptimizationQueryTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        study = os.path.join(cls.tmp.name, "opt.toml")
+        with open(study, "w") as f:
+            f.write(OPTIMIZE)
+        cls.h5 = os.path.join(cls.tmp.name, "opt.h5")
+        r = ks("run", study, "-o", cls.h5, "-q")
+        assert r.returncode == 0, r.stderr
+        with h5py.File(cls.h5, "r") as f:
+            g = f["optimizations"]["h1"]
+            cls.a = {k: (h5s(v) if isinstance(v, (bytes, str)) else v) for k, v in g.attrs.items()}
+            cls.variables = [h5s(v) for v in g.attrs["variables"]]
+            cls.units = [h5s(v) for v in g.attrs["units"]]
+            e = g["evaluations"]
+            cls.ev = {"x": e["x"][()], "objective": e["objective"][()], "constraint": e["constraint"][()],
+                      "stage": [h5s(v) for v in e["stage"][()]], "status": [h5s(v) for v in e["status"][()]],
+                      "start": e["start"][()]}
+            cls.stages = [h5s(v) for v in g["stages"]["name"][()]]
+            cls.algorithms = [h5s(v) for v in g["stages"]["algorithm"][()]]
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_info_shows_the_optimization(self):
+        r = ks("info", self.h5)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        out = r.stdout
+        sec = out[out.index("optimizations 1"):]
+        self.assertIn("h1: trajectory, preset 1h, minimise E", sec)
+        self.assertIn("alpha1A in [-30, 10] deg, k in [0, 1]", sec)
+        self.assertIn(f"evaluations {len(self.ev['objective'])} in", sec)
+        best = next(x for x in sec.splitlines() if x.strip().startswith("best "))
+        self.assertIn(f"E = {self.a['best_objective']:.6g} [{self.a['best_status']}, stage {self.a['best_stage']}]",
+                      best)
+        self.assertIn(f"alpha1A = {self.a['best_x'][0] * D:.6g} deg", best)
+        self.assertEqual(self.stages, ["sweep", "global", "local"])
+        stage_lines = [x.replace("stages", "", 1).split() for x in sec.splitlines() if " evals " in x]
+        self.assertEqual([x[0] for x in stage_lines], self.stages)  # one line per stage, in order
+        self.assertEqual([x[1] for x in stage_lines], [a or "-" for a in self.algorithms])
+        self.assertIn(f"E = {self.a['reference_thesis_E']:.6g} at alpha1A = "
+                      f"{self.a['reference_thesis_alpha1A'] * D:.6g} deg, k = {self.a['reference_thesis_k']:.6g}", sec)
+        self.assertIn(f"E at the thesis point = {self.a['reference_objective_at_thesis_x']:.6g}", sec)
+        self.assertIn("best run    E = ", sec)
+
+    def check_rows(self, idx, got_x, got):
+        ev = self.ev
+        np.testing.assert_array_equal([g["index"] for g in got], idx)
+        self.assertEqual([g["stage"] for g in got], [ev["stage"][i] for i in idx])
+        self.assertEqual([g["status"] for g in got], [ev["status"][i] for i in idx])
+        np.testing.assert_array_equal([g["start"] for g in got], ev["start"][idx])
+        np.testing.assert_array_equal([g["objective"] for g in got], ev["objective"][idx])
+        c = np.array([np.nan if g["constraint"] is None else g["constraint"] for g in got], dtype=float)
+        np.testing.assert_array_equal(c, ev["constraint"][idx])
+        scale = np.array([D if u == "rad" else 1.0 for u in self.units])
+        np.testing.assert_allclose(got_x, ev["x"][idx] * scale, rtol=1e-14, atol=1e-14)
+
+    def test_query_csv_equals_h5py(self):
+        r = ks("query", self.h5, "--optimization", "h1", "--format", "csv")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        head, rows = read_csv(r.stdout)
+        self.assertEqual(head, ["index", "stage", "start", "alpha1A [deg]", "k", "objective", "constraint", "status"])
+        self.assertEqual(len(rows), len(self.ev["objective"]))
+        got = [{"index": int(x[0]), "stage": x[1], "start": int(x[2]), "objective": float(x[5]),
+                "constraint": None if x[6] == "" else float(x[6]), "status": x[7]} for x in rows]
+        self.check_rows(np.arange(len(rows)), np.array([[float(x[3]), float(x[4])] for x in rows]), got)
+        self.assertEqual(set(self.ev["stage"]), {"sweep", "global", "local"})
+
+    def test_query_json_limit_and_table(self):
+        r = ks("query", self.h5, "--optimization", "h1", "-f", "json", "--limit", "20")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        j = json.loads(r.stdout)
+        self.assertEqual(j["units"]["alpha1A"], "deg")
+        self.assertEqual(len(j["rows"]), 20)
+        self.check_rows(np.arange(20), np.array([[g["alpha1A"], g["k"]] for g in j["rows"]]), j["rows"])
+        r = ks("query", self.h5, "--optimization", "h1", "--radians", "-f", "json")
+        j = json.loads(r.stdout)
+        np.testing.assert_array_equal([g["alpha1A"] for g in j["rows"]], self.ev["x"][:, 0])
+        r = ks("query", self.h5, "--optimization", "h1", "-n", "3")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("alpha1A [deg]", r.stdout)
+        self.assertIn(f"(3 of {len(self.ev['objective'])} evaluations of optimization h1", r.stdout)
+
+    def test_unknown_optimization(self):
+        r = ks("query", self.h5, "--optimization", "h2")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("no optimization 'h2'", r.stderr)
+        self.assertIn("valid optimizations: h1", r.stderr)
+        r = ks("query", self.h5, "--optimization", "h1", "--where", "E<3")
+        self.assertEqual(r.returncode, 2)
 
 
 if __name__ == "__main__":
