@@ -36,13 +36,14 @@ struct Ldlt3 {
     const double y1 = b[1] - l10 * b[0];
     return {b[0], y1, b[2] - l20 * b[0] - l21 * y1};
   }
-  /// x = M^-1 b
-  Vec3 solve(const Vec3& b) const {
-    const Vec3 y = solve_lower(b);
+  /// x = L^-T D^-1 y
+  Vec3 solve_upper(const Vec3& y) const {
     const double x2 = y[2] * r2;
     const double x1 = y[1] * r1 - l21 * x2;
     return {y[0] * r0 - l10 * x1 - l20 * x2, x1, x2};
   }
+  /// x = M^-1 b
+  Vec3 solve(const Vec3& b) const { return solve_upper(solve_lower(b)); }
   /// b^T M^-1 b (>= 0 for SPD M)
   double inverse_quadratic_form(const Vec3& b) const {
     const Vec3 y = solve_lower(b);
