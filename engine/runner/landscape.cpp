@@ -29,27 +29,35 @@ double number(const Cell& c) {
 
 LandscapeGrid::LandscapeGrid(const Block& block) : block_(block) {
   names_ = grid_metrics(block.kind());
+  const auto& cols = metric_columns(block.kind());
+  for (const std::string& n : names_) {
+    sources_.push_back(n == "ok" || n == "converged" ? Source::is_ok
+                       : n == "status_code"          ? Source::status_code
+                                                     : Source::column);
+    std::size_t j = 0;
+    while (j < cols.size() && cols[j].name != n) ++j;
+    metric_index_.push_back(j);
+  }
   enabled_ = block.run_count() <= kMaxLandscapeCells && !block.overflowed();
   if (enabled_) grids_.assign(names_.size(), std::vector<double>(block.run_count(), kNaN));
 }
 
 void LandscapeGrid::add(std::uint64_t local, const Record& row, const StudySchema& schema, std::size_t b) {
   if (!enabled_) return;
-  const auto& metric_cols = metric_columns(block_.kind());
   const std::string& status = std::get<std::string>(row.cells[schema.status]);
   const auto& statuses = status_names(block_.kind());
+  double code = kNaN;
+  for (std::size_t s = 0; s < statuses.size(); ++s)
+    if (statuses[s] == status) code = static_cast<double>(s);
   for (std::size_t m = 0; m < names_.size(); ++m) {
-    const std::string& n = names_[m];
     double v = kNaN;
-    if (n == "ok" || n == "converged") {
-      v = status == n ? 1.0 : 0.0;
-    } else if (n == "status_code") {
-      for (std::size_t s = 0; s < statuses.size(); ++s)
-        if (statuses[s] == status) v = static_cast<double>(s);
-    } else {
-      for (std::size_t j = 0; j < metric_cols.size(); ++j)
-        if (metric_cols[j].name == n) v = number(row.cells[schema.metric_column[b][j]]);
-      if (n == "solution" && v < 0) v = kNaN;
+    switch (sources_[m]) {
+      case Source::is_ok: v = code == 0.0 ? 1.0 : 0.0; break;  // ok / converged are code 0
+      case Source::status_code: v = code; break;
+      case Source::column:
+        v = number(row.cells[schema.metric_column[b][metric_index_[m]]]);
+        if (names_[m] == "solution" && v < 0) v = kNaN;
+        break;
     }
     grids_[m][local] = v;
   }

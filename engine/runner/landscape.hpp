@@ -17,6 +17,8 @@ class LandscapeGrid {
   bool enabled() const { return enabled_; }
   /// Record the row of run `local` of this block (block index `b` in the schema).
   void add(std::uint64_t local, const Record& row, const StudySchema& schema, std::size_t b);
+  /// Which value a grid takes from a row: a metric column, or a status-derived value.
+  enum class Source { column, is_ok, status_code };
   /// The axes (one per dimension; a zipped dimension is named "a+b" and takes the first axis'
   /// values; string axes take 0..n-1 with the names in the unit field) and the gridded metrics.
   store::LandscapeSpec spec() const;
@@ -25,6 +27,8 @@ class LandscapeGrid {
   const Block& block_;
   bool enabled_ = false;
   std::vector<std::string> names_;            // metric names
+  std::vector<Source> sources_;               // per metric
+  std::vector<std::size_t> metric_index_;     // per metric: index into metric_columns(kind) (Source::column)
   std::vector<std::vector<double>> grids_;    // per metric
 };
 

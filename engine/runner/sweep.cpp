@@ -55,12 +55,25 @@ class Accumulator {
       r.runs = study.blocks[b].run_count();
       report_.blocks.push_back(std::move(r));
     }
-    metric_ = [&](std::size_t b, std::string_view name) {
+    auto metric = [&](std::size_t b, std::string_view name) {
       const auto& cols = metric_columns(study.blocks[b].kind());
       for (std::size_t j = 0; j < cols.size(); ++j)
         if (cols[j].name == name) return schema.metric_column[b][j];
       return std::size_t(0);
     };
+    for (std::size_t b = 0; b < study.blocks.size(); ++b) {  // column indices, looked up once
+      const Block& block = study.blocks[b];
+      Columns c;
+      if (block.kind() == BlockKind::trajectory) {
+        c.value = metric(b, "E");
+        for (int j = 0; j < 3; ++j) c.tau[j] = metric(b, "tau" + std::to_string(j + 1) + "_inf");
+        c.preset = schema.param_column[b][block.column_index("preset")];
+        c.inertia = schema.param_column[b][block.column_index("inertia")];
+      } else {
+        c.value = metric(b, "iterations");
+      }
+      columns_.push_back(c);
+    }
   }
 
   void add(std::uint64_t id, const RunRef& ref, const Record& row) {
@@ -71,20 +84,17 @@ class Accumulator {
     grids_[ref.block].add(ref.local, row, schema_, ref.block);
     const bool traj = block.kind() == BlockKind::trajectory;
     const bool good = traj ? status == "ok" : status == "converged";
-    if (good) {
-      const double v = as_f64(row.cells[metric_(ref.block, traj ? "E" : "iterations")]);
-      consider_best(br, id, v, row, ref.block);
-    }
+    const Columns& c = columns_[ref.block];
+    if (good) consider_best(br, id, as_f64(row.cells[c.value]), row, ref.block);
     if (traj) {
-      const std::size_t pc = schema_.param_column[ref.block][block.column_index("preset")];
-      const std::string& preset = as_str(row.cells[pc]);
-      if (!preset.empty() && find_seed_case(preset) && report_.seed_rows.size() < 1000) {
+      const std::string& preset = as_str(row.cells[c.preset]);
+      if (!preset.empty() && seed_.size() < 1000 && find_seed_case(preset)) {
         SeedRow s;
         s.preset = preset;
-        s.inertia = as_str(row.cells[schema_.param_column[ref.block][block.column_index("inertia")]]);
+        s.inertia = as_str(row.cells[c.inertia]);
         s.status = status;
-        s.E = as_f64(row.cells[metric_(ref.block, "E")]);
-        for (int j = 0; j < 3; ++j) s.tau[j] = as_f64(row.cells[metric_(ref.block, "tau" + std::to_string(j + 1) + "_inf")]);
+        s.E = as_f64(row.cells[c.value]);
+        for (int j = 0; j < 3; ++j) s.tau[j] = as_f64(row.cells[c.tau[j]]);
         seed_[id] = std::move(s);
       }
     }
@@ -134,7 +144,10 @@ class Accumulator {
   std::vector<LandscapeGrid> grids_;
   SweepReport report_;
   std::map<std::uint64_t, SeedRow> seed_;
-  std::function<std::size_t(std::size_t, std::string_view)> metric_;
+  struct Columns {  // schema columns a block's rows are read at
+    std::size_t value = 0, preset = 0, inertia = 0, tau[3] = {0, 0, 0};
+  };
+  std::vector<Columns> columns_;
 };
 
 }  // namespace
