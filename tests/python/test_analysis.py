@@ -16,6 +16,8 @@ import unittest
 import h5py
 import numpy as np
 
+from e2e_common import OPTIMIZE as OPTIMIZE_COMMON
+
 KS = None
 ROOT = None
 D = 180.0 / math.pi
@@ -51,32 +53,7 @@ q0_2 = { from = -180, to = 180, count = 13 }
 """
 
 # A coarse alpha1A x k landscape and an [[optimize]] block over the same two variables (seconds).
-OPTIMIZE = """
-[study]
-name = "ana_optimize"
-histories = "none"
-[robot]
-inertia = "thesis_m11"
-[[block]]
-name = "grid"
-kind = "trajectory"
-method = "local_weighted"
-[block.axes]
-alpha1A = { from = -30, to = 10, step = 5 }
-k = { from = 0, to = 1, step = 0.25 }
-[[optimize]]
-name = "h1"
-preset = "1h"
-variables = { alpha1A = [-30, 10], k = [0, 1] }
-polish_from = { block = "grid", best = 2 }
-[optimize.global]
-algorithm = "GN_ESCH"
-population = 10
-max_evals = 40
-[optimize.local]
-algorithm = "LN_BOBYQA"
-max_evals = 30
-[[optimize]]
+OPTIMIZE = OPTIMIZE_COMMON.replace('name = "e2e_optimize"', 'name = "ana_optimize"') + """[[optimize]]
 name = "k_only"
 preset = "1d"
 variables = { k = [0, 1] }

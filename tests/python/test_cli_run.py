@@ -15,53 +15,13 @@ import unittest
 import h5py
 import numpy as np
 
+from e2e_common import SWEEP, runs_table, same_tables
+
 KS = None
 STUDIES = None
 
-SWEEP = """
-[study]
-name = "e2e"
-histories = "every=5"
-
-[[block]]
-name = "weighted"
-kind = "trajectory"
-method = "local_weighted"
-[block.axes]
-alpha1A = { from = -20, to = 30, step = 1 }
-k = { from = 0, to = 1, count = 11 }
-
-[[block]]
-name = "newton_basin"
-kind = "ik"
-problem = "scara"
-method = "newton"
-[block.axes]
-q0_1 = { from = -180, to = 180, count = 21 }
-q0_2 = { from = -180, to = 180, count = 21 }
-"""
-
-
 def run(*args, **kw):
     return subprocess.run([KS, *args], capture_output=True, text=True, **kw)
-
-
-def runs_table(path):
-    with h5py.File(path, "r") as f:
-        return {k: f["runs"][k][()] for k in f["runs"] if k != "wall_time"}
-
-
-def same_tables(a, b):
-    if a.keys() != b.keys():
-        return False
-    for k in a:
-        x, y = a[k], b[k]
-        if x.dtype.kind == "f":
-            if not np.array_equal(x.view(np.uint64), y.view(np.uint64)):  # bitwise, NaN included
-                return False
-        elif not np.array_equal(x, y):
-            return False
-    return True
 
 
 class Base(unittest.TestCase):

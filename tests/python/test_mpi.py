@@ -17,31 +17,12 @@ import unittest
 import h5py
 import numpy as np
 
+from e2e_common import SWEEP as SWEEP_COMMON, bitwise_equal, runs_table
+
 KS = None
 MPIRUN = ["mpirun", "--oversubscribe", "--allow-run-as-root", "--bind-to", "none", "-np", "2"]
 
-SWEEP = """
-[study]
-name = "mpi_e2e"
-histories = "every=5"
-
-[[block]]
-name = "weighted"
-kind = "trajectory"
-method = "local_weighted"
-[block.axes]
-alpha1A = { from = -20, to = 30, step = 1 }
-k = { from = 0, to = 1, count = 11 }
-
-[[block]]
-name = "newton_basin"
-kind = "ik"
-problem = "scara"
-method = "newton"
-[block.axes]
-q0_1 = { from = -180, to = 180, count = 21 }
-q0_2 = { from = -180, to = 180, count = 21 }
-"""
+SWEEP = SWEEP_COMMON.replace('name = "e2e"', 'name = "mpi_e2e"')
 
 # Long enough (several seconds on 2 ranks) to kill a rank in the middle.
 LONG = SWEEP.replace('name = "mpi_e2e"', 'name = "mpi_kill"').replace("step = 1 }", "step = 0.1 }")
@@ -53,19 +34,6 @@ def run(*args):
 
 def mpirun(*args):
     return subprocess.run([*MPIRUN, KS, *args], capture_output=True, text=True, timeout=600)
-
-
-def bitwise_equal(x, y):
-    if x.shape != y.shape:
-        return False
-    if x.dtype.kind == "f":
-        return np.array_equal(x.view(np.uint64), y.view(np.uint64))  # NaN included
-    return np.array_equal(x, y)
-
-
-def runs_table(path):
-    with h5py.File(path, "r") as f:
-        return {k: f["runs"][k][()] for k in f["runs"] if k != "wall_time"}
 
 
 def descendants(root):

@@ -16,6 +16,8 @@ import unittest
 import h5py
 import numpy as np
 
+from e2e_common import OPTIMIZE as OPTIMIZE_COMMON
+
 KS = None
 ROOT = None
 D = 180.0 / math.pi
@@ -58,32 +60,7 @@ k = { from = 0, to = 1, count = 11 }
 """
 
 # A coarse landscape and an [[optimize]] block polishing from it (sweep, global and local stages; seconds).
-OPTIMIZE = """
-[study]
-name = "query_opt"
-histories = "none"
-[robot]
-inertia = "thesis_m11"
-[[block]]
-name = "grid"
-kind = "trajectory"
-method = "local_weighted"
-[block.axes]
-alpha1A = { from = -30, to = 10, step = 5 }
-k = { from = 0, to = 1, step = 0.25 }
-[[optimize]]
-name = "h1"
-preset = "1h"
-variables = { alpha1A = [-30, 10], k = [0, 1] }
-polish_from = { block = "grid", best = 2 }
-[optimize.global]
-algorithm = "GN_ESCH"
-population = 10
-max_evals = 40
-[optimize.local]
-algorithm = "LN_BOBYQA"
-max_evals = 30
-"""
+OPTIMIZE = OPTIMIZE_COMMON.replace('name = "e2e_optimize"', 'name = "query_opt"')
 
 
 def ks(*args):

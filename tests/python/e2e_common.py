@@ -1,0 +1,75 @@
+"""What the end-to-end tests share: the small studies they run and how they compare results files.
+Run with Debian's /usr/bin/python3 (h5py, numpy)."""
+import h5py
+import numpy as np
+
+# A trajectory landscape (561 runs) and an IK basin (441 runs): about a second on 2 cores.
+SWEEP = """
+[study]
+name = "e2e"
+histories = "every=5"
+
+[[block]]
+name = "weighted"
+kind = "trajectory"
+method = "local_weighted"
+[block.axes]
+alpha1A = { from = -20, to = 30, step = 1 }
+k = { from = 0, to = 1, count = 11 }
+
+[[block]]
+name = "newton_basin"
+kind = "ik"
+problem = "scara"
+method = "newton"
+[block.axes]
+q0_1 = { from = -180, to = 180, count = 21 }
+q0_2 = { from = -180, to = 180, count = 21 }
+"""
+
+# A coarse landscape and an [[optimize]] block polishing from it (sweep, global and local stages).
+OPTIMIZE = """
+[study]
+name = "e2e_optimize"
+histories = "none"
+[robot]
+inertia = "thesis_m11"
+[[block]]
+name = "grid"
+kind = "trajectory"
+method = "local_weighted"
+[block.axes]
+alpha1A = { from = -30, to = 10, step = 5 }
+k = { from = 0, to = 1, step = 0.25 }
+[[optimize]]
+name = "h1"
+preset = "1h"
+variables = { alpha1A = [-30, 10], k = [0, 1] }
+polish_from = { block = "grid", best = 2 }
+[optimize.global]
+algorithm = "GN_ESCH"
+population = 10
+max_evals = 40
+[optimize.local]
+algorithm = "LN_BOBYQA"
+max_evals = 30
+"""
+
+
+def bitwise_equal(x, y):
+    """Arrays equal bit for bit (NaN payloads included)."""
+    if x.shape != y.shape:
+        return False
+    if x.dtype.kind == "f":
+        return np.array_equal(x.view(np.uint64), y.view(np.uint64))
+    return np.array_equal(x, y)
+
+
+def runs_table(path):
+    """Every /runs column but wall_time (the one column that varies between identical sweeps)."""
+    with h5py.File(path, "r") as f:
+        return {k: f["runs"][k][()] for k in f["runs"] if k != "wall_time"}
+
+
+def same_tables(a, b):
+    return a.keys() == b.keys() and all(bitwise_equal(a[k], b[k]) for k in a)
