@@ -1,5 +1,7 @@
 #include "methods/seed_cases.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <numbers>
 
 namespace ks {
@@ -47,6 +49,12 @@ TrajectoryOptions SeedCase::options() const {
   if (method == TrajectoryMethod::vertex_alpha)
     for (double a : vertex_alpha_deg) o.vertex_alpha.push_back(a * kDeg);
   return o;
+}
+
+double SeedCase::worst_deviation(double E_other, const double (&tau_other)[3]) const {
+  double d = std::abs(E_other / E - 1.0);
+  for (int i = 0; i < 3; ++i) d = std::max(d, std::abs(tau_other[i] / tau_inf[i] - 1.0));
+  return d;
 }
 
 std::span<const SeedCase> seed_cases() { return kCases; }

@@ -21,6 +21,8 @@ struct SeedCase {
 
   /// Run options of this case (seed defaults for everything else).
   TrajectoryOptions options() const;
+  /// Largest relative deviation of (E, tau_inf) from this row's printed figures (0.01 = 1 %).
+  double worst_deviation(double E_other, const double (&tau_other)[3]) const;
 };
 
 /// All 21 rows, in the thesis' order.

@@ -281,8 +281,7 @@ void print_report(std::ostream& os, const Study& study, const SweepReport& r) {
     os << "                  | thesis                              | kinesweep\n" << line;
     for (const SeedRow& s : r.seed_rows) {
       const SeedCase& c = *find_seed_case(s.preset);
-      double dev = std::abs(s.E / c.E - 1);
-      for (int j = 0; j < 3; ++j) dev = std::max(dev, std::abs(s.tau[j] / c.tau_inf[j] - 1));
+      const double dev = c.worst_deviation(s.E, s.tau);
       std::snprintf(line, sizeof line, "%-5s %-11s | %8.2f %8.2f %8.2f %7.2f | %8.2f %8.2f %8.2f %7.2f %6.1f%% | %s\n",
                     s.preset.c_str(), s.inertia.c_str(), c.E, c.tau_inf[0], c.tau_inf[1], c.tau_inf[2], s.E, s.tau[0],
                     s.tau[1], s.tau[2], 100 * dev, s.status.c_str());
