@@ -1,5 +1,9 @@
 """What the end-to-end tests share: the small studies they run and how they compare results files.
 Run with Debian's /usr/bin/python3 (h5py, numpy)."""
+import os
+import tempfile
+import unittest
+
 import h5py
 import numpy as np
 
@@ -73,3 +77,20 @@ def runs_table(path):
 
 def same_tables(a, b):
     return a.keys() == b.keys() and all(bitwise_equal(a[k], b[k]) for k in a)
+
+
+class TempDirTest(unittest.TestCase):
+    """A test case with a temporary directory and a helper to write study files into it."""
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def write(self, name, text):
+        p = os.path.join(self.dir, name)
+        with open(p, "w") as f:
+            f.write(text)
+        return p

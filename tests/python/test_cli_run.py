@@ -15,7 +15,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import SWEEP, runs_table, same_tables
+from e2e_common import SWEEP, TempDirTest, runs_table, same_tables
 
 KS = None
 STUDIES = None
@@ -24,19 +24,8 @@ def run(*args, **kw):
     return subprocess.run([KS, *args], capture_output=True, text=True, **kw)
 
 
-class Base(unittest.TestCase):
-    def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory()
-        self.dir = self.tmp.name
-
-    def tearDown(self):
-        self.tmp.cleanup()
-
-    def write(self, name, text):
-        p = os.path.join(self.dir, name)
-        with open(p, "w") as f:
-            f.write(text)
-        return p
+class Base(TempDirTest):
+    pass
 
 
 class BadInput(Base):

@@ -17,7 +17,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import SWEEP as SWEEP_COMMON, bitwise_equal, runs_table
+from e2e_common import SWEEP as SWEEP_COMMON, TempDirTest, bitwise_equal, runs_table
 
 KS = None
 MPIRUN = ["mpirun", "--oversubscribe", "--allow-run-as-root", "--bind-to", "none", "-np", "2"]
@@ -69,19 +69,7 @@ def rank_pid(mpirun_pid, rank):
     return None
 
 
-class Base(unittest.TestCase):
-    def setUp(self):
-        self.tmp = tempfile.TemporaryDirectory()
-        self.dir = self.tmp.name
-
-    def tearDown(self):
-        self.tmp.cleanup()
-
-    def write(self, name, text):
-        p = os.path.join(self.dir, name)
-        with open(p, "w") as f:
-            f.write(text)
-        return p
+class Base(TempDirTest):
 
     def assertSameFile(self, a, b):
         ta, tb = runs_table(a), runs_table(b)
