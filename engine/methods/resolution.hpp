@@ -22,24 +22,26 @@ inline Vec3 local_acceleration(Weighting w, const Ldlt3& llt, const Mat23& J, co
   if (w == Weighting::inertia) {
     // W = M: with M = L D L^T and f = L^-1 (J^T, c + k g), A = f^T D^-1 f and
     // qdd = L^-T D^-1 (f0 z0 + f1 z1 - fu) - K_N qd: forward solves only, one back solve at the end.
-    const Vec3 f0 = llt.solve_lower(J.row(0).transpose()), f1 = llt.solve_lower(J.row(1).transpose());
-    const Vec3 fu = llt.solve_lower(Vec3(c[0] + k * g[0], c[1] + k * g[1], c[2] + k * g[2]));
-    const double d[3] = {llt.r0, llt.r1, llt.r2};
-    double a00 = 0, a01 = 0, a11 = 0, ju0 = 0, ju1 = 0;
-    for (int i = 0; i < 3; ++i) {
-      const double g0 = f0[i] * d[i], g1 = f1[i] * d[i];
-      a00 += g0 * f0[i];
-      a01 += g0 * f1[i];
-      a11 += g1 * f1[i];
-      ju0 += g0 * fu[i];
-      ju1 += g1 * fu[i];
+    // Written in scalars: this is the hottest code of a sweep.
+    const double l10 = llt.l10, l20 = llt.l20, l21 = llt.l21, d0 = llt.r0, d1 = llt.r1, d2 = llt.r2;
+    const double u0 = c[0] + k * g[0], u1 = c[1] + k * g[1], u2 = c[2] + k * g[2];
+    const double a0 = J(0, 0), a1 = J(0, 1) - l10 * a0, a2 = J(0, 2) - l20 * a0 - l21 * a1;  // f0
+    const double b0 = J(1, 0), b1 = J(1, 1) - l10 * b0, b2 = J(1, 2) - l20 * b0 - l21 * b1;  // f1
+    const double e0 = u0, e1 = u1 - l10 * e0, e2 = u2 - l20 * e0 - l21 * e1;                 // fu
+    const double ga0 = a0 * d0, ga1 = a1 * d1, ga2 = a2 * d2, gb0 = b0 * d0, gb1 = b1 * d1, gb2 = b2 * d2;
+    const double a00 = ga0 * a0 + ga1 * a1 + ga2 * a2, a01 = ga0 * b0 + ga1 * b1 + ga2 * b2;
+    const double a11 = gb0 * b0 + gb1 * b1 + gb2 * b2;
+    double r0 = b[0] + (ga0 * e0 + ga1 * e1 + ga2 * e2), r1 = b[1] + (gb0 * e0 + gb1 * e1 + gb2 * e2);
+    if (K_N != 0.0) {
+      r0 += K_N * (J(0, 0) * qd[0] + J(0, 1) * qd[1] + J(0, 2) * qd[2]);
+      r1 += K_N * (J(1, 0) * qd[0] + J(1, 1) * qd[1] + J(1, 2) * qd[2]);
     }
-    const double r0 = b[0] + ju0 + K_N * J.row(0).dot(qd), r1 = b[1] + ju1 + K_N * J.row(1).dot(qd);
     const double inv_det = 1.0 / (a00 * a11 - a01 * a01);  // overlaps with adj(A) r below
     const double w0 = a11 * r0 - a01 * r1, w1 = a00 * r1 - a01 * r0;
-    const Vec3 h((f0[0] * w0 + f1[0] * w1) * inv_det - fu[0], (f0[1] * w0 + f1[1] * w1) * inv_det - fu[1],
-                 (f0[2] * w0 + f1[2] * w1) * inv_det - fu[2]);
-    return llt.solve_upper(h) - K_N * qd;
+    const double h0 = (a0 * w0 + b0 * w1) * inv_det - e0, h1 = (a1 * w0 + b1 * w1) * inv_det - e1,
+                 h2 = (a2 * w0 + b2 * w1) * inv_det - e2;
+    const double x2 = h2 * d2, x1 = h1 * d1 - l21 * x2, x0 = h0 * d0 - l10 * x1 - l20 * x2;  // L^-T D^-1 h
+    return {x0 - K_N * qd[0], x1 - K_N * qd[1], x2 - K_N * qd[2]};
   }
   // W = M^2: Y = M^-2 J^T
   const Vec3 y0 = llt.solve(llt.solve(J.row(0).transpose())), y1 = llt.solve(llt.solve(J.row(1).transpose()));
