@@ -34,7 +34,6 @@ namespace {
 
 /// Everything one evaluation of the method at (t, q, qd) produces.
 struct Evaluation {
-  JointTrig trig;
   Mat3 M;
   Ldlt3 llt;
   Vec3 c, g, qdd;
@@ -56,14 +55,13 @@ class Resolver {
   }
   /// The same with the joint trig of q given (see TrigTracker).
   bool evaluate(double t, std::size_t segment, const JointTrig& trig, const Vec3& qd, Evaluation& e) const {
-    e.trig = trig;
-    e.M = mass_matrix(dyn_, e.trig);
-    e.c = coriolis(dyn_, e.trig, qd);
-    e.g = gravity(dyn_, e.trig);
-    e.J = jacobian(arm_, e.trig);
+    e.M = mass_matrix(dyn_, trig);
+    e.c = coriolis(dyn_, trig, qd);
+    e.g = gravity(dyn_, trig);
+    e.J = jacobian(arm_, trig);
     e.llt.compute(e.M);
     const PathSample<2> xs = path_.sample_on(segment, t);
-    const Vec2 b = xs.a - jacobian_dot_times_qd(arm_, e.trig, qd);
+    const Vec2 b = xs.a - jacobian_dot_times_qd(arm_, trig, qd);
     e.x_ref = xs.p;
     if (o_.method == TrajectoryMethod::vertex_alpha) {
       double det = 0;
