@@ -101,3 +101,26 @@ TEST(Dynamics, ThesisInertiaFormDiffersOnlyInM11) {
   d(0, 0) = 0;
   EXPECT_EQ(d.norm(), 0.0);
 }
+
+// SymInverse3 (adjugate / determinant) against Eigen's LU on the mass matrices the simulation meets.
+TEST(SymInverse3, SolvesLikeLuAndGivesTheInverseQuadraticForm) {
+  test::RandomStates r;
+  for (auto form : {InertiaForm::physical, InertiaForm::thesis_m11}) {
+    PlanarArm3 a = PlanarArm3::seed();
+    a.inertia_form = form;
+    const DynamicsCoefficients d(a);
+    for (int n = 0; n < 1000; ++n) {
+      const JointTrig t = joint_trig(r.q());
+      const Sym3 M = mass_matrix_sym(d, t);
+      const Mat3 Md = M.dense();
+      const SymInverse3 Mi(M);
+      const Vec3 b = r.v();
+      const Vec3 x = Md.lu().solve(b);
+      EXPECT_NEAR(Mi.det, Md.determinant(), 1e-12 * std::abs(Md.determinant()));
+      EXPECT_LT((Mi.solve(b) - x).norm(), 1e-12 * (1 + x.norm()));
+      EXPECT_NEAR(Mi.inverse_quadratic_form(b), b.dot(x), 1e-12 * (1 + b.dot(x)));
+      EXPECT_LT((M * b - Md * b).norm(), 1e-13 * (1 + (Md * b).norm()));
+      EXPECT_NEAR(M.quadratic_form(b), b.dot(Md * b), 1e-12 * (1 + b.dot(Md * b)));
+    }
+  }
+}

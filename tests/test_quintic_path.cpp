@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "task/quintic_path.hpp"
+#include "task/sampled_path.hpp"
 
 using namespace ks;
 
@@ -50,4 +51,23 @@ TEST(QuinticPath, RestAtEveryVertexAndDerivativesConsistent) {
 TEST(QuinticPath, RejectsBadShapes) {
   EXPECT_THROW(Path2({Eigen::Vector2d(0, 0)}, {}), std::invalid_argument);
   EXPECT_THROW(Path2({Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 0)}, {0.0}), std::invalid_argument);
+}
+
+// SampledPath holds exactly what the seed's loop computes at t = i dt: same times, same segments,
+// same values as sampling the path on the fly.
+TEST(SampledPath, EqualsSamplingOnTheFly) {
+  const Path2 p = seed_square();
+  const SampledPath s(p, 1e-3);
+  ASSERT_EQ(s.size(), 2001u);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const double t = static_cast<double>(i) * 1e-3;
+    const auto x = p.sample(t);
+    ASSERT_EQ(s.time(i), t);
+    ASSERT_EQ(s.segment(i), p.segment_at(t));
+    ASSERT_EQ(s.position(i), x.p);
+    ASSERT_EQ(s.acceleration(i), x.a);
+  }
+  EXPECT_EQ(s.segment(500), 0u);  // t = 0.5 still on side A (the seed's t <= 0.5 rule)
+  EXPECT_EQ(s.segment(501), 1u);
+  EXPECT_EQ(SampledPath(p, 0.3).size(), 7u);  // 0, 0.3, ..., 1.8
 }

@@ -77,17 +77,17 @@ TEST(LocalResolution, SatisfiesTaskAndIsOptimalInNullSpace) {
     const Mat23 J = jacobian(a, t);
     if (manipulability(J) < 0.05) continue;
     const Mat3 M = mass_matrix(a, t);
-    const Ldlt3 llt(M);
+    const SymInverse3 Mi(mass_matrix_sym(DynamicsCoefficients(a), t));
     const Vec3 c = coriolis(a, t, qd), g = gravity(a, t);
     const Vec2 b(r.rate(r.rng), r.rate(r.rng));
     const double k = 0.3;
     const Vec3 null = J.row(0).cross(J.row(1)).transpose().normalized();
     for (Weighting w : {Weighting::inertia, Weighting::inertia_squared}) {
-      const Vec3 qdd = local_acceleration(w, llt, J, b, c, g, k, 0.0, qd);
+      const Vec3 qdd = local_acceleration(w, Mi, J, b, c, g, k, 0.0, qd);
       EXPECT_LT((J * qdd - b).norm(), 1e-9 * (1 + b.norm()));
       auto cost = [&](const Vec3& x) {
         const Vec3 u = M * x + c + k * g;
-        return w == Weighting::inertia ? u.dot(llt.solve(u)) : u.squaredNorm();
+        return w == Weighting::inertia ? u.dot(Mi.solve(u)) : u.squaredNorm();
       };
       const double c0 = cost(qdd);
       for (double s : {-1e-2, 1e-2, -1.0, 1.0}) EXPECT_GT(cost(qdd + s * null), c0);
@@ -101,10 +101,10 @@ TEST(LocalResolution, NullSpaceDampingActsInNullSpace) {
   const Vec3 q(0.2, 1.1, -0.7), qd(0.5, -1.0, 2.0);
   const JointTrig t = joint_trig(q);
   const Mat23 J = jacobian(a, t);
-  const Ldlt3 llt(mass_matrix(a, t));
+  const SymInverse3 Mi(mass_matrix_sym(DynamicsCoefficients(a), t));
   const Vec2 b(0.3, -0.2);
-  const Vec3 d0 = local_acceleration(Weighting::inertia, llt, J, b, coriolis(a, t, qd), gravity(a, t), 0, 0, qd);
-  const Vec3 d1 = local_acceleration(Weighting::inertia, llt, J, b, coriolis(a, t, qd), gravity(a, t), 0, 5, qd);
+  const Vec3 d0 = local_acceleration(Weighting::inertia, Mi, J, b, coriolis(a, t, qd), gravity(a, t), 0, 0, qd);
+  const Vec3 d1 = local_acceleration(Weighting::inertia, Mi, J, b, coriolis(a, t, qd), gravity(a, t), 0, 5, qd);
   EXPECT_LT((J * (d1 - d0)).norm(), 1e-10);
   EXPECT_GT((d1 - d0).norm(), 1e-3);
 }
@@ -187,4 +187,14 @@ TEST(Trajectory, NamesRoundTrip) {
   }
   TrajectoryMethod x;
   EXPECT_FALSE(parse("local_weigthed", x));
+}
+
+TEST(Trajectory, SampledPathMustMatchTheStep) {
+  TrajectoryOptions o = find_seed_case("1a")->options();
+  const SampledPath p(seed_square(), 2e-3);
+  EXPECT_THROW(simulate(PlanarArm3::seed(), p, o), std::invalid_argument);
+  o.dt = 2e-3;
+  const TrajectoryMetrics r = simulate(PlanarArm3::seed(), p, o);
+  EXPECT_EQ(r.status, RunStatus::ok);
+  EXPECT_EQ(r.samples, 1001u);
 }

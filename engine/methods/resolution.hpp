@@ -2,7 +2,7 @@
 // Joint accelerations of the seed's redundancy resolutions at one instant (free functions, no state).
 #include <Eigen/LU>
 
-#include "model/ldlt3.hpp"
+#include "model/sym3.hpp"
 #include "model/kinematics.hpp"
 
 namespace ks {
@@ -14,48 +14,38 @@ enum class Weighting {
 
 /// Local (instantaneous) resolution at acceleration level:
 ///   qdd = J_W+ b - (I - J_W+ J) v,  J_W+ = W^-1 J^T (J W^-1 J^T)^-1,  v = M^-1 (c + k g) + K_N qd,
-/// computed as qdd = Y A^-1 (b + J v) - v with Y = W^-1 J^T and A = J Y (a 2x2 solve, no inverse).
-/// Inputs: Cholesky factor of M (Ldlt3) [kg m^2], J (2x3) [m], b = xdd - Jdot qd [m/s^2], c and g [Nm],
+/// i.e. qdd = Y A^-1 (b + J v) - v with Y = W^-1 J^T and A = J Y (a 2x2 system).
+/// With M^-1 = P / D (P = adj M, D = det M) and Q = P (W = M) or P^2 (W = M^2), every factor of D
+/// cancels but one: with Yh = Q J^T, Ah = J Yh, pv = P u + D K_N qd and rh = D b + J pv,
+///   qdd = (Yh adj(Ah) rh - det(Ah) pv) / (D det(Ah)),
+/// one division, computed while the numerator is formed (the step's dependency chain runs through here).
+/// Inputs: M^-1 as SymInverse3 [1/(kg m^2)], J (2x3) [m], b = xdd - Jdot qd [m/s^2], c and g [Nm],
 /// gravity weight k [-], null-space damping K_N [1/s], qd [rad/s]. Output: qdd [rad/s^2].
-inline Vec3 local_acceleration(Weighting w, const Ldlt3& llt, const Mat23& J, const Vec2& b, const Vec3& c,
+inline Vec3 local_acceleration(Weighting w, const SymInverse3& Mi, const Mat23& J, const Vec2& b, const Vec3& c,
                                const Vec3& g, double k, double K_N, const Vec3& qd) {
-  if (w == Weighting::inertia) {
-    // W = M: with M = L D L^T and f = L^-1 (J^T, c + k g), A = f^T D^-1 f and
-    // qdd = L^-T D^-1 (f0 z0 + f1 z1 - fu) - K_N qd: forward solves only, one back solve at the end.
-    // Written in scalars: this is the hottest code of a sweep.
-    const double l10 = llt.l10, l20 = llt.l20, l21 = llt.l21, d0 = llt.r0, d1 = llt.r1, d2 = llt.r2;
-    const double u0 = c[0] + k * g[0], u1 = c[1] + k * g[1], u2 = c[2] + k * g[2];
-    const double a0 = J(0, 0), a1 = J(0, 1) - l10 * a0, a2 = J(0, 2) - l20 * a0 - l21 * a1;  // f0
-    const double b0 = J(1, 0), b1 = J(1, 1) - l10 * b0, b2 = J(1, 2) - l20 * b0 - l21 * b1;  // f1
-    const double e0 = u0, e1 = u1 - l10 * e0, e2 = u2 - l20 * e0 - l21 * e1;                 // fu
-    const double ga0 = a0 * d0, ga1 = a1 * d1, ga2 = a2 * d2, gb0 = b0 * d0, gb1 = b1 * d1, gb2 = b2 * d2;
-    const double a00 = ga0 * a0 + ga1 * a1 + ga2 * a2, a01 = ga0 * b0 + ga1 * b1 + ga2 * b2;
-    const double a11 = gb0 * b0 + gb1 * b1 + gb2 * b2;
-    double r0 = b[0] + (ga0 * e0 + ga1 * e1 + ga2 * e2), r1 = b[1] + (gb0 * e0 + gb1 * e1 + gb2 * e2);
-    if (K_N != 0.0) {
-      r0 += K_N * (J(0, 0) * qd[0] + J(0, 1) * qd[1] + J(0, 2) * qd[2]);
-      r1 += K_N * (J(1, 0) * qd[0] + J(1, 1) * qd[1] + J(1, 2) * qd[2]);
-    }
-    const double inv_det = 1.0 / (a00 * a11 - a01 * a01);  // overlaps with adj(A) r below
-    const double w0 = a11 * r0 - a01 * r1, w1 = a00 * r1 - a01 * r0;
-    const double h0 = (a0 * w0 + b0 * w1) * inv_det - e0, h1 = (a1 * w0 + b1 * w1) * inv_det - e1,
-                 h2 = (a2 * w0 + b2 * w1) * inv_det - e2;
-    const double x2 = h2 * d2, x1 = h1 * d1 - l21 * x2, x0 = h0 * d0 - l10 * x1 - l20 * x2;  // L^-T D^-1 h
-    return {x0 - K_N * qd[0], x1 - K_N * qd[1], x2 - K_N * qd[2]};
+  const Sym3& P = Mi.P;
+  const double D = Mi.det;
+  const Vec3 j0(J(0, 0), J(0, 1), J(0, 2)), j1(J(1, 0), J(1, 1), J(1, 2));
+  Vec3 y0 = P * j0, y1 = P * j1;
+  if (w == Weighting::inertia_squared) {
+    y0 = P * y0;
+    y1 = P * y1;
   }
-  // W = M^2: Y = M^-2 J^T
-  const Vec3 y0 = llt.solve(llt.solve(J.row(0).transpose())), y1 = llt.solve(llt.solve(J.row(1).transpose()));
-  const Vec3 v = llt.solve(Vec3(c[0] + k * g[0], c[1] + k * g[1], c[2] + k * g[2])) + K_N * qd;
-  const double a00 = J(0, 0) * y0[0] + J(0, 1) * y0[1] + J(0, 2) * y0[2];
-  const double a01 = J(0, 0) * y1[0] + J(0, 1) * y1[1] + J(0, 2) * y1[2];  // A is symmetric
-  const double a11 = J(1, 0) * y1[0] + J(1, 1) * y1[1] + J(1, 2) * y1[2];
-  const double r0 = b[0] + J(0, 0) * v[0] + J(0, 1) * v[1] + J(0, 2) * v[2];
-  const double r1 = b[1] + J(1, 0) * v[0] + J(1, 1) * v[1] + J(1, 2) * v[2];
-  // z = A^-1 r = adj(A) r / det(A): the division runs while Y adj(A) r is formed (shorter chain)
-  const double inv_det = 1.0 / (a00 * a11 - a01 * a01);
+  Vec3 pv = P * Vec3(c[0] + k * g[0], c[1] + k * g[1], c[2] + k * g[2]);
+  if (K_N != 0.0) {
+    const double s = D * K_N;
+    pv = Vec3(pv[0] + s * qd[0], pv[1] + s * qd[1], pv[2] + s * qd[2]);
+  }
+  const double a00 = j0[0] * y0[0] + j0[1] * y0[1] + j0[2] * y0[2];
+  const double a01 = j0[0] * y1[0] + j0[1] * y1[1] + j0[2] * y1[2];  // Ah is symmetric
+  const double a11 = j1[0] * y1[0] + j1[1] * y1[1] + j1[2] * y1[2];
+  const double r0 = D * b[0] + (j0[0] * pv[0] + j0[1] * pv[1] + j0[2] * pv[2]);
+  const double r1 = D * b[1] + (j1[0] * pv[0] + j1[1] * pv[1] + j1[2] * pv[2]);
+  const double det = a00 * a11 - a01 * a01;
+  const double inv = 1.0 / (D * det);
   const double w0 = a11 * r0 - a01 * r1, w1 = a00 * r1 - a01 * r0;
-  const Vec3 yw(y0[0] * w0 + y1[0] * w1, y0[1] * w0 + y1[1] * w1, y0[2] * w0 + y1[2] * w1);
-  return {yw[0] * inv_det - v[0], yw[1] * inv_det - v[1], yw[2] * inv_det - v[2]};
+  return {(y0[0] * w0 + y1[0] * w1 - det * pv[0]) * inv, (y0[1] * w0 + y1[1] * w1 - det * pv[1]) * inv,
+          (y0[2] * w0 + y1[2] * w1 - det * pv[2]) * inv};
 }
 
 /// Non-redundant resolution (vertex_alpha, seed cases 3-5): solve [J; 1 1 1] qdd = [b; alpha_dd]

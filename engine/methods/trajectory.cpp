@@ -26,19 +26,20 @@ void TrajectoryHistory::prepare(std::size_t samples) {
   size = 0;
 }
 
-std::size_t sample_count(double duration, double dt) {
-  return static_cast<std::size_t>(std::floor(duration / dt + 1e-9)) + 1;
-}
-
 namespace {
+
+/// What the path asks of the arm at one instant.
+struct TaskSample {
+  Vec2 a;           // path acceleration [m/s^2]
+  double alpha_dd;  // vertex_alpha: orientation acceleration [rad/s^2]
+};
 
 /// Everything one evaluation of the method at (t, q, qd) produces.
 struct Evaluation {
-  Mat3 M;
-  Ldlt3 llt;
+  Sym3 M;
+  SymInverse3 Mi;  // M^-1 as adj(M) / det(M)
   Vec3 c, g, qdd;
   Mat23 J;
-  Vec2 x_ref;    // path position at t
   double w2;     // squared manipulability det(J J^T) (the square root is taken once, at the end)
 };
 
@@ -48,31 +49,37 @@ class Resolver {
            const std::optional<Profile1>& alpha_profile)
       : arm_(arm), dyn_(arm), path_(path), o_(o), alpha_(alpha_profile) {}
 
-  /// Joint accelerations of the method at (t, q, qd); fills every intermediate in `e`.
+  /// The task at time t on segment `segment` (for times off the sample grid: RK4's stages).
+  TaskSample task(double t, std::size_t segment) const {
+    return {path_.sample_on(segment, t).a, alpha_ ? alpha_->sample_on(segment, t).a[0] : 0.0};
+  }
+  /// The task at sample i of the sampled path.
+  TaskSample task(const SampledPath& p, std::size_t i) const {
+    return {p.acceleration(i), alpha_ ? alpha_->sample_on(p.segment(i), p.time(i)).a[0] : 0.0};
+  }
+  /// Joint accelerations of the method for task x at (q, qd); fills every intermediate in `e`.
   /// Returns false when the Jacobian is singular.
-  bool evaluate(double t, std::size_t segment, const Vec3& q, const Vec3& qd, Evaluation& e) const {
-    return evaluate(t, segment, joint_trig(q), qd, e);
+  bool evaluate(const TaskSample& x, const Vec3& q, const Vec3& qd, Evaluation& e) const {
+    return evaluate(x, joint_trig(q), qd, e);
   }
   /// The same with the joint trig of q given (see TrigTracker).
-  bool evaluate(double t, std::size_t segment, const JointTrig& trig, const Vec3& qd, Evaluation& e) const {
-    e.M = mass_matrix(dyn_, trig);
+  bool evaluate(const TaskSample& x, const JointTrig& trig, const Vec3& qd, Evaluation& e) const {
+    e.M = mass_matrix_sym(dyn_, trig);
     e.c = coriolis(dyn_, trig, qd);
     e.g = gravity(dyn_, trig);
     e.J = jacobian(arm_, trig);
-    e.llt.compute(e.M);
-    const PathSample<2> xs = path_.sample_on(segment, t);
-    const Vec2 b = xs.a - jacobian_dot_times_qd(arm_, trig, qd);
-    e.x_ref = xs.p;
+    e.Mi = SymInverse3(e.M);
+    const Vec2 b = x.a - jacobian_dot_times_qd(arm_, trig, qd);
     if (o_.method == TrajectoryMethod::vertex_alpha) {
       double det = 0;
-      e.qdd = nonredundant_acceleration(e.J, b, alpha_->sample_on(segment, t).a[0], det);
+      e.qdd = nonredundant_acceleration(e.J, b, x.alpha_dd, det);
       e.w2 = manipulability_squared(e.J);
       return std::abs(det) >= o_.singular_tolerance;
     }
     e.w2 = manipulability_squared(e.J);
     if (!(e.w2 >= o_.singular_tolerance * o_.singular_tolerance)) return false;
     const Weighting w = o_.method == TrajectoryMethod::local_unweighted ? Weighting::inertia_squared : Weighting::inertia;
-    e.qdd = local_acceleration(w, e.llt, e.J, b, e.c, e.g, o_.k, o_.null_damping, qd);
+    e.qdd = local_acceleration(w, e.Mi, e.J, b, e.c, e.g, o_.k, o_.null_damping, qd);
     return true;
   }
 
@@ -88,6 +95,15 @@ class Resolver {
 
 TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const TrajectoryOptions& o,
                            TrajectoryHistory* history) {
+  return simulate(arm, SampledPath(path, o.dt), o, history);
+}
+
+TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, const TrajectoryOptions& o,
+                           TrajectoryHistory* history) {
+  if (sampled.dt() != o.dt)
+    throw std::invalid_argument("simulate: path sampled at dt = " + std::to_string(sampled.dt()) +
+                                " s, options ask for dt = " + std::to_string(o.dt) + " s");
+  const Path2& path = sampled.path();
   TrajectoryMetrics out;
   std::optional<Profile1> alpha_profile;
   if (o.method == TrajectoryMethod::vertex_alpha) {
@@ -98,7 +114,7 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const Traje
     for (double v : o.vertex_alpha) a.emplace_back(v);
     alpha_profile.emplace(std::move(a), path.durations());
   }
-  const std::size_t n = sample_count(path.duration(), o.dt);
+  const std::size_t n = sampled.size();
   if (history) history->prepare(n);
 
   const std::optional<Vec3> q0 = inverse_kinematics(arm, path.vertices().front(), o.alpha1A, o.elbow);
@@ -122,9 +138,8 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const Traje
   double last_t = 0, last_alpha = q.sum();
 
   for (std::size_t i = 0; i < n; ++i) {
-    const double t = static_cast<double>(i) * dt;
-    const std::size_t seg = path.segment_at(t);
-    if (!resolver.evaluate(t, seg, trig.trig(), qd, e)) {
+    const double t = sampled.time(i);
+    if (!resolver.evaluate(resolver.task(sampled, i), trig.trig(), qd, e)) {
       out.status = RunStatus::singular;
       break;
     }
@@ -138,11 +153,11 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const Traje
     }
     // metrics of this sample
     sumE += std::sqrt(tt);
-    sumEM += std::sqrt(e.llt.inverse_quadratic_form(tau));
+    sumEM += std::sqrt(e.Mi.inverse_quadratic_form(tau));
     for (int j = 0; j < 3; ++j) tau_inf[j] = std::max(tau_inf[j], std::abs(tau[j]));
     min_w2 = std::min(min_w2, e.w2);
     const Vec2 tip = end_effector_from_jacobian(e.J);
-    max_err2 = std::max(max_err2, (tip - e.x_ref).squaredNorm());
+    max_err2 = std::max(max_err2, (tip - sampled.position(i)).squaredNorm());
     const double p6 = tau.cwiseProduct(qd).squaredNorm();
     if (i > 0) {
       f5 += 0.5 * dt * (prev5 + tt);
@@ -174,11 +189,12 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const Traje
       const double th = t + 0.5 * dt, t1 = t + dt;
       const std::size_t sh = path.segment_at(th), s1 = path.segment_at(t1);
       const Vec3 k1q = qd, k1v = e.qdd;
-      bool good = resolver.evaluate(th, sh, q + 0.5 * dt * k1q, qd + 0.5 * dt * k1v, s);
+      const TaskSample xh = resolver.task(th, sh), x1 = resolver.task(t1, s1);
+      bool good = resolver.evaluate(xh, q + 0.5 * dt * k1q, qd + 0.5 * dt * k1v, s);
       const Vec3 k2q = qd + 0.5 * dt * k1v, k2v = s.qdd;
-      good = good && resolver.evaluate(th, sh, q + 0.5 * dt * k2q, qd + 0.5 * dt * k2v, s);
+      good = good && resolver.evaluate(xh, q + 0.5 * dt * k2q, qd + 0.5 * dt * k2v, s);
       const Vec3 k3q = qd + 0.5 * dt * k2v, k3v = s.qdd;
-      good = good && resolver.evaluate(t1, s1, q + dt * k3q, qd + dt * k3v, s);
+      good = good && resolver.evaluate(x1, q + dt * k3q, qd + dt * k3v, s);
       if (!good) {
         out.status = RunStatus::singular;
         break;

@@ -9,6 +9,7 @@
 #include "model/arm.hpp"
 #include "model/kinematics.hpp"
 #include "task/quintic_path.hpp"
+#include "task/sampled_path.hpp"
 
 namespace ks {
 
@@ -87,11 +88,13 @@ struct TrajectoryHistory {
   void prepare(std::size_t samples);
 };
 
-/// Number of samples the seed takes on a path: t = 0 : dt : T.
-std::size_t sample_count(double duration, double dt);
-
-/// Simulate one run. Inputs: arm constants, path [m, s], options. Output: metrics; the history is
-/// filled when given. Never throws on bad numbers: trouble is a status.
+/// Simulate one run. Inputs: arm constants, the path sampled at options.dt (see SampledPath: sample it
+/// once and share it between the runs of a sweep), options. Output: metrics; the history is filled
+/// when given. Never throws on bad numbers: trouble is a status. Throws std::invalid_argument when
+/// path.dt() != options.dt or vertex_alpha has the wrong number of vertex orientations.
+TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& path, const TrajectoryOptions& options,
+                           TrajectoryHistory* history = nullptr);
+/// The same, sampling the path for this one run.
 TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const TrajectoryOptions& options,
                            TrajectoryHistory* history = nullptr);
 

@@ -5,6 +5,7 @@
 
 #include "model/arm.hpp"
 #include "model/kinematics.hpp"
+#include "model/sym3.hpp"
 #include "model/trig.hpp"
 
 namespace ks {
@@ -42,17 +43,15 @@ struct DynamicsCoefficients {
 };
 
 /// Joint-space inertia matrix M(q) [kg m^2], symmetric positive definite (in either InertiaForm).
-inline Mat3 mass_matrix(const DynamicsCoefficients& d, const JointTrig& t) {
+inline Sym3 mass_matrix_sym(const DynamicsCoefficients& d, const JointTrig& t) {
   const double k2 = d.k2 * t.c2, k23 = d.k23 * t.c23, k3 = d.k3 * t.c3;
   const double m22 = d.m22 + 2.0 * k3;
   double m11 = d.m11 + 2.0 * (k3 + k2 + k23);
   // InertiaForm::thesis_m11: m2*(l1^2 + lc2^2 + 2 l1 lc2 c2 + m3*(bracket)) adds (m2 - 1) m3 bracket
   if (d.thesis_extra != 0.0) m11 += d.thesis_extra * (d.b0 + d.b2 * t.c2 + d.b3 * t.c3 + d.b23 * t.c23);
-  const double m12 = m22 + k2 + k23, m13 = d.m33 + k3 + k23, m23 = d.m33 + k3;
-  Mat3 M;
-  M << m11, m12, m13, m12, m22, m23, m13, m23, d.m33;
-  return M;
+  return {m11, m22 + k2 + k23, d.m33 + k3 + k23, m22, d.m33 + k3, d.m33};
 }
+inline Mat3 mass_matrix(const DynamicsCoefficients& d, const JointTrig& t) { return mass_matrix_sym(d, t).dense(); }
 
 /// Centrifugal and Coriolis torques c(q, qd) [Nm] (Christoffel form of M).
 inline Vec3 coriolis(const DynamicsCoefficients& d, const JointTrig& t, const Vec3& qd) {

@@ -36,7 +36,7 @@ inline JointTrig joint_trig(const Vec3& q) {
 /// Joint trig carried along a time-stepping loop: after a step q += dq, the new sines and cosines
 /// follow by rotating the old ones by dq (sin and cos of a small angle are short polynomials),
 /// which takes the three sincos calls off the step's dependency chain. Every `resync` steps, or when
-/// a step is not small (|dq_i| >= 0.05 rad), they are evaluated directly, so rounding cannot drift:
+/// a step is not small (|dq_i| >= 0.01 rad, 10 rad/s at 1 ms), they are evaluated directly, so rounding cannot drift:
 /// the values stay within ~1e-14 of joint_trig(q) (tested).
 class TrigTracker {
  public:
@@ -53,7 +53,7 @@ class TrigTracker {
   /// After q has become q + dq.
   template <class V, class D>
   void advance(const V& q, const D& dq) {
-    if (++steps_ >= resync || !(std::abs(dq[0]) < 0.05 && std::abs(dq[1]) < 0.05 && std::abs(dq[2]) < 0.05)) {
+    if (++steps_ >= resync || !(std::abs(dq[0]) < 0.01 && std::abs(dq[1]) < 0.01 && std::abs(dq[2]) < 0.01)) {
       reset(q);
       return;
     }
@@ -66,11 +66,10 @@ class TrigTracker {
 
  private:
   static void rotate(double& s, double& c, double d) {
-    // Taylor series of sin to d^7 and cos to d^8 (next terms < 6e-18 for |d| < 0.05), evaluated
-    // with Estrin's scheme: the step's dependency chain runs through here.
-    const double z = d * d, z2 = z * z, dz = d * z;
-    const double sd = d + dz * ((-1.0 / 6 + z * (1.0 / 120)) + z2 * (-1.0 / 5040));
-    const double cd = 1.0 + z * ((-0.5 + z * (1.0 / 24)) + z2 * (-1.0 / 720 + z * (1.0 / 40320)));
+    // Taylor series of sin to d^5 and cos to d^6: the next terms are below 2e-18 for |d| < 0.01.
+    const double z = d * d, dz = d * z;
+    const double sd = d + dz * (-1.0 / 6 + z * (1.0 / 120));
+    const double cd = 1.0 + z * (-0.5 + z * (1.0 / 24 + z * (-1.0 / 720)));
     const double sn = s * cd + c * sd;
     c = c * cd - s * sd;
     s = sn;

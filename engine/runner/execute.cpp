@@ -73,13 +73,13 @@ const std::vector<ColumnSpec>& metric_columns(BlockKind kind) {
 
 struct RunWorkspace::Impl {
   const Study* study = nullptr;
-  std::optional<Path2> path;
+  std::optional<SampledPath> path;  // the study's path sampled at the last dt asked for
   TrajectoryHistory history;
   ik::Summary<3, 3> s33;
   ik::Summary<3, 2> s32;
-  const Path2& path_of(const Study& s) {
-    if (study != &s || !path) {
-      path.emplace(s.task.path());
+  const SampledPath& path_of(const Study& s, double dt) {
+    if (study != &s || !path || path->dt() != dt) {
+      path.emplace(s.task.path(), dt);
       study = &s;
     }
     return *path;
@@ -102,9 +102,9 @@ RunOutcome run_trajectory(const Study& study, const Block& b, std::span<const Ce
   o.null_damping = num(p, b, "K_N");
   o.dt = num(p, b, "dt");
   o.torque_bound = num(p, b, "torque_bound");
-  const Path2& path = ws.path_of(study);
+  const SampledPath& path = ws.path_of(study, o.dt);
   if (o.method == TrajectoryMethod::vertex_alpha)
-    for (std::size_t v = 2; v <= path.vertices().size(); ++v) o.vertex_alpha.push_back(num(p, b, "vertex_alpha_" + std::to_string(v)));
+    for (std::size_t v = 2; v <= path.path().vertices().size(); ++v) o.vertex_alpha.push_back(num(p, b, "vertex_alpha_" + std::to_string(v)));
   TrajectoryHistory* h = nullptr;
   if (stride > 0) {
     ws.history.stride = stride;
