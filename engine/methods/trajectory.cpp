@@ -1,5 +1,7 @@
-// simulate(): the seed's loop (Appendix F) with solves instead of inverses, one Cholesky of M per
-// evaluation, fixed-size types and no allocation per step.
+// simulate(): the seed's loop (Appendix F) with solves instead of inverses, fixed-size types and no
+// allocation per step. The per-sample arithmetic is written element by element: Eigen's two-lane
+// packets on 3-vectors would load, as one 16-byte read, two scalars the step has just stored, and
+// such a load cannot be forwarded from the store buffer (a stall of the whole step on x86).
 #include "methods/trajectory.hpp"
 
 #include <Eigen/LU>
@@ -69,7 +71,8 @@ class Resolver {
     e.g = gravity(dyn_, trig);
     e.J = jacobian(arm_, trig);
     e.Mi = SymInverse3(e.M);
-    const Vec2 b = x.a - jacobian_dot_times_qd(arm_, trig, qd);
+    const Vec2 jdqd = jacobian_dot_times_qd(arm_, trig, qd);
+    const Vec2 b(x.a[0] - jdqd[0], x.a[1] - jdqd[1]);
     if (o_.method == TrajectoryMethod::vertex_alpha) {
       double det = 0;
       e.qdd = nonredundant_acceleration(e.J, b, x.alpha_dd, det);
@@ -131,11 +134,11 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
   Evaluation e, s;  // e: at the sample; s: RK4 stages
   TrigTracker trig(q);  // the sample's trig, carried from step to step (semi-implicit Euler)
   double sumE = 0, sumEM = 0, min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0;
-  double f5 = 0, f6 = 0, prev5 = 0, prev6 = 0;
-  Vec3 tau_inf = Vec3::Zero();
+  double f5 = 0, f6 = 0, first5 = 0, first6 = 0, last5 = 0, last6 = 0;
+  double inf0 = 0, inf1 = 0, inf2 = 0;
   const double dt = o.dt;
   std::size_t done = 0;
-  double last_t = 0, last_alpha = q.sum();
+  double last_t = 0, last_alpha = q[0] + q[1] + q[2];
 
   for (std::size_t i = 0; i < n; ++i) {
     const double t = sampled.time(i);
@@ -143,30 +146,39 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
       out.status = RunStatus::singular;
       break;
     }
-    const Vec3 tau = e.M * e.qdd + e.c + e.g;
+    const Vec3 Mqdd = e.M * e.qdd;
+    const double tau0 = Mqdd[0] + e.c[0] + e.g[0], tau1 = Mqdd[1] + e.c[1] + e.g[1], tau2 = Mqdd[2] + e.c[2] + e.g[2];
+    const Vec3 tau(tau0, tau1, tau2);
+    const double a0 = std::abs(tau0), a1 = std::abs(tau1), a2 = std::abs(tau2);
+    const double tt = tau0 * tau0 + tau1 * tau1 + tau2 * tau2;
     // NaN fails every comparison: one test catches non-finite values and the bound
-    const double tt = tau.squaredNorm();
-    if (!(std::abs(tau[0]) <= o.torque_bound && std::abs(tau[1]) <= o.torque_bound &&
-          std::abs(tau[2]) <= o.torque_bound && std::isfinite(tt))) {
+    if (!(a0 <= o.torque_bound && a1 <= o.torque_bound && a2 <= o.torque_bound && std::isfinite(tt))) {
       out.status = RunStatus::diverged;
       break;
     }
     // metrics of this sample
     sumE += std::sqrt(tt);
     sumEM += std::sqrt(e.Mi.inverse_quadratic_form(tau));
-    for (int j = 0; j < 3; ++j) tau_inf[j] = std::max(tau_inf[j], std::abs(tau[j]));
+    inf0 = std::max(inf0, a0);
+    inf1 = std::max(inf1, a1);
+    inf2 = std::max(inf2, a2);
     min_w2 = std::min(min_w2, e.w2);
-    const Vec2 tip = end_effector_from_jacobian(e.J);
-    max_err2 = std::max(max_err2, (tip - sampled.position(i)).squaredNorm());
-    const double p6 = tau.cwiseProduct(qd).squaredNorm();
-    if (i > 0) {
-      f5 += 0.5 * dt * (prev5 + tt);
-      f6 += 0.5 * dt * (prev6 + p6);
+    const Vec2 ref = sampled.position(i);
+    const double ex = e.J(1, 0) - ref[0], ey = -e.J(0, 0) - ref[1];  // tip = (x1, y1) = (J10, -J00)
+    max_err2 = std::max(max_err2, ex * ex + ey * ey);
+    const double p0 = tau0 * qd[0], p1 = tau1 * qd[1], p2 = tau2 * qd[2];
+    const double p6 = p0 * p0 + p1 * p1 + p2 * p2;
+    // trapezoidal rule: sums of every sample, half of the first and last taken off at the end
+    f5 += tt;
+    f6 += p6;
+    if (i == 0) {
+      first5 = tt;
+      first6 = p6;
     }
-    prev5 = tt;
-    prev6 = p6;
+    last5 = tt;
+    last6 = p6;
     last_t = t;
-    last_alpha = q.sum();
+    last_alpha = q[0] + q[1] + q[2];
     if (history && (i % history->stride == 0 || i + 1 == n)) {
       const Eigen::Index c = history->size++;
       history->t[c] = t;
@@ -174,16 +186,16 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
       history->qd.col(c) = qd;
       history->qdd.col(c) = e.qdd;
       history->tau.col(c) = tau;
-      history->x.col(c) = tip;
+      history->x.col(c) = end_effector_from_jacobian(e.J);
       history->alpha[c] = last_alpha;
     }
     ++done;
     if (i + 1 == n) break;  // the last sample is measured, not integrated past
     // integrate to the next sample
     if (o.integrator == Integrator::semi_implicit_euler) {
-      qd += dt * e.qdd;
-      const Vec3 dq = dt * qd;
-      q += dq;
+      for (int j = 0; j < 3; ++j) qd[j] += dt * e.qdd[j];
+      const Vec3 dq(dt * qd[0], dt * qd[1], dt * qd[2]);
+      for (int j = 0; j < 3; ++j) q[j] += dq[j];
       trig.advance(q, dq);
     } else {
       const double th = t + 0.5 * dt, t1 = t + dt;
@@ -209,10 +221,10 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
   if (done > 0) {
     out.E = sumE / static_cast<double>(done);
     out.E_M = sumEM / static_cast<double>(done);
-    out.tau_inf = tau_inf;
+    out.tau_inf = Vec3(inf0, inf1, inf2);
     out.min_manipulability = std::sqrt(min_w2);
-    out.torque_sq_integral = f5;
-    out.power_sq_integral = f6;
+    out.torque_sq_integral = dt * (f5 - 0.5 * (first5 + last5));
+    out.power_sq_integral = dt * (f6 - 0.5 * (first6 + last6));
     out.max_tracking_error = std::sqrt(max_err2);
   }
   out.final_alpha = last_alpha;
