@@ -94,6 +94,42 @@ class Resolver {
   const std::optional<Profile1>& alpha_;
 };
 
+/// The square roots and divisions of E and E_M, taken a block of samples at a time: in the step they
+/// would compete for the divider with the step's own division and hold the out-of-order window
+/// behind them; a block runs back to back, vectorised. The sums are taken in sample order, so the
+/// result is the same as summing sample by sample.
+class RootSums {
+ public:
+  RootSums() {
+    for (double& d : det_) d = 1.0;  // the unfilled tail of a last, partial block stays harmless
+  }
+  /// tt = tau^T tau; qf / det = tau^T M^-1 tau.
+  void add(double tt, double qf, double det) {
+    tt_[n_] = tt;
+    qf_[n_] = qf;
+    det_[n_] = det;
+    if (++n_ == kBlock) flush();
+  }
+  void flush() {
+    alignas(32) double e[kBlock], em[kBlock];
+    for (int j = 0; j < kBlock; ++j) {  // whole block: fixed trip count, vectorised
+      e[j] = std::sqrt(tt_[j]);
+      em[j] = std::sqrt(qf_[j] / det_[j]);
+    }
+    for (int j = 0; j < n_; ++j) {
+      sumE += e[j];
+      sumEM += em[j];
+    }
+    n_ = 0;
+  }
+  double sumE = 0, sumEM = 0;
+
+ private:
+  static constexpr int kBlock = 32;
+  alignas(32) double tt_[kBlock] = {}, qf_[kBlock] = {}, det_[kBlock];
+  int n_ = 0;
+};
+
 }  // namespace
 
 TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const TrajectoryOptions& o,
@@ -133,7 +169,8 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
   const Resolver resolver(arm, path, o, alpha_profile);
   Evaluation e, s;  // e: at the sample; s: RK4 stages
   TrigTracker trig(q);  // the sample's trig, carried from step to step (semi-implicit Euler)
-  double sumE = 0, sumEM = 0, min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0;
+  RootSums roots;
+  double min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0;
   double f5 = 0, f6 = 0, first5 = 0, first6 = 0, last5 = 0, last6 = 0;
   double inf0 = 0, inf1 = 0, inf2 = 0;
   const double dt = o.dt;
@@ -157,8 +194,7 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
       break;
     }
     // metrics of this sample
-    sumE += std::sqrt(tt);
-    sumEM += std::sqrt(e.Mi.inverse_quadratic_form(tau));
+    roots.add(tt, e.Mi.P.quadratic_form(tau), e.Mi.det);
     inf0 = std::max(inf0, a0);
     inf1 = std::max(inf1, a1);
     inf2 = std::max(inf2, a2);
@@ -218,9 +254,10 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
     }
   }
   out.samples = done;
+  roots.flush();
   if (done > 0) {
-    out.E = sumE / static_cast<double>(done);
-    out.E_M = sumEM / static_cast<double>(done);
+    out.E = roots.sumE / static_cast<double>(done);
+    out.E_M = roots.sumEM / static_cast<double>(done);
     out.tau_inf = Vec3(inf0, inf1, inf2);
     out.min_manipulability = std::sqrt(min_w2);
     out.torque_sq_integral = dt * (f5 - 0.5 * (first5 + last5));
