@@ -19,7 +19,9 @@ struct ResultsWriter::Impl {
   detail::Hid file, runs, histories, landscapes, done_dset;
   std::vector<detail::Hid> col_dsets;
   std::vector<std::uint8_t> done;       // committed or pending
-  std::map<std::int64_t, Record> pending;
+  std::map<std::int64_t, Record> pending;   // rows not yet in the datasets
+  std::vector<hsize_t> unflagged;           // rows in the datasets, not yet committed with done = 1
+  static constexpr std::size_t kRowBatch = 512;
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false, broken = false;
 
@@ -36,7 +38,8 @@ struct ResultsWriter::Impl {
   }
   void open_objects();
   void write_history(std::int64_t id, const EncodedHistory& h);
-  void do_flush();
+  void write_rows();  // pending rows into the datasets (no commit)
+  void do_flush();    // write_rows, commit, set done flags, commit
 };
 
 }  // namespace ks::store
