@@ -4,7 +4,9 @@
 // M^-1 = adj(M) / det(M) those products need no division, and the single division of the step comes
 // at its very end (see local_acceleration): no square root, no chain of divisions on the step's
 // critical path. M is symmetric positive definite and well conditioned for the arms studied, so the
-// adjugate form loses nothing measurable (the results match the factorised forms to ~1e-15).
+// adjugate form (Cramer's rule) loses nothing measurable: cond(M) < 1e3 over all configurations and
+// local_acceleration agrees with LU solves to 1e-11 (both tested). It replaced a scalar LDL^T, whose
+// divisions and triangular solves on the chain cost about 25 us more per 2001-step run.
 // Non-finite or singular input yields non-finite output, which the simulation reports; never throws.
 #include "model/kinematics.hpp"
 
