@@ -134,6 +134,10 @@ TEST(StudyErrors, MoreBlockMistakes) {
   expect_error_at(kTraj + "k = 0.5\n[block.axes]\nk = [0, 1]\n", 4, 1, "both a fixed parameter and an axis");
   expect_error_at(kTraj + "vertex_alpha = [1, 2, 3]\n", 4, 16, "expected an array of 4 angles");
   expect_error_at(kTraj + "dt = -1\n", 4, 6, "expected dt > 0");
+  // a dt that asks for more than 1e7 samples on the 2 s square, fixed or swept, and in [task]
+  expect_error_at(kTraj + "dt = 1e-9\n", 4, 6, "samples on the 2 s path; expected at most");
+  expect_error_at(kTraj + "[block.axes]\ndt = [1e-3, 1e-8]\n", 5, 13, "expected at most");
+  expect_error_at("[task]\ndt = 1e-8\n" + kTraj, 2, 6, "samples on the 2 s path");
   expect_error_at("[study]\nhistories = \"every=0\"\n" + kTraj, 2, 13, "every=N");
   expect_error_at("[study]\nname = \"x\"\n", 1, 1, "no blocks");
   expect_error_at("[block]\nname = \"b\"\nkind = \"ik\"\n", 1, 1, "expected [[block]] tables");

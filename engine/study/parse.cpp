@@ -205,7 +205,12 @@ class Parser {
   StudyOptions options_;
   std::vector<StudyDiagnostic> diags_;
   std::uint64_t max_runs_ = 0;
+  double path_duration_ = 2.0;  // [s], the task's; bounds the samples a dt asks for
 };
+
+/// At most this many samples per trajectory run (the seed takes 2001): each thread keeps the sampled
+/// path, and a full history holds 16 doubles per sample.
+constexpr double kMaxSamples = 1e7;
 
 void Parser::check_keys(const toml::table& t, const std::vector<std::string>& allowed, std::string_view where) {
   for (auto&& [k, n] : ordered(t)) {
@@ -419,8 +424,12 @@ void Parser::parse_task(const toml::table& root, Study& s) {
       s.task.durations = d;
     }
   }
+  if (!s.task.durations.empty()) {
+    path_duration_ = 0;
+    for (double d : s.task.durations) path_duration_ += d;
+  }
   if (auto v = get_number(*t, "dt", "dt")) {
-    if (*v <= 0) error(*t->get("dt"), "dt = " + fmt(*v) + "; expected dt > 0 [s]");
+    if (auto p = domain_problem("dt", *v); !p.empty()) error(*t->get("dt"), p + " [s]");
     else s.task.dt = *v;
   }
   if (auto v = get_string(*t, "integrator", "integrator")) {
@@ -434,6 +443,10 @@ void Parser::parse_task(const toml::table& root, Study& s) {
 std::string Parser::domain_problem(const std::string& name, double v) {
   if ((name == "dt" || name == "torque_bound" || name == "tol") && !(v > 0))
     return name + " = " + fmt(v) + "; expected " + name + " > 0";
+  if (name == "dt" && path_duration_ / v + 1 > kMaxSamples)
+    return "dt = " + fmt(v) + " gives " + fmt(std::floor(path_duration_ / v) + 1) + " samples on the " +
+           fmt(path_duration_) + " s path; expected at most " + fmt(kMaxSamples) + " (dt >= " +
+           fmt(path_duration_ / (kMaxSamples - 1)) + ")";
   if ((name == "lambda" || name == "K_N") && v < 0) return name + " = " + fmt(v) + "; expected " + name + " >= 0";
   if (name == "max_iter" && v < 1) return "max_iter = " + fmt(v) + "; expected max_iter >= 1";
   return "";

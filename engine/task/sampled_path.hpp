@@ -6,6 +6,8 @@
 // choosing a segment and evaluating three quintics.
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "task/quintic_path.hpp"
@@ -19,8 +21,12 @@ inline std::size_t sample_count(double duration, double dt) {
 
 class SampledPath {
  public:
-  /// path: positions [m] over time [s]; dt > 0 [s].
+  /// path: positions [m] over time [s]; dt > 0 [s] (std::invalid_argument otherwise, or for more
+  /// than 1e8 samples: study files are checked for that before any run).
   SampledPath(Path2 path, double dt) : path_(std::move(path)), dt_(dt) {
+    if (!(dt_ > 0) || !(path_.duration() / dt_ < 1e8))
+      throw std::invalid_argument("SampledPath: dt = " + std::to_string(dt_) + " s on a " +
+                                  std::to_string(path_.duration()) + " s path");
     const std::size_t n = sample_count(path_.duration(), dt_);
     xa_.resize(4 * n);
     segment_.resize(n);
