@@ -42,6 +42,14 @@ void shuffle8(const double* src, std::size_t n, unsigned char* dst) {
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = 0; j < 8; ++j) dst[j * n + i] = s[i * 8 + j];
 }
+/// The byte-shuffled array as one zlib stream, the format HDF5's deflate filter reads. The six
+/// low-order byte planes of a history's doubles are close to noise (deflate gains ~4 % on them at
+/// the price of most of its time), so they go into the stream as stored blocks, copied; only the two
+/// high planes (sign, exponent, top of the mantissa: 2.5x and 50x smaller) are deflated, at `level`.
+/// The stream: zlib header, stored blocks (BFINAL = 0, each ending on a byte boundary), libdeflate's
+/// raw deflate of the high planes (its last block final), Adler-32 of all the bytes. Empty on failure.
+std::vector<unsigned char> zlib_stream_high_planes(const unsigned char* shuffled, std::size_t n, int level);
+
 /// One libdeflate compressor per thread and level (allocating one costs more than a small array).
 libdeflate_compressor* compressor(int level) {
   struct Cache {
@@ -54,6 +62,39 @@ libdeflate_compressor* compressor(int level) {
   thread_local Cache cache;
   if (!cache.c[level]) cache.c[level] = libdeflate_alloc_compressor(level);
   return cache.c[level];
+}
+
+std::vector<unsigned char> zlib_stream_high_planes(const unsigned char* shuffled, std::size_t n, int level) {
+  const std::size_t total = 8 * n, low = 6 * n;  // planes 0..5 stored, 6..7 deflated
+  libdeflate_compressor* c = compressor(level);
+  if (!c) return {};
+  const std::size_t stored_blocks = (low + 65534) / 65535;
+  std::vector<unsigned char> out(2 + low + 5 * stored_blocks + libdeflate_deflate_compress_bound(c, total - low) + 4);
+  unsigned char* p = out.data();
+  *p++ = 0x78;  // CMF: deflate, 32 KiB window
+  *p++ = 0x01;  // FLG: no dictionary, (0x78 * 256 + 0x01) % 31 == 0
+  for (std::size_t at = 0; at < low;) {
+    const std::size_t len = std::min<std::size_t>(65535, low - at);
+    *p++ = 0x00;  // BFINAL = 0, BTYPE = 00 (stored), then padding to the byte boundary
+    *p++ = static_cast<unsigned char>(len & 0xff);
+    *p++ = static_cast<unsigned char>(len >> 8);
+    *p++ = static_cast<unsigned char>(~len & 0xff);
+    *p++ = static_cast<unsigned char>((~len >> 8) & 0xff);
+    std::memcpy(p, shuffled + at, len);
+    p += len;
+    at += len;
+  }
+  const std::size_t room = static_cast<std::size_t>(out.data() + out.size() - p) - 4;
+  const std::size_t m = libdeflate_deflate_compress(c, shuffled + low, total - low, p, room);
+  if (m == 0) return {};
+  p += m;
+  const std::uint32_t adler = libdeflate_adler32(1, shuffled, total);
+  *p++ = static_cast<unsigned char>(adler >> 24);
+  *p++ = static_cast<unsigned char>(adler >> 16);
+  *p++ = static_cast<unsigned char>(adler >> 8);
+  *p++ = static_cast<unsigned char>(adler);
+  out.resize(static_cast<std::size_t>(p - out.data()));
+  return out;
 }
 }  // namespace
 
@@ -76,12 +117,8 @@ EncodedHistory encode_history(const RunHistory& history, int level) {
       } else {  // shuffle, then deflate (zlib format, as HDF5's deflate filter writes it)
         shuffled.resize(src);
         shuffle8(a.data.data(), a.data.size(), shuffled.data());
-        libdeflate_compressor* c = compressor(level);
-        if (!c) throw StoreError("", "libdeflate: cannot allocate a compressor");
-        e.bytes.resize(libdeflate_zlib_compress_bound(c, src));
-        const std::size_t n = libdeflate_zlib_compress(c, shuffled.data(), src, e.bytes.data(), e.bytes.size());
-        if (n == 0) throw StoreError("", "libdeflate failed for history array '" + a.name + "'");
-        e.bytes.resize(n);
+        e.bytes = zlib_stream_high_planes(shuffled.data(), a.data.size(), level);
+        if (e.bytes.empty()) throw StoreError("", "libdeflate failed for history array '" + a.name + "'");
       }
     }
     out.arrays.push_back(std::move(e));
