@@ -166,6 +166,28 @@ TEST(StoreEncode, DeflateStreamDecodesToTheRawArray) {
   EXPECT_THROW(encode_history(RunHistory{{bad}}), StoreError);
 }
 
+// The same oracle (zlib's own inflate) on sizes around the 65535-byte stored-block limit of the
+// stream's low byte planes (6 n bytes: one, two and several stored blocks), smooth and random data.
+TEST(StoreEncode, StoredAndDeflatedPartsDecodeAtEverySize) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1e3, 1e3);
+  for (std::size_t rows : {1u, 7u, 3640u, 3641u, 10922u, 10923u, 40000u})
+    for (int level : {1, 9}) {
+      HistoryArray a{"x", "m", rows, 3, std::vector<double>(rows * 3)};
+      for (std::size_t i = 0; i < a.data.size(); ++i) a.data[i] = i % 2 ? u(rng) : std::sin(0.001 * i);
+      const auto e = encode_history(RunHistory{{a}}, level);
+      std::vector<unsigned char> shuffled(a.data.size() * 8 + 16);
+      uLongf n = static_cast<uLongf>(shuffled.size());
+      ASSERT_EQ(uncompress(shuffled.data(), &n, e.arrays[0].bytes.data(), e.arrays[0].bytes.size()), Z_OK) << rows;
+      ASSERT_EQ(n, a.data.size() * 8);
+      std::vector<double> back(a.data.size());
+      auto* b = reinterpret_cast<unsigned char*>(back.data());
+      for (std::size_t i = 0; i < back.size(); ++i)
+        for (std::size_t j = 0; j < 8; ++j) b[i * 8 + j] = shuffled[j * back.size() + i];
+      EXPECT_EQ(0, std::memcmp(back.data(), a.data.data(), n)) << rows << " rows, level " << level;
+    }
+}
+
 TEST(StoreEncode, ThreadSafeInWorkers) {
   std::vector<std::thread> th;
   std::vector<int> ok(4, 0);
