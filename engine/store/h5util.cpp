@@ -119,4 +119,22 @@ std::vector<std::string> read_str_list_attr(hid_t obj, const char* name) {
 
 bool link_exists(hid_t loc, const std::string& path) { return H5Lexists(loc, path.c_str(), H5P_DEFAULT) > 0; }
 
+std::vector<ColumnSpec> read_run_columns(hid_t file, const std::string& path, std::int64_t& n_runs) {
+  Hid runs(check(H5Gopen2(file, "runs", H5P_DEFAULT), path, "open /runs"));
+  n_runs = read_i64_attr(runs, "n_runs", -1);
+  std::vector<ColumnSpec> columns;
+  for (auto& name : read_str_list_attr(runs, "columns")) {
+    Hid d(check(H5Dopen2(runs, name.c_str(), H5P_DEFAULT), path, "open /runs/" + name));
+    Hid t(H5Dget_type(d));
+    ColumnSpec c;
+    c.name = name;
+    H5T_class_t cls = H5Tget_class(t);
+    c.type = cls == H5T_FLOAT ? CellType::f64 : cls == H5T_INTEGER ? CellType::i64 : CellType::str;
+    c.unit = read_str_attr(d, "unit");
+    c.description = read_str_attr(d, "description");
+    columns.push_back(std::move(c));
+  }
+  return columns;
+}
+
 }  // namespace ks::store::detail

@@ -70,5 +70,8 @@ std::string read_str_attr(hid_t obj, const char* name);  // "" when absent
 std::int64_t read_i64_attr(hid_t obj, const char* name, std::int64_t fallback);
 std::vector<std::string> read_str_list_attr(hid_t obj, const char* name);
 bool link_exists(hid_t loc, const std::string& path);
+/// The /runs column specs (name, type, unit, description) in file order, and the n_runs attribute
+/// (-1 when absent). Throws StoreError naming `path` when a column cannot be opened.
+std::vector<ColumnSpec> read_run_columns(hid_t file, const std::string& path, std::int64_t& n_runs);
 
 }  // namespace ks::store::detail

@@ -42,21 +42,9 @@ struct ResultsReader::Impl {
       meta.study_text = p ? p : "";
       H5Dvlen_reclaim(t, s, H5P_DEFAULT, &p);
     }
-    Hid runs(check(H5Gopen2(f, "runs", H5P_DEFAULT), path, "open /runs"));
-    n_runs = read_i64_attr(runs, "n_runs", -1);
-    for (auto& name : read_str_list_attr(runs, "columns")) {
-      Hid d(check(H5Dopen2(runs, name.c_str(), H5P_DEFAULT), path, "open /runs/" + name));
-      Hid t(H5Dget_type(d));
-      ColumnSpec c;
-      c.name = name;
-      H5T_class_t cls = H5Tget_class(t);
-      c.type = cls == H5T_FLOAT ? CellType::f64 : cls == H5T_INTEGER ? CellType::i64 : CellType::str;
-      c.unit = read_str_attr(d, "unit");
-      c.description = read_str_attr(d, "description");
-      columns.push_back(std::move(c));
-    }
+    columns = read_run_columns(f, path, n_runs);
     if (n_runs < 0) {
-      Hid d(check(H5Dopen2(runs, "done", H5P_DEFAULT), path, "open /runs/done"));
+      Hid d(check(H5Dopen2(f, "runs/done", H5P_DEFAULT), path, "open /runs/done"));
       n_runs = H5Sget_simple_extent_npoints(Hid(H5Dget_space(d)));
     }
   }

@@ -354,19 +354,7 @@ ResultsWriter::Resumed ResultsWriter::open_for_resume(const std::string& path, c
   if (lower(sha) != lower(expected_sha256))
     throw StoreError(path, "study sha256 mismatch: the file was written for study " + sha +
                                ", the study given now has " + expected_sha256 + " (refusing to resume)");
-  Hid runs(check(H5Gopen2(f, "runs", H5P_DEFAULT), path, "open /runs"));
-  impl->n_runs = read_i64_attr(runs, "n_runs", -1);
-  for (auto& name : read_str_list_attr(runs, "columns")) {
-    Hid d(check(H5Dopen2(runs, name.c_str(), H5P_DEFAULT), path, "open /runs/" + name));
-    Hid t(H5Dget_type(d));
-    ColumnSpec c;
-    c.name = name;
-    H5T_class_t cls = H5Tget_class(t);
-    c.type = cls == H5T_FLOAT ? CellType::f64 : cls == H5T_INTEGER ? CellType::i64 : CellType::str;
-    c.unit = read_str_attr(d, "unit");
-    c.description = read_str_attr(d, "description");
-    impl->columns.push_back(std::move(c));
-  }
+  impl->columns = read_run_columns(f, path, impl->n_runs);
   impl->open_objects();
   if (impl->n_runs < 0) impl->n_runs = H5Sget_simple_extent_npoints(Hid(H5Dget_space(impl->done_dset)));
   impl->done.assign(static_cast<std::size_t>(impl->n_runs), 0);
