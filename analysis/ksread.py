@@ -416,6 +416,17 @@ def save(fig, args, suffix):
     return out
 
 
+def finish(fig, args, suffix, data):
+    """Save the figure (see save); with --print-data print `data` plus the output path as JSON,
+    else print the path. Returns 0, the scripts' exit code."""
+    out = save(fig, args, suffix)
+    if args.print_data:
+        print_json({**data, "output": out})
+    else:
+        print(out)
+    return 0
+
+
 def print_json(obj):
     import json
 

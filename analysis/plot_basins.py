@@ -146,15 +146,11 @@ def main(argv=None):
                            + (f" ({', '.join(f'{k} = {v}' for k, v in fixed.items())})" if fixed else "")
                            + f"\n{os.path.basename(args.file)}")
     fig.suptitle(title, fontsize=11)
-    out = ksread.save(fig, args, f"basins_{ls.block}")
-    if args.print_data:
-        ksread.print_json({"file": args.file, "block": ls.block, "panel_axis": panel_axis,
-                           "x": {"name": xa.name, "unit": xa.unit, "values": xa.values},
-                           "y": {"name": ya.name, "unit": ya.unit, "values": ya.values},
-                           "panels": data_panels, "solutions": sol_label, "output": out})
-    else:
-        print(out)
-    return 0
+    return ksread.finish(fig, args, f"basins_{ls.block}",
+        {"file": args.file, "block": ls.block, "panel_axis": panel_axis,
+         "x": {"name": xa.name, "unit": xa.unit, "values": xa.values},
+         "y": {"name": ya.name, "unit": ya.unit, "values": ya.values},
+         "panels": data_panels, "solutions": sol_label})
 
 
 if __name__ == "__main__":

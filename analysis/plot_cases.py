@@ -68,13 +68,9 @@ def main(argv=None):
     ax.legend(fontsize=9, loc="upper left")
     ax.set_title(args.title or f"{LABELS[args.metric]} per case: thesis beside kinesweep (labels: deviation ≥ 1 %)\n"
                  f"{os.path.basename(args.file)}", fontsize=10)
-    out = ksread.save(fig, args, f"cases_{args.metric}")
-    if args.print_data:
-        ksread.print_json({"file": args.file, "metric": args.metric, "unit": unit, "cases": cases,
-                           "run_ids": ids, "kinesweep": ours, "thesis": thesis, "output": out})
-    else:
-        print(out)
-    return 0
+    return ksread.finish(fig, args, f"cases_{args.metric}",
+        {"file": args.file, "metric": args.metric, "unit": unit, "cases": cases,
+         "run_ids": ids, "kinesweep": ours, "thesis": thesis})
 
 
 if __name__ == "__main__":

@@ -98,12 +98,7 @@ def main(argv=None):
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     q = f" from q0 = ({args.start}) deg" if args.start else ""
     ax.set_title(args.title or f"Convergence ‖F_k‖ per method and λ{q}\n{os.path.basename(args.file)}", fontsize=10)
-    out = ksread.save(fig, args, "convergence")
-    if args.print_data:
-        ksread.print_json({"file": args.file, "runs": data, "output": out})
-    else:
-        print(out)
-    return 0
+    return ksread.finish(fig, args, "convergence", {"file": args.file, "runs": data})
 
 
 if __name__ == "__main__":

@@ -89,12 +89,7 @@ def main(argv=None):
     title = args.title or (f"{', '.join(NAMES.get(w, w) for w in whats)} against time, "
                            f"{'; '.join(label[r] for r in ids)}\n{os.path.basename(args.file)}")
     fig.suptitle(title, fontsize=10)
-    out = ksread.save(fig, args, "histories")
-    if args.print_data:
-        ksread.print_json({"file": args.file, "runs": data, "output": out})
-    else:
-        print(out)
-    return 0
+    return ksread.finish(fig, args, "histories", {"file": args.file, "runs": data})
 
 
 if __name__ == "__main__":

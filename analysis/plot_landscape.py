@@ -319,17 +319,13 @@ def main(argv=None):
     title = args.title or (f"{what} over {xa.name} × {ya.name} — block {ls.block}{(' (' + sub + ')') if sub else ''}"
                            f"\n{os.path.basename(args.file)}{' (log colour scale)' if args.log else ''}")
     ax.set_title(title, fontsize=10)
-    out = ksread.save(fig, args, f"landscape_{ls.block}_{metric}")
-    if args.print_data:
-        ksread.print_json({"file": args.file, "block": ls.block, "metric": metric, "unit": unit,
-                           "reduce": d["reduce"], "fixed": d["fixed"],
-                           "x": {"name": xa.name, "unit": xa.unit, "values": xa.values, "labels": xa.labels},
-                           "y": {"name": ya.name, "unit": ya.unit, "values": ya.values, "labels": ya.labels},
-                           "z": z, "masked_status": [[(ls.statuses[c] if c >= 0 else None) for c in row] for row in cat],
-                           "best": best, "thesis": thesis, "optimization": opt, "output": out})
-    else:
-        print(out)
-    return 0
+    return ksread.finish(fig, args, f"landscape_{ls.block}_{metric}",
+        {"file": args.file, "block": ls.block, "metric": metric, "unit": unit,
+         "reduce": d["reduce"], "fixed": d["fixed"],
+         "x": {"name": xa.name, "unit": xa.unit, "values": xa.values, "labels": xa.labels},
+         "y": {"name": ya.name, "unit": ya.unit, "values": ya.values, "labels": ya.labels},
+         "z": z, "masked_status": [[(ls.statuses[c] if c >= 0 else None) for c in row] for row in cat],
+         "best": best, "thesis": thesis, "optimization": opt})
 
 
 if __name__ == "__main__":

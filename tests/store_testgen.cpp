@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "store/store.hpp"
+#include "store_testgen.hpp"
 
 namespace ks::store_test {
 

@@ -13,14 +13,7 @@
 #include <vector>
 
 #include "store/store.hpp"
-
-namespace ks::store_test {
-std::vector<ColumnSpec> test_columns();
-Record test_record(std::int64_t id);
-RunHistory test_history(std::int64_t id);
-store::StoreMeta test_meta();
-store::LandscapeSpec test_landscape();
-}  // namespace ks::store_test
+#include "store_testgen.hpp"
 
 int main(int argc, char** argv) {
   using namespace ks;
