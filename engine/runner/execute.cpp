@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <optional>
+#include <vector>
 
 #include "ik/solve.hpp"
 #include "methods/trajectory.hpp"
@@ -73,16 +74,19 @@ const std::vector<ColumnSpec>& metric_columns(BlockKind kind) {
 
 struct RunWorkspace::Impl {
   const Study* study = nullptr;
-  std::optional<SampledPath> path;  // the study's path sampled at the last dt asked for
+  std::vector<SampledPath> paths;  // the study's path sampled at the last few dt asked for
   TrajectoryHistory history;
   ik::Summary<3, 3> s33;
   ik::Summary<3, 2> s32;
   const SampledPath& path_of(const Study& s, double dt) {
-    if (study != &s || !path || path->dt() != dt) {
-      path.emplace(s.task.path(), dt);
+    if (study != &s) {
+      paths.clear();
       study = &s;
     }
-    return *path;
+    for (const SampledPath& p : paths)  // a dt axis alternates between a few values: keep them all
+      if (p.dt() == dt) return p;
+    if (paths.size() == 8) paths.erase(paths.begin());
+    return paths.emplace_back(s.task.path(), dt);
   }
 };
 RunWorkspace::RunWorkspace() : impl_(std::make_unique<Impl>()) {}
