@@ -12,12 +12,19 @@ enum class CellType { f64, i64, str };
 /// One value of a /runs column. Missing values: NaN (f64), -1 (i64), "" (str).
 using Cell = std::variant<double, std::int64_t, std::string>;
 
-/// A column of /runs: its name (the user's word: "alpha1A", "E", "status", ...), type, unit, meaning.
+/// What a /runs column holds (stored as its `role` attribute: "parameter", "metric", "bookkeeping").
+enum class Role { parameter, metric, bookkeeping };
+
+/// A column of /runs: its name (the user's word: "alpha1A", "E", "status", ...), type, unit, meaning,
+/// role and the run kinds it applies to. All are stored as attributes, so readers need no guessing.
 struct ColumnSpec {
   std::string name;
   CellType type = CellType::f64;
   std::string unit;         ///< "rad", "Nm", "" for dimensionless or strings
   std::string description;  ///< one line, stored as an HDF5 attribute
+  Role role = Role::bookkeeping;
+  std::string kinds;        ///< comma-separated run kinds the column applies to ("trajectory", "ik",
+                            ///< "trajectory,ik"); "" for bookkeeping columns that apply to every run
 };
 
 /// One result row: one cell per ColumnSpec of the study's schema, in schema order.
