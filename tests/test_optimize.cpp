@@ -23,7 +23,6 @@ using namespace ks;
 namespace fs = std::filesystem;
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 /// Shifted, scaled Rosenbrock in 2-D (minimum 1.5 at (0.7, 0.49)) plus a quadratic in further dims.
 opt::Problem smooth(std::size_t dims) {

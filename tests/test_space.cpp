@@ -13,7 +13,6 @@
 using namespace ks;
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
 const std::string kTraj = "[[block]]\nname = \"b\"\nkind = \"trajectory\"\n";
 
 Axis num_axis(std::string name, std::vector<double> v) {

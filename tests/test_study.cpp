@@ -13,7 +13,6 @@
 using namespace ks;
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 std::string studies_dir() { return std::string(KS_SOURCE_DIR) + "/studies/"; }
 

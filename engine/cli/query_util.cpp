@@ -7,7 +7,7 @@
 #include <ostream>
 #include <set>
 
-#include "runner/execute.hpp"
+#include "schema/params.hpp"
 
 namespace ks::cli {
 
@@ -28,13 +28,13 @@ ColumnRole RunsTable::role(const std::string& name) {
   if (name == "block") return ColumnRole::block;
   if (name == "status") return ColumnRole::status;
   if (name == "wall_time" || name == "done") return ColumnRole::other;
-  static const std::set<std::string> metrics = [] {
+  static const std::set<std::string> metric_names = [] {
     std::set<std::string> m;
-    for (const auto& c : metric_columns(BlockKind::trajectory)) m.insert(c.name);
-    for (const auto& c : metric_columns(BlockKind::ik)) m.insert(c.name);
+    for (BlockKind k : block_kinds())
+      for (const auto& c : ks::metrics(k)) m.insert(c.name);
     return m;
   }();
-  return metrics.count(name) ? ColumnRole::metric : ColumnRole::parameter;
+  return metric_names.count(name) ? ColumnRole::metric : ColumnRole::parameter;
 }
 
 std::string RunsTable::kind(std::int64_t row) const {

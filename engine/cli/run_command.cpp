@@ -84,9 +84,9 @@ int dry_run(const Study& study, const StudySchema& schema, const HistoryPolicy& 
   for (std::uint64_t i = 0; i < samples; ++i) {
     const std::uint64_t id = samples > 1 ? i * (total - 1) / (samples - 1) : 0;
     const RunRef ref = study.locate(id);
-    const auto params = study.blocks[ref.block].params(ref.local);
+    const RunSpec run = study.blocks[ref.block].run(ref.local);
     const auto t0 = std::chrono::steady_clock::now();
-    const RunOutcome o = execute_run(study, ref.block, params, stride, ws);
+    const RunOutcome o = execute(Scenario::of(study), run, stride, ws);
     const store::EncodedHistory encoded = store::encode_history(o.history, level);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const auto& a : encoded.arrays) bytes += static_cast<double>(a.bytes.size()) + 600;

@@ -16,6 +16,7 @@
 #include <string_view>
 #include <vector>
 
+#include "common/domain.hpp"
 #include "ik/planar_problems.hpp"
 #include "ik/problem.hpp"
 #include "ik/scara.hpp"
@@ -58,7 +59,7 @@ bool parse(std::string_view name, Status& out);
 struct Options {
   Method method = Method::newton;
   double tolerance = 1e-6;        ///< stop when ||F|| < tolerance (units of F; the seed's 1e-6 mm)
-  int max_iter = 500;             ///< at most this many updates (lm_adaptive: rejected trials do not count)
+  int max_iter = 1000;            ///< at most this many updates (lm_adaptive: rejected trials do not count)
   double step_floor = 1e-14;      ///< stalled when ||delta|| falls below this (units of q)
   double lambda = 0.1;            ///< lm: the fixed damping (the seed runs 0.1 and 10) [units of J^2]
   double lambda_scale = 1e-3;     ///< lm_adaptive: initial lambda = lambda_scale * max diag(J^T J)
@@ -80,6 +81,22 @@ struct Options {
   /// far apart except near a singularity.
   double match_tolerance = 1e-3;
   bool keep_history = true;       ///< record the history (off: no allocation at all in a solve)
+
+  /// The rules on the fields (checked by IsValid; the study schema reports them at the key).
+  static constexpr Domain tolerance_rule = Domain::positive();
+  static constexpr Domain max_iter_rule = Domain::at_least(1);
+  static constexpr Domain lambda_rule = Domain::nonnegative();
+  static constexpr Domain step_floor_rule = Domain::nonnegative();
+  static constexpr Domain lambda_scale_rule = Domain::positive();
+  static constexpr Domain rcond_min_rule = Domain::nonnegative();
+  static constexpr Domain divergence_bound_rule = Domain::positive();
+  static constexpr Domain cycle_tolerance_rule = Domain::nonnegative();
+  static constexpr Domain match_tolerance_rule = Domain::positive();
+  static constexpr int max_cycle_window = 16;
+
+  /// True when every field is finite and within its rule (cycle_window within [0, 16]); otherwise
+  /// false, with `why` (when given) naming the field and the rule, e.g. "max_iter = 0; expected max_iter >= 1".
+  bool IsValid(std::string* why = nullptr) const;
 };
 
 /// Iteration history: row k is iterate k (k = 0 the start). lm_adaptive records accepted iterates.

@@ -3,6 +3,8 @@
 
 #include "methods/trajectory.hpp"
 
+#include <cmath>
+
 namespace ks {
 namespace {
 constexpr NameTable<TrajectoryMethod, 3> kMethods{{{TrajectoryMethod::local_weighted, "local_weighted"},
@@ -23,5 +25,31 @@ std::string_view to_string(RunStatus s) { return name_of(kStatuses, s); }
 bool parse(std::string_view n, TrajectoryMethod& out) { return value_of(kMethods, n, out); }
 bool parse(std::string_view n, Integrator& out) { return value_of(kIntegrators, n, out); }
 bool parse(std::string_view n, RunStatus& out) { return value_of(kStatuses, n, out); }
+
+}  // namespace ks
+
+namespace ks {
+
+bool TrajectoryOptions::IsValid(std::string* why) const {
+  auto bad = [&](std::string msg) {
+    if (why) *why = std::move(msg);
+    return false;
+  };
+  const std::pair<const char*, std::pair<double, Domain>> fields[] = {
+      {"k", {k, Domain::any()}},
+      {"alpha1A", {alpha1A, Domain::any()}},
+      {"null_damping", {null_damping, null_damping_rule}},
+      {"dt", {dt, dt_rule}},
+      {"torque_bound", {torque_bound, torque_bound_rule}},
+      {"singular_tolerance", {singular_tolerance, singular_tolerance_rule}},
+  };
+  for (const auto& [name, vr] : fields) {
+    if (!std::isfinite(vr.first)) return bad(std::string(name) + " is not finite; expected a finite number");
+    if (auto p = vr.second.problem(name, vr.first); !p.empty()) return bad(p);
+  }
+  for (double a : vertex_alpha)
+    if (!std::isfinite(a)) return bad("vertex_alpha has a value that is not finite; expected finite angles [rad]");
+  return true;
+}
 
 }  // namespace ks

@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include "common/domain.hpp"
 #include "model/arm.hpp"
 #include "model/kinematics.hpp"
 #include "task/quintic_path.hpp"
@@ -54,6 +55,16 @@ struct TrajectoryOptions {
   double torque_bound = 1.0e6;        ///< |tau_i| above this [Nm] stops the run as diverged
   /// singular when sqrt(det(J J^T)) [m^2] (local methods) or |det J3| (vertex_alpha) falls below this
   double singular_tolerance = 1.0e-9;
+
+  /// The rules on the fields (checked by IsValid; the study schema reports them at the key).
+  static constexpr Domain null_damping_rule = Domain::nonnegative();
+  static constexpr Domain dt_rule = Domain::positive();
+  static constexpr Domain torque_bound_rule = Domain::positive();
+  static constexpr Domain singular_tolerance_rule = Domain::nonnegative();
+
+  /// True when every field is finite and within its rule; otherwise false, with `why` (when given)
+  /// naming the field and the rule, e.g. "dt = -0.001; expected dt > 0".
+  bool IsValid(std::string* why = nullptr) const;
 };
 
 /// Figures of merit of one run (seed Eq. 60 and seed 002's measures).

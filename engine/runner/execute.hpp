@@ -1,28 +1,19 @@
 #pragma once
-// One run: a block's parameter cells -> model + method -> metric cells, status and history.
-// A run is a pure function of its parameters (no shared state), which is what makes results
-// independent of the thread count and resume exact.
-#include <cstdint>
+// One run: (model and task constants, typed run spec, workspace) -> typed outcome. A run is a pure
+// function of its spec (no shared state), which is what makes results independent of the thread
+// count and resume exact.
 #include <memory>
-#include <span>
-#include <string>
-#include <vector>
 
-#include "store/record.hpp"
+#include "schema/run_spec.hpp"
 #include "study/study.hpp"
 
 namespace ks {
 
-/// The metrics a kind writes to /runs (after the parameters), in order.
-const std::vector<ColumnSpec>& trajectory_metric_columns();
-const std::vector<ColumnSpec>& ik_metric_columns();
-const std::vector<ColumnSpec>& metric_columns(BlockKind kind);
-
-/// Outcome of one run, ready for the store.
-struct RunOutcome {
-  std::vector<Cell> metrics;  ///< metric_columns(kind) order
-  std::string status;         ///< the kind's status name (ok, diverged, converged, max_iter, ...)
-  RunHistory history;         ///< empty when histories are off
+/// The constants a run executes against: the study's robot and task (not copied).
+struct Scenario {
+  const PlanarArm3* robot = nullptr;
+  const StudyTask* task = nullptr;
+  static Scenario of(const Study& s) { return {&s.robot, &s.task}; }
 };
 
 /// Per-thread buffers reused from run to run (no allocation per time step or iteration).
@@ -37,9 +28,8 @@ class RunWorkspace {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Execute run `local` of block `block` of the study. `history_stride`: 0 = no history, N = every
-/// N-th sample (trajectory) or iteration (ik). Never throws on bad numbers: trouble is a status.
-RunOutcome execute_run(const Study& study, std::size_t block, std::span<const Cell> params, int history_stride,
-                       RunWorkspace& workspace);
+/// Execute one run. `history_stride`: 0 = no history, N = every N-th sample (trajectory) or
+/// iteration (ik). Never throws on bad numbers: trouble is the outcome's status.
+RunOutcome execute(const Scenario& scenario, const RunSpec& run, int history_stride, RunWorkspace& workspace);
 
 }  // namespace ks

@@ -7,19 +7,6 @@ namespace ks {
 namespace {
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Gridded metrics per kind: metric columns by name, plus status-derived grids.
-const std::vector<std::string>& grid_metrics(BlockKind k) {
-  static const std::vector<std::string> traj{"E", "E_M", "tau_inf", "tau1_inf", "tau2_inf", "tau3_inf",
-                                             "min_manipulability", "max_tracking_error", "ok", "status_code"};
-  static const std::vector<std::string> ik{"converged", "iterations", "solution", "error", "status_code"};
-  return k == BlockKind::trajectory ? traj : ik;
-}
-const std::vector<std::string>& status_names(BlockKind k) {
-  static const std::vector<std::string> traj{"ok", "unreachable_start", "singular", "diverged"};
-  static const std::vector<std::string> ik{"converged", "stalled", "singular", "max_iter",
-                                           "cycle",     "diverged", "unsupported", "no_solution"};
-  return k == BlockKind::trajectory ? traj : ik;
-}
 double number(const Cell& c) {
   if (const double* d = std::get_if<double>(&c)) return *d;
   if (const std::int64_t* i = std::get_if<std::int64_t>(&c)) return static_cast<double>(*i);
@@ -28,16 +15,20 @@ double number(const Cell& c) {
 }  // namespace
 
 LandscapeGrid::LandscapeGrid(const Block& block) : block_(block) {
-  names_ = grid_metrics(block.kind());
-  const auto& cols = metric_columns(block.kind());
-  for (const std::string& n : names_) {
-    sources_.push_back(n == "ok" || n == "converged" ? Source::is_ok
-                       : n == "status_code"          ? Source::status_code
-                                                     : Source::column);
-    std::size_t j = 0;
-    while (j < cols.size() && cols[j].name != n) ++j;
-    metric_index_.push_back(j);
-  }
+  // The good-status grid (ok / converged), the metrics marked gridded, the status code.
+  const auto& ms = metrics(block.kind());
+  names_.emplace_back(statuses(block.kind()).front());
+  sources_.push_back(Source::is_ok);
+  metric_index_.push_back(ms.size());
+  for (std::size_t j = 0; j < ms.size(); ++j)
+    if (ms[j].gridded) {
+      names_.push_back(ms[j].name);
+      sources_.push_back(Source::column);
+      metric_index_.push_back(j);
+    }
+  names_.emplace_back("status_code");
+  sources_.push_back(Source::status_code);
+  metric_index_.push_back(ms.size());
   enabled_ = block.run_count() <= kMaxLandscapeCells && !block.overflowed();
   if (enabled_) grids_.assign(names_.size(), std::vector<double>(block.run_count(), kNaN));
 }
@@ -45,10 +36,10 @@ LandscapeGrid::LandscapeGrid(const Block& block) : block_(block) {
 void LandscapeGrid::add(std::uint64_t local, const Record& row, const StudySchema& schema, std::size_t b) {
   if (!enabled_) return;
   const std::string& status = std::get<std::string>(row.cells[schema.status]);
-  const auto& statuses = status_names(block_.kind());
+  const auto names = statuses(block_.kind());
   double code = kNaN;
-  for (std::size_t s = 0; s < statuses.size(); ++s)
-    if (statuses[s] == status) code = static_cast<double>(s);
+  for (std::size_t s = 0; s < names.size(); ++s)
+    if (names[s] == status) code = static_cast<double>(s);
   for (std::size_t m = 0; m < names_.size(); ++m) {
     double v = kNaN;
     switch (sources_[m]) {
@@ -56,7 +47,8 @@ void LandscapeGrid::add(std::uint64_t local, const Record& row, const StudySchem
       case Source::status_code: v = code; break;
       case Source::column:
         v = number(row.cells[schema.metric_column[b][metric_index_[m]]]);
-        if (names_[m] == "solution" && v < 0) v = kNaN;
+        if (std::holds_alternative<std::int64_t>(row.cells[schema.metric_column[b][metric_index_[m]]]) && v == -1.0)
+          v = kNaN;  // the missing integer (solution -1: none reached)
         break;
     }
     grids_[m][local] = v;
@@ -83,18 +75,16 @@ store::LandscapeSpec LandscapeGrid::spec() const {
     if (!labels.empty()) a.unit = "labels:" + labels;
     s.axes.push_back(std::move(a));
   }
-  const auto& cols = metric_columns(block_.kind());
-  const auto& statuses = status_names(block_.kind());
+  const auto& ms = metrics(block_.kind());
   for (std::size_t m = 0; m < names_.size(); ++m) {
     store::LandscapeMetric lm;
     lm.name = names_[m];
     lm.grid = grids_[m];
-    for (const ColumnSpec& c : cols)
-      if (c.name == lm.name) lm.unit = c.unit, lm.description = c.description;
-    if (lm.name == "ok" || lm.name == "converged") lm.description = "1 where the run's status is " + lm.name + ", else 0";
-    if (lm.name == "status_code") {
+    if (sources_[m] == Source::column) lm.unit = ms[metric_index_[m]].unit, lm.description = ms[metric_index_[m]].description;
+    if (sources_[m] == Source::is_ok) lm.description = "1 where the run's status is " + lm.name + ", else 0";
+    if (sources_[m] == Source::status_code) {
       lm.description = "index of the run's status in:";
-      for (const auto& st : statuses) lm.description += " " + st;
+      for (const auto& st : statuses(block_.kind())) lm.description += " " + std::string(st);
     }
     s.metrics.push_back(std::move(lm));
   }

@@ -28,7 +28,7 @@ class LandscapeGrid {
   bool enabled_ = false;
   std::vector<std::string> names_;            // metric names
   std::vector<Source> sources_;               // per metric
-  std::vector<std::size_t> metric_index_;     // per metric: index into metric_columns(kind) (Source::column)
+  std::vector<std::size_t> metric_index_;     // per metric: index into metrics(kind) (Source::column)
   std::vector<std::vector<double>> grids_;    // per metric
 };
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <numbers>
 #include <numeric>
@@ -29,75 +30,76 @@ double cell_num(const Cell& c) {
   return kNaN;
 }
 
-std::size_t metric_index(BlockKind kind, const std::string& name) {
-  const auto& cols = metric_columns(kind);
-  for (std::size_t i = 0; i < cols.size(); ++i)
-    if (cols[i].name == name) return i;
-  return cols.size();
-}
-
-/// Everything an evaluation needs, shared by the objective's copies (thread-safe: per-thread workspaces).
+/// Everything an evaluation needs, shared by the objective's copies (thread-safe: per-thread
+/// workspaces). Evaluates typed runs: the evaluation set's specs with the variables set to x.
 struct Evaluator {
-  Study study;  // the study with blocks = {the optimisation's base block}
+  const Study* study = nullptr;
+  Scenario scenario;
   const OptimizeBlock* ob = nullptr;
+  const Block* block = nullptr;              // the block whose runs are evaluated
   BlockKind kind = BlockKind::trajectory;
-  std::vector<std::vector<Cell>> set;       // parameters of the evaluation set's runs
-  std::vector<std::size_t> var_col;         // variable -> parameter column
-  std::vector<std::pair<std::size_t, double>> terms;  // metric index (or npos for failure_rate), weight
-  bool failure_rate = false;
+  std::vector<RunSpec> set;                  // the evaluation set's runs
+  std::vector<const ParamDef*> vars;         // the variables' table entries
+  std::vector<std::pair<const MetricDef*, double>> terms;  // metric (nullptr: failure_rate), weight
+  const MetricDef* stop_time = nullptr;      // trajectory: penalty of runs that stopped early
+  const MetricDef* iterations = nullptr;     // ik: counted as max_iter when not converged
   double duration = 0.0;
   bool reach_varies = false;
   tbb::enumerable_thread_specific<RunWorkspace> workspaces;
-  int threads = 0;
 
-  std::vector<Cell> params_at(std::size_t run, std::span<const double> x) const {
-    std::vector<Cell> p = set[run];
-    for (std::size_t i = 0; i < var_col.size(); ++i) p[var_col[i]] = x[i];
-    return p;
+  RunSpec run_at(std::size_t run, std::span<const double> x) const {
+    RunSpec r = set[run];
+    for (std::size_t i = 0; i < vars.size(); ++i) vars[i]->set(r, Cell(x[i]));
+    return r;
   }
-  const Block& block() const { return study.blocks.front(); }
 
-  /// Reach margin of one run's parameters: the start (local methods) or every vertex (vertex_alpha).
-  double margin_of(const std::vector<Cell>& p) const {
-    const Block& b = block();
-    const auto& verts = study.task.vertices;
-    const std::string& method = std::get<std::string>(p[b.column_index("method")]);
-    double m = reach_margin(study.robot, verts.front(), cell_num(p[b.column_index("alpha1A")]));
-    if (method == "vertex_alpha")
-      for (std::size_t v = 2; v <= verts.size(); ++v)
-        m = std::max(m, reach_margin(study.robot, verts[v - 1], cell_num(p[b.column_index("vertex_alpha_" + std::to_string(v))])));
+  /// Reach margin of a run: its start (local methods) or every vertex (vertex_alpha).
+  double margin_of(const RunSpec& r) const {
+    const auto& verts = study->task.vertices;
+    const TrajectoryOptions& o = std::get<TrajectoryRun>(r).options;
+    double m = reach_margin(study->robot, verts.front(), o.alpha1A);
+    if (o.method == TrajectoryMethod::vertex_alpha)
+      for (std::size_t v = 2; v <= verts.size() && v - 2 < o.vertex_alpha.size(); ++v)
+        m = std::max(m, reach_margin(study->robot, verts[v - 1], o.vertex_alpha[v - 2]));
     return m;
   }
   double constraint(std::span<const double> x) const {
     double m = -std::numeric_limits<double>::infinity();
-    for (std::size_t r = 0; r < set.size(); ++r) m = std::max(m, margin_of(params_at(r, x)));
+    for (std::size_t r = 0; r < set.size(); ++r) m = std::max(m, margin_of(run_at(r, x)));
     return m;
   }
 
-  /// One run's objective (penalised when it failed) and status.
-  std::pair<double, std::string> run_value(std::size_t run, std::span<const double> x, int stride, RunOutcome* keep) {
-    const std::vector<Cell> p = params_at(run, x);
-    RunOutcome o = execute_run(study, 0, p, stride, workspaces.local());
+  /// The objective of a run with status `good` (ok / converged) and metric values `metric(def)`
+  /// (from a fresh outcome or from a results file), penalised when it failed.
+  template <class MetricOf>
+  double value_of(const RunSpec& r, bool good, std::string_view status, MetricOf metric) const {
     double v = 0.0;
     if (kind == BlockKind::trajectory) {
-      if (o.status == "ok") {
-        for (const auto& [i, w] : terms) v += w * cell_num(o.metrics[i]);
-      } else if (o.status == "unreachable_start") {
-        v = ob->penalty * (2.0 + std::max(0.0, margin_of(p)));
+      if (good) {
+        for (const auto& [m, w] : terms) v += w * metric(*m);
+      } else if (status == "unreachable_start") {
+        v = ob->penalty * (2.0 + std::max(0.0, margin_of(r)));
       } else {  // singular / diverged: the earlier it stopped, the worse
-        const double t = cell_num(o.metrics[metric_index(kind, "stop_time")]);
+        const double t = metric(*stop_time);
         v = ob->penalty * (1.0 + std::clamp(1.0 - (std::isfinite(t) ? t : 0.0) / duration, 0.0, 1.0));
       }
     } else {
-      const bool conv = o.status == "converged";
-      for (const auto& [i, w] : terms) {
-        if (i == std::size_t(-1)) v += w * (conv ? 0.0 : 1.0);
-        else if (i == metric_index(kind, "iterations") && !conv) v += w * cell_num(p[block().column_index("max_iter")]);
-        else v += w * cell_num(o.metrics[i]);
+      for (const auto& [m, w] : terms) {
+        if (!m) v += w * (good ? 0.0 : 1.0);
+        else if (m == iterations && !good) v += w * std::get<IkRun>(r).options.max_iter;
+        else v += w * metric(*m);
       }
     }
     if (!std::isfinite(v)) v = ob->penalty * 3.0;
-    std::string status = o.status;
+    return v;
+  }
+
+  /// One run's objective and status.
+  std::pair<double, std::string> run_value(std::size_t run, std::span<const double> x, int stride, RunOutcome* keep) {
+    const RunSpec r = run_at(run, x);
+    RunOutcome o = execute(scenario, r, stride, workspaces.local());
+    const double v = value_of(r, o.good(), o.status(), [&](const MetricDef& m) { return cell_num(m.get(o)); });
+    std::string status(o.status());
     if (keep) *keep = std::move(o);
     return {v, std::move(status)};
   }
@@ -114,41 +116,46 @@ struct Evaluator {
     double sum = 0.0;
     std::size_t bad = 0;
     std::string first_bad;
+    const std::string good(statuses(kind).front());
     for (const auto& [v, s] : r) {
       sum += v;
-      const bool good = kind == BlockKind::trajectory ? s == "ok" : s == "converged";
-      if (!good && bad++ == 0) first_bad = s;
+      if (s != good && bad++ == 0) first_bad = s;
     }
-    std::string status = bad == 0 ? (kind == BlockKind::trajectory ? "ok" : "converged")
-                                  : first_bad + " (" + std::to_string(bad) + "/" + std::to_string(n) + " runs)";
+    std::string status = bad == 0 ? good : first_bad + " (" + std::to_string(bad) + "/" + std::to_string(n) + " runs)";
     return {sum / static_cast<double>(n), status};
   }
 };
 
-std::shared_ptr<Evaluator> make_evaluator(const Study& study, std::size_t index) {
+/// The evaluator of optimisation `index` over the runs of `block` (its base block, or the
+/// polish_from block whose cells are ranked).
+std::shared_ptr<Evaluator> make_evaluator(const Study& study, std::size_t index, const Block& block) {
   const OptimizeBlock& ob = study.optimizations.at(index);
   auto e = std::make_shared<Evaluator>();
-  e->study = study;
-  e->study.blocks = ob.base;
-  e->study.optimizations.clear();
-  e->ob = &study.optimizations[index];
-  e->kind = ob.block().kind();
-  const Block& b = e->block();
-  for (std::uint64_t r = 0; r < b.run_count(); ++r) e->set.push_back(b.params(r));
+  e->study = &study;
+  e->scenario = Scenario::of(study);
+  e->ob = &ob;
+  e->block = &block;
+  e->kind = block.kind();
+  for (std::uint64_t r = 0; r < block.run_count(); ++r) e->set.push_back(block.run(r));
   for (const auto& v : ob.variables) {
-    const std::size_t c = b.column_index(v.name);
-    if (c == Block::npos) throw std::invalid_argument("optimization " + ob.name + ": no parameter " + v.name);
-    e->var_col.push_back(c);
-    if (v.name == "alpha1A" || v.name.starts_with("vertex_alpha_")) e->reach_varies = true;
+    const ParamDef* p = find_param(block.table(), v.name);
+    if (!p) throw std::invalid_argument("optimization " + ob.name + ": no parameter " + v.name);
+    e->vars.push_back(p);
+    if (p->file_unit == FileUnit::deg && e->kind == BlockKind::trajectory) e->reach_varies = true;
   }
+  const auto& ms = metrics(e->kind);
+  auto metric = [&](std::string_view n) -> const MetricDef* {
+    for (const MetricDef& m : ms)
+      if (m.name == n) return &m;
+    return nullptr;
+  };
   for (const auto& [m, w] : ob.objective) {
-    if (m == "failure_rate") e->terms.emplace_back(std::size_t(-1), w);
-    else {
-      const std::size_t i = metric_index(e->kind, m);
-      if (i >= metric_columns(e->kind).size()) throw std::invalid_argument("optimization " + ob.name + ": no metric " + m);
-      e->terms.emplace_back(i, w);
-    }
+    if (m == "failure_rate") e->terms.emplace_back(nullptr, w);
+    else if (const MetricDef* d = metric(m)) e->terms.emplace_back(d, w);
+    else throw std::invalid_argument("optimization " + ob.name + ": no metric " + m);
   }
+  e->stop_time = metric("stop_time");
+  e->iterations = metric("iterations");
   for (double d : study.task.durations) e->duration += d;
   if (e->duration <= 0) e->duration = 1.0;
   return e;
@@ -194,13 +201,13 @@ double reach_margin(const PlanarArm3& a, const Eigen::Vector2d& p, double alpha)
 
 opt::Problem make_problem(const Study& study, std::size_t index) {
   const OptimizeBlock& ob = study.optimizations.at(index);
-  auto e = make_evaluator(study, index);
+  auto e = make_evaluator(study, index, ob.block());
   opt::Problem p;
-  const std::vector<Cell>& base = e->set.front();
+  const RunSpec& base = e->set.front();
   for (std::size_t i = 0; i < ob.variables.size(); ++i) {
     const auto& v = ob.variables[i];
     opt::Variable var{v.name, v.unit, v.lower, v.upper, v.start};
-    if (std::isnan(var.start)) var.start = cell_num(base[e->var_col[i]]);  // the block's value (the preset's)
+    if (std::isnan(var.start)) var.start = cell_num(e->vars[i]->get(base));  // the block's value (the preset's)
     p.variables.push_back(std::move(var));
   }
   p.objective = [e](std::span<const double> x) { return e->evaluate(x); };
@@ -218,12 +225,8 @@ std::vector<opt::Start> best_cells(const Study& study, std::size_t index, const 
   const Block& lb = study.blocks[bi];
   const std::uint64_t n = lb.run_count(), first = study.first_run(bi);
   // The cells' objective: same weighting and penalties as the optimisation, from the cells' metrics.
-  Study one = study;
-  one.blocks = {lb};
-  one.optimizations = study.optimizations;
-  one.optimizations[index].base = {lb};
-  auto e = make_evaluator(one, index);
-  e->var_col.clear();  // cells keep their own parameters
+  auto e = make_evaluator(study, index, lb);
+  e->vars.clear();  // cells keep their own parameters
   std::vector<double> value(n, kNaN);
   std::vector<std::string> status(n);
   bool from_file = false;
@@ -233,31 +236,16 @@ std::vector<opt::Start> best_cells(const Study& study, std::size_t index, const 
       bool all = done.size() >= first + n;
       for (std::uint64_t r = 0; all && r < n; ++r) all = done[first + r] != 0;
       if (all) {
-        std::vector<std::vector<double>> metric;
-        for (const auto& [i, w] : e->terms)
-          metric.push_back(i == std::size_t(-1) ? std::vector<double>() : options.cells->read_f64(metric_columns(e->kind)[i].name));
+        std::map<const MetricDef*, std::vector<double>> column;  // the metrics the objective reads
+        for (const auto& [m, w] : e->terms)
+          if (m) column[m] = options.cells->read_f64(m->name);
+        if (e->stop_time) column[e->stop_time] = options.cells->read_f64(e->stop_time->name);
         const auto st = options.cells->read_str("status");
-        const auto stop = e->kind == BlockKind::trajectory ? options.cells->read_f64("stop_time") : std::vector<double>();
+        const std::string good(statuses(e->kind).front());
         for (std::uint64_t r = 0; r < n; ++r) {
           const std::size_t g = first + r;
           status[r] = st[g];
-          const std::vector<Cell> p = lb.params(r);
-          double v = 0;
-          if (e->kind == BlockKind::trajectory) {
-            if (st[g] == "ok")
-              for (std::size_t t = 0; t < e->terms.size(); ++t) v += e->terms[t].second * metric[t][g];
-            else if (st[g] == "unreachable_start") v = ob.penalty * (2.0 + std::max(0.0, e->margin_of(p)));
-            else v = ob.penalty * (1.0 + std::clamp(1.0 - stop[g] / e->duration, 0.0, 1.0));
-          } else {
-            const bool conv = st[g] == "converged";
-            for (std::size_t t = 0; t < e->terms.size(); ++t) {
-              const auto [i, w] = e->terms[t];
-              if (i == std::size_t(-1)) v += w * (conv ? 0.0 : 1.0);
-              else if (metric_columns(e->kind)[i].name == "iterations" && !conv) v += w * cell_num(p[lb.column_index("max_iter")]);
-              else v += w * metric[t][g];
-            }
-          }
-          value[r] = v;
+          value[r] = e->value_of(e->set[r], st[g] == good, st[g], [&](const MetricDef& m) { return column.at(&m)[g]; });
         }
         from_file = true;
       }
@@ -281,9 +269,8 @@ std::vector<opt::Start> best_cells(const Study& study, std::size_t index, const 
   std::stable_sort(idx.begin(), idx.end(), [&](auto a, auto b) { return value[a] < value[b]; });
   for (std::uint64_t r : idx) {
     if (static_cast<int>(out.size()) >= ob.polish_best) break;
-    const std::vector<Cell> p = lb.params(r);
     opt::Start s;
-    for (const auto& v : ob.variables) s.x.push_back(cell_num(p[lb.column_index(v.name)]));
+    for (const auto& v : ob.variables) s.x.push_back(cell_num(find_param(lb.table(), v.name)->get(e->set[r])));
     s.value = value[r];
     s.status = status[r];
     s.run = static_cast<std::int64_t>(first + r);
@@ -294,7 +281,7 @@ std::vector<opt::Start> best_cells(const Study& study, std::size_t index, const 
 
 OptimizeResult run_optimization(const Study& study, std::size_t index, const OptimizeRunOptions& options) {
   const OptimizeBlock& ob = study.optimizations.at(index);
-  auto e = make_evaluator(study, index);
+  auto e = make_evaluator(study, index, ob.block());
   opt::Problem problem = make_problem(study, index);
   opt::PipelineOptions po;
   po.global = ob.global;
@@ -370,8 +357,7 @@ OptimizeResult run_optimization(const Study& study, std::size_t index, const Opt
   if (!s.best_x.empty()) {
     RunOutcome o;
     e->run_value(0, s.best_x, 1, &o);
-    const auto& cols = metric_columns(e->kind);
-    for (std::size_t i = 0; i < cols.size() && i < o.metrics.size(); ++i) r.best_metrics.emplace_back(cols[i].name, cell_num(o.metrics[i]));
+    for (const MetricDef& m : metrics(e->kind)) r.best_metrics.emplace_back(m.name, cell_num(m.get(o)));
     r.history = std::move(o.history);
   }
   // A seed row: the thesis' optimum and figures, and this objective at the thesis' printed point.

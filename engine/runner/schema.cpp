@@ -12,9 +12,15 @@ Cell missing(CellType t) {
     default: return std::string();
   }
 }
+/// Index of column c.name, adding it (or the kinds of c to it) as needed.
 std::size_t add(std::vector<ColumnSpec>& cols, const ColumnSpec& c) {
   for (std::size_t i = 0; i < cols.size(); ++i)
-    if (cols[i].name == c.name) return i;
+    if (cols[i].name == c.name) {
+      std::string& k = cols[i].kinds;
+      if (!c.kinds.empty() && !k.empty() && ("," + k + ",").find("," + c.kinds + ",") == std::string::npos)
+        k += "," + c.kinds;
+      return i;
+    }
   cols.push_back(c);
   return cols.size() - 1;
 }
@@ -23,8 +29,8 @@ std::size_t add(std::vector<ColumnSpec>& cols, const ColumnSpec& c) {
 StudySchema make_schema(const Study& study) {
   StudySchema s;
   auto& c = s.columns;
-  s.run_id = add(c, {"run_id", CellType::i64, "", "global run id (row index)"});
-  s.block = add(c, {"block", CellType::str, "", "name of the study block the run belongs to"});
+  s.run_id = add(c, run_id_column());
+  s.block = add(c, block_column());
   for (const Block& b : study.blocks) {
     std::vector<std::size_t> pc;
     for (const ColumnSpec& p : b.columns()) pc.push_back(add(c, p));
@@ -32,26 +38,25 @@ StudySchema make_schema(const Study& study) {
   }
   for (const Block& b : study.blocks) {
     std::vector<std::size_t> mc;
-    for (const ColumnSpec& m : metric_columns(b.kind())) mc.push_back(add(c, m));
+    for (const MetricDef& m : metrics(b.kind())) mc.push_back(add(c, m.column(b.kind())));
     s.metric_column.push_back(std::move(mc));
   }
-  s.status = add(c, {"status", CellType::str, "",
-                     "trajectory: ok, unreachable_start, singular, diverged; ik: converged, stalled, singular, "
-                     "max_iter, cycle, diverged, unsupported, no_solution"});
-  s.wall_time = add(c, {"wall_time", CellType::f64, "s", "wall-clock time of the run (the only column that "
-                                                            "varies between identical sweeps)"});
+  s.status = add(c, status_column());
+  s.wall_time = add(c, wall_time_column());
   for (const ColumnSpec& col : c) s.blank.cells.push_back(missing(col.type));
   return s;
 }
 
-Record StudySchema::row(std::uint64_t id, std::size_t b, const std::string& block_name, std::span<const Cell> params,
-                        const RunOutcome& o, double wall) const {
+Record StudySchema::row(std::uint64_t id, std::size_t bi, const Block& b, const RunSpec& run, const RunOutcome& o,
+                        double wall) const {
   Record r = blank;
   r.cells[run_id] = static_cast<std::int64_t>(id);
-  r.cells[block] = block_name;
-  for (std::size_t i = 0; i < params.size(); ++i) r.cells[param_column[b][i]] = params[i];
-  for (std::size_t j = 0; j < o.metrics.size(); ++j) r.cells[metric_column[b][j]] = o.metrics[j];
-  r.cells[status] = o.status;
+  r.cells[block] = b.name();
+  const auto& table = b.table();
+  for (std::size_t i = 0; i < table.size(); ++i) r.cells[param_column[bi][i]] = table[i].get(run);
+  const auto& ms = metrics(b.kind());
+  for (std::size_t j = 0; j < ms.size(); ++j) r.cells[metric_column[bi][j]] = ms[j].get(o);
+  r.cells[status] = std::string(o.status());
   r.cells[wall_time] = wall;
   return r;
 }

@@ -1,10 +1,12 @@
 #pragma once
 // The /runs schema of a study: run_id, block, every block's parameters (union by name, file order),
 // the metrics of each kind present, status and wall time. A row of a block leaves the columns of
-// other kinds missing (NaN, -1, "").
+// other kinds missing (NaN, -1, ""). Conversion of a typed run and outcome to a row happens here
+// only, through the parameter and metric tables.
 #include <vector>
 
 #include "runner/execute.hpp"
+#include "schema/params.hpp"
 
 namespace ks {
 
@@ -15,9 +17,9 @@ struct StudySchema {
   std::size_t run_id = 0, block = 1, status = 0, wall_time = 0;
   Record blank;                                         ///< every cell missing
 
-  /// The full row of one run.
-  Record row(std::uint64_t run_id, std::size_t block, const std::string& block_name, std::span<const Cell> params,
-             const RunOutcome& outcome, double wall_time_s) const;
+  /// The full row of one run of block `block` (index into the study's blocks).
+  Record row(std::uint64_t run_id, std::size_t block, const Block& b, const RunSpec& run, const RunOutcome& outcome,
+             double wall_time_s) const;
 };
 
 StudySchema make_schema(const Study& study);

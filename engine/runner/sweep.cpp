@@ -56,9 +56,9 @@ class Accumulator {
       report_.blocks.push_back(std::move(r));
     }
     auto metric = [&](std::size_t b, std::string_view name) {
-      const auto& cols = metric_columns(study.blocks[b].kind());
-      for (std::size_t j = 0; j < cols.size(); ++j)
-        if (cols[j].name == name) return schema.metric_column[b][j];
+      const auto& ms = metrics(study.blocks[b].kind());
+      for (std::size_t j = 0; j < ms.size(); ++j)
+        if (ms[j].name == name) return schema.metric_column[b][j];
       return std::size_t(0);
     };
     for (std::size_t b = 0; b < study.blocks.size(); ++b) {  // column indices, looked up once
@@ -83,7 +83,7 @@ class Accumulator {
     ++br.by_status[status];
     grids_[ref.block].add(ref.local, row, schema_, ref.block);
     const bool traj = block.kind() == BlockKind::trajectory;
-    const bool good = traj ? status == "ok" : status == "converged";
+    const bool good = status == statuses(block.kind()).front();
     const Columns& c = columns_[ref.block];
     if (good) consider_best(br, id, as_f64(row.cells[c.value]), row, ref.block);
     if (traj) {
@@ -215,14 +215,15 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
                 tbb::filter_mode::parallel,
                 [&](std::shared_ptr<Batch> b) {
                   RunWorkspace& ws = workspaces.local();
+                  const Scenario scenario = Scenario::of(study);
                   for (Job& j : b->jobs) {
                     const Block& block = study.blocks[j.ref.block];
-                    const std::vector<Cell> params = block.params(j.ref.local);
+                    const RunSpec run = block.run(j.ref.local);
                     const auto t0 = Clock::now();
-                    RunOutcome o = execute_run(study, j.ref.block, params, stride, ws);
+                    RunOutcome o = execute(scenario, run, stride, ws);
                     const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
                     if (!o.history.arrays.empty()) j.history = store::encode_history(o.history, options.compression);
-                    j.row = schema.row(j.id, j.ref.block, block.name(), params, o, wall);
+                    j.row = schema.row(j.id, j.ref.block, block, run, o, wall);
                   }
                   return b;
                 }) &

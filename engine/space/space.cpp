@@ -7,29 +7,9 @@
 #include <random>
 #include <stdexcept>
 
-#include "methods/seed_cases.hpp"
 
 namespace ks {
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;  // the same conversion as SeedCase::options()
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-constexpr std::array<std::string_view, 3> kIkProblems{"scara", "planar3r_pose", "planar3r_position"};
-constexpr std::array<std::string_view, 6> kIkMethods{"newton", "lm", "lm_adaptive", "halley_thesis", "halley",
-                                                     "analytic"};
-constexpr std::array<std::string_view, 3> kTrajMethods{"local_weighted", "local_unweighted", "vertex_alpha"};
-constexpr std::array<std::string_view, 2> kIntegrators{"semi_implicit_euler", "rk4"};
-constexpr std::array<std::string_view, 2> kInertia{"physical", "thesis_m11"};
-constexpr std::array<std::string_view, 2> kZModes{"thesis", "physical"};
-std::span<const std::string_view> preset_span() {
-  static const std::vector<std::string_view> names = [] {
-    std::vector<std::string_view> n;
-    for (const auto& c : seed_cases()) n.push_back(c.name);
-    return n;
-  }();
-  return names;
-}
-
 bool type_matches(const Cell& c, CellType t) {
   switch (t) {
     case CellType::f64: return std::holds_alternative<double>(c);
@@ -38,73 +18,31 @@ bool type_matches(const Cell& c, CellType t) {
   }
   return false;
 }
+std::vector<std::string> choices_of(BlockKind kind, std::string_view param) {
+  const auto table = params(kind);
+  const ParamDef* p = find_param(table, param);
+  return p ? p->choices : std::vector<std::string>{};
+}
 }  // namespace
 
-std::string_view to_string(BlockKind k) { return k == BlockKind::trajectory ? "trajectory" : "ik"; }
-bool parse(std::string_view name, BlockKind& out) {
-  if (name == "trajectory") out = BlockKind::trajectory;
-  else if (name == "ik") out = BlockKind::ik;
-  else return false;
-  return true;
+std::vector<std::string> integrator_names() { return choices_of(BlockKind::trajectory, "integrator"); }
+std::vector<std::string> inertia_names() { return choices_of(BlockKind::trajectory, "inertia"); }
+bool ik_problem_is_scara(std::string_view problem) {
+  IkProblem p = IkProblem::scara;
+  return parse(problem, p) && p == IkProblem::scara;
 }
-std::string_view to_string(InertiaForm f) { return f == InertiaForm::physical ? "physical" : "thesis_m11"; }
-bool parse(std::string_view name, InertiaForm& out) {
-  if (name == "physical") out = InertiaForm::physical;
-  else if (name == "thesis_m11") out = InertiaForm::thesis_m11;
-  else return false;
-  return true;
-}
-std::span<const std::string_view> ik_problem_names() { return kIkProblems; }
-std::span<const std::string_view> ik_method_names() { return kIkMethods; }
-std::span<const std::string_view> trajectory_method_names() { return kTrajMethods; }
-std::span<const std::string_view> integrator_names() { return kIntegrators; }
-std::span<const std::string_view> inertia_names() { return kInertia; }
-bool ik_problem_is_scara(std::string_view problem) { return problem == "scara"; }
 
-std::vector<ParamInfo> block_params(BlockKind kind, std::size_t path_vertices) {
-  using enum CellType;
-  std::vector<ParamInfo> p;
-  if (kind == BlockKind::trajectory) {
-    p.push_back({"preset", str, FileUnit::none, preset_span(), "seed 000 Table 4 case (\"\" when none)"});
-    p.push_back({"method", str, FileUnit::none, kTrajMethods, "redundancy resolution method"});
-    p.push_back({"k", f64, FileUnit::none, {}, "gravity weight in the resolution"});
-    p.push_back({"alpha1A", f64, FileUnit::deg, {}, "end-effector orientation at the start"});
-    p.push_back({"K_N", f64, FileUnit::none, {}, "null-space damping"});
-    for (std::size_t v = 2; v <= path_vertices; ++v)
-      p.push_back({"vertex_alpha_" + std::to_string(v), f64, FileUnit::deg, {},
-                   "orientation at vertex " + std::to_string(v) + " (vertex_alpha method)"});
-    p.push_back({"integrator", str, FileUnit::none, kIntegrators, "time integrator"});
-    p.push_back({"dt", f64, FileUnit::none, {}, "sample / integration step"});
-    p.push_back({"torque_bound", f64, FileUnit::none, {}, "|tau_i| above this stops the run (diverged)"});
-    p.push_back({"inertia", str, FileUnit::none, kInertia, "closed form of M(q)"});
-  } else {
-    p.push_back({"problem", str, FileUnit::none, kIkProblems, "IK problem"});
-    p.push_back({"method", str, FileUnit::none, kIkMethods, "IK method"});
-    p.push_back({"lambda", f64, FileUnit::none, {}, "Levenberg-Marquardt damping (lm, lm_adaptive)"});
-    p.push_back({"q0_1", f64, FileUnit::deg, {}, "initial guess, joint 1"});
-    p.push_back({"q0_2", f64, FileUnit::deg, {}, "initial guess, joint 2"});
-    p.push_back({"q0_3", f64, FileUnit::q0_3, {}, "initial guess, joint 3 (SCARA: prismatic d)"});
-    p.push_back({"target_x", f64, FileUnit::none, {}, "target x"});
-    p.push_back({"target_y", f64, FileUnit::none, {}, "target y"});
-    p.push_back({"target_z", f64, FileUnit::none, {}, "target z (SCARA)"});
-    p.push_back({"target_alpha", f64, FileUnit::deg, {}, "target orientation (planar3r_pose)"});
-    p.push_back({"tol", f64, FileUnit::none, {}, "stop when the residual norm falls below this"});
-    p.push_back({"max_iter", i64, FileUnit::none, {}, "iteration cap"});
-    p.push_back({"z_mode", str, FileUnit::none, kZModes, "SCARA z residual: thesis (+q3) or physical"});
-  }
-  return p;
+std::vector<ParamInfo> block_params(BlockKind kind, std::size_t path_vertices, bool scara) {
+  KindContext c;
+  c.path_vertices = path_vertices;
+  c.scara = scara;
+  return params(kind, c);
 }
 
 // ---------------------------------------------------------------------------------------------------
 Block::Block(BlockSpec spec, const BlockContext& context)
     : name_(std::move(spec.name)), kind_(spec.kind), context_(context) {
-  const auto infos = block_params(kind_, context_.path_vertices);
-  auto col_of = [&](const std::string& n) -> std::size_t {
-    for (std::size_t i = 0; i < infos.size(); ++i)
-      if (infos[i].name == n) return i;
-    throw std::invalid_argument("block '" + name_ + "': unknown parameter '" + n + "'");
-  };
-  // IK problem family (fixes the units of q0_3 and the targets).
+  // IK problem family (fixes the units of q0_3, the targets and tol, and the defaults).
   if (kind_ == BlockKind::ik) {
     std::vector<std::string> problems;
     for (const auto& [n, v] : spec.fixed)
@@ -113,31 +51,24 @@ Block::Block(BlockSpec spec, const BlockContext& context)
       if (a.name == "problem")
         for (const auto& v : a.values)
           if (std::holds_alternative<std::string>(v)) problems.push_back(std::get<std::string>(v));
-    if (!problems.empty()) {
-      scara_ = ik_problem_is_scara(problems.front());
-      for (const auto& p : problems)
-        if (ik_problem_is_scara(p) != scara_)
-          throw std::invalid_argument("block '" + name_ + "': problems mix scara and planar3r units");
-    }
+    context_.scara = problems.empty() || ik_problem_is_scara(problems.front());
+    for (const auto& p : problems)
+      if (ik_problem_is_scara(p) != context_.scara)
+        throw std::invalid_argument("block '" + name_ + "': problems mix scara and planar3r units");
   }
-  for (const auto& info : infos) {
-    std::string unit;
-    if (info.file_unit == FileUnit::deg) unit = "rad";
-    else if (info.file_unit == FileUnit::q0_3) unit = scara_ ? "mm" : "rad";
-    else if (info.name == "K_N") unit = "1/s";
-    else if (info.name == "dt") unit = "s";
-    else if (info.name == "torque_bound") unit = "Nm";
-    else if (kind_ == BlockKind::ik && (info.name.starts_with("target_") || info.name == "tol"))
-      unit = scara_ ? "mm" : "m";
-    columns_.push_back({info.name, info.type, unit, info.description});
-  }
-  if (kind_ == BlockKind::ik && !scara_) columns_[col_of("tol")].unit = "";
+  table_ = ks::params(kind_, context_);
+  for (const ParamDef& p : table_) columns_.push_back(p.column(kind_));
+  auto col_of = [&](const std::string& n) -> std::size_t {
+    for (std::size_t i = 0; i < table_.size(); ++i)
+      if (table_[i].name == n) return i;
+    throw std::invalid_argument("block '" + name_ + "': unknown parameter '" + n + "'");
+  };
 
-  std::vector<char> used(infos.size(), 0);
+  std::vector<char> used(table_.size(), 0);
   for (auto& [n, v] : spec.fixed) {
     const std::size_t c = col_of(n);
     if (used[c]) throw std::invalid_argument("block '" + name_ + "': parameter '" + n + "' given twice");
-    if (!type_matches(v, infos[c].type))
+    if (!type_matches(v, table_[c].type))
       throw std::invalid_argument("block '" + name_ + "': parameter '" + n + "' has the wrong type");
     used[c] = 1;
     fixed_.emplace_back(c, std::move(v));
@@ -147,13 +78,21 @@ Block::Block(BlockSpec spec, const BlockContext& context)
     if (used[c]) throw std::invalid_argument("block '" + name_ + "': parameter '" + a.name + "' given twice");
     if (a.values.empty()) throw std::invalid_argument("block '" + name_ + "': axis '" + a.name + "' is empty");
     for (const auto& v : a.values)
-      if (!type_matches(v, infos[c].type))
+      if (!type_matches(v, table_[c].type))
         throw std::invalid_argument("block '" + name_ + "': axis '" + a.name + "' has a value of the wrong type");
     used[c] = 1;
     a.unit = columns_[c].unit;
+    if (table_[c].leading) leading_swept_ = true;
     axis_column_.push_back(c);
     axes_.push_back(std::move(a));
   }
+  // Fixed values in table order, the leading ones first (a preset sets defaults the others override).
+  std::stable_sort(fixed_.begin(), fixed_.end(), [&](const auto& x, const auto& y) {
+    return std::pair(!table_[x.first].leading, x.first) < std::pair(!table_[y.first].leading, y.first);
+  });
+  defaults_ = default_run(kind_, context_);
+  base_ = defaults_;
+  for (const auto& [c, v] : fixed_) table_[c].set(base_, v);
   // Dimensions: groups first assigned, then each remaining axis alone; ordered by first axis.
   std::vector<std::size_t> group_of(axes_.size(), npos);
   std::vector<std::vector<std::size_t>> groups;
@@ -225,81 +164,43 @@ std::uint64_t Block::local_index(std::span<const std::uint64_t> grid) const {
   return i;
 }
 
-void Block::resolve(std::vector<Cell>& c, std::vector<char>& set) const {
-  auto put = [&](std::size_t i, Cell v) {
-    if (!set[i]) {
-      c[i] = std::move(v);
-      set[i] = 1;
-    }
-  };
-  if (kind_ == BlockKind::trajectory) {
-    // Columns: 0 preset, 1 method, 2 k, 3 alpha1A, 4 K_N, 5.. vertex alphas, then 4 more.
-    const std::size_t nva = context_.path_vertices >= 1 ? context_.path_vertices - 1 : 0;
-    const std::size_t after = 5 + nva;
-    put(0, std::string());
-    if (const SeedCase* sc = find_seed_case(std::get<std::string>(c[0]))) {
-      put(1, std::string(to_string(sc->method)));
-      put(2, sc->k);
-      put(3, sc->alpha1A_deg * kDeg);
-      for (std::size_t v = 0; v < nva; ++v) put(5 + v, v < 4 ? sc->vertex_alpha_deg[v] * kDeg : 0.0);
-    }
-    put(1, std::string("local_weighted"));
-    put(2, 0.0);
-    put(3, 0.0);
-    put(4, 0.0);
-    for (std::size_t v = 0; v < nva; ++v) put(5 + v, 0.0);
-    put(after, std::string(to_string(context_.integrator)));
-    put(after + 1, context_.dt);
-    put(after + 2, 1.0e6);
-    put(after + 3, std::string(to_string(context_.inertia)));
-  } else {
-    // 0 problem, 1 method, 2 lambda, 3-5 q0, 6-8 target xyz, 9 target_alpha, 10 tol, 11 max_iter, 12 z_mode
-    put(0, std::string("scara"));
-    put(1, std::string("newton"));
-    put(2, 0.1);
-    if (scara_) {
-      put(3, 60.0 * kDeg);
-      put(4, 45.0 * kDeg);
-      put(5, 50.0);
-      put(6, 50.0);
-      put(7, -80.0);
-      put(8, 10.0);
-      put(9, kNaN);
-      put(12, std::string("thesis"));
-    } else {
-      put(3, 0.0);
-      put(4, 90.0 * kDeg);
-      put(5, -90.0 * kDeg);
-      put(6, 1.5);
-      put(7, 1.5);
-      put(8, kNaN);
-      put(9, 0.0);
-      put(12, std::string());
-    }
-    put(10, 1e-6);
-    put(11, std::int64_t{1000});
+RunSpec Block::run(std::uint64_t local) const {
+  if (local >= runs_) throw std::out_of_range("Block::run: run index past the block's end");
+  // Mixed-radix decoding: the value index of each dimension.
+  std::uint64_t idx[64];
+  std::vector<std::uint64_t> big;
+  std::uint64_t* at = idx;
+  if (dims_.size() > 64) {
+    big.resize(dims_.size());
+    at = big.data();
   }
+  std::uint64_t rest = local;
+  for (std::size_t d = dims_.size(); d-- > 0;) {
+    at[d] = rest % dims_[d].size;
+    rest /= dims_[d].size;
+  }
+  if (!leading_swept_) {
+    RunSpec r = base_;
+    for (std::size_t a = 0; a < axes_.size(); ++a)
+      table_[axis_column_[a]].set(r, axes_[a].values[at[axis_dim_[a]]]);
+    return r;
+  }
+  RunSpec r = defaults_;
+  for (int pass = 0; pass < 2; ++pass) {  // leading parameters first, fixed or swept
+    const bool leading = pass == 0;
+    for (const auto& [c, v] : fixed_)
+      if (table_[c].leading == leading) table_[c].set(r, v);
+    for (std::size_t a = 0; a < axes_.size(); ++a)
+      if (table_[axis_column_[a]].leading == leading) table_[axis_column_[a]].set(r, axes_[a].values[at[axis_dim_[a]]]);
+  }
+  return r;
 }
 
 std::vector<Cell> Block::params(std::uint64_t local) const {
-  if (local >= runs_) throw std::out_of_range("Block::params: run index past the block's end");
-  std::vector<Cell> c(columns_.size());
-  std::vector<char> set(columns_.size(), 0);
-  for (const auto& [col, v] : fixed_) {
-    c[col] = v;
-    set[col] = 1;
-  }
-  // Mixed-radix decoding straight into the axes' values.
-  std::uint64_t rest = local;
-  for (std::size_t d = dims_.size(); d-- > 0;) {
-    const std::uint64_t i = rest % dims_[d].size;
-    rest /= dims_[d].size;
-    for (std::size_t a : dims_[d].axes) {
-      c[axis_column_[a]] = axes_[a].values[i];
-      set[axis_column_[a]] = 1;
-    }
-  }
-  resolve(c, set);
+  const RunSpec r = run(local);
+  std::vector<Cell> c;
+  c.reserve(table_.size());
+  for (const ParamDef& p : table_) c.push_back(p.get(r));
   return c;
 }
 

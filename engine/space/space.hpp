@@ -15,57 +15,24 @@
 #include <utility>
 #include <vector>
 
-#include "methods/trajectory.hpp"
-#include "model/arm.hpp"
+#include "schema/params.hpp"
 #include "store/record.hpp"
 
 namespace ks {
 
-enum class BlockKind { trajectory, ik };
-std::string_view to_string(BlockKind k);
-bool parse(std::string_view name, BlockKind& out);
-std::string_view to_string(InertiaForm f);
-bool parse(std::string_view name, InertiaForm& out);
-
-/// Names accepted for the IK parameters (validated here; the IK module owns the meaning).
-std::span<const std::string_view> ik_problem_names();  ///< scara, planar3r_pose, planar3r_position
-std::span<const std::string_view> ik_method_names();   ///< newton, lm, lm_adaptive, halley_thesis, halley, analytic
-std::span<const std::string_view> trajectory_method_names();
-std::span<const std::string_view> integrator_names();
-std::span<const std::string_view> inertia_names();
+/// Names accepted for [task] integrator and [robot] inertia (from the trajectory table).
+std::vector<std::string> integrator_names();
+std::vector<std::string> inertia_names();
 /// True for "scara": lengths in mm and q0_3 is the prismatic d [mm]; false for the planar 3R problems
 /// (lengths in m, q0_3 an angle).
 bool ik_problem_is_scara(std::string_view problem);
 
-/// How a study file writes a parameter (stored values are SI except the SCARA's mm).
-enum class FileUnit {
-  none,  ///< as written
-  deg,   ///< degrees in the file, radians stored
-  q0_3,  ///< ik q0_3: degrees for planar 3R (stored rad), mm for the SCARA (stored mm)
-};
-
-/// A parameter of a block kind.
-struct ParamInfo {
-  std::string name;
-  CellType type = CellType::f64;
-  FileUnit file_unit = FileUnit::none;
-  std::span<const std::string_view> choices;  ///< allowed names of a string parameter (empty: any)
-  std::string description;
-};
-
-/// What a block inherits from the study: the path (for the number of vertex alphas) and defaults.
-struct BlockContext {
-  std::size_t path_vertices = 5;  ///< vertices of the task path (the square: 5, the last = the first)
-  Integrator integrator = Integrator::semi_implicit_euler;
-  double dt = 1e-3;
-  InertiaForm inertia = InertiaForm::physical;
-};
-
-/// The parameters of a kind, in column order. Trajectory: preset, method, k, alpha1A, K_N,
-/// vertex_alpha_2 .. vertex_alpha_<path_vertices>, integrator, dt, torque_bound, inertia.
-/// IK: problem, method, lambda, q0_1, q0_2, q0_3, target_x, target_y, target_z, target_alpha, tol,
-/// max_iter, z_mode.
-std::vector<ParamInfo> block_params(BlockKind kind, std::size_t path_vertices = 5);
+/// A block's parameters are the table entries of its kind (schema/params.hpp).
+using ParamInfo = ParamDef;
+/// What a block inherits from the study: its path and the study-wide defaults.
+using BlockContext = KindContext;
+/// The parameters of a kind for a path of `path_vertices` vertices (IK: of the SCARA family or not).
+std::vector<ParamInfo> block_params(BlockKind kind, std::size_t path_vertices = 5, bool scara = true);
 
 /// An axis: a parameter and its values, in stored units (angles in rad).
 struct Axis {
@@ -95,13 +62,17 @@ class Block {
   static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
 
   /// Throws std::invalid_argument on an inconsistent spec (unknown parameter, bad cell type, a
-  /// parameter both fixed and swept, unequal lengths in a group, an axis in two groups, empty axis).
+  /// parameter both fixed and swept, unequal lengths in a group, an axis in two groups, empty axis,
+  /// IK problems of both families). `context.scara` is derived from the block's problems.
   Block(BlockSpec spec, const BlockContext& context);
 
   const std::string& name() const { return name_; }
   BlockKind kind() const { return kind_; }
   /// The parameter columns, in order (every parameter of the kind).
   const std::vector<ColumnSpec>& columns() const { return columns_; }
+  /// The kind's parameter table for this block (units resolved for its context), columns() order.
+  const std::vector<ParamDef>& table() const { return table_; }
+  const BlockContext& context() const { return context_; }
   /// Column of a parameter, or npos.
   std::size_t column_index(std::string_view param) const;
   const std::vector<Axis>& axes() const { return axes_; }
@@ -118,20 +89,24 @@ class Block {
   /// Inverse of grid_index.
   std::uint64_t local_index(std::span<const std::uint64_t> grid) const;
 
-  /// All parameter cells of a run, in columns() order.
+  /// Run `local`, decoded straight into its typed spec: the kind's defaults, then the leading
+  /// parameters (a preset), then the block's fixed values and the run's axis values.
+  RunSpec run(std::uint64_t local) const;
+  /// All parameter cells of a run, in columns() order (table().get of run(local)).
   std::vector<Cell> params(std::uint64_t local) const;
   /// One parameter cell of a run (by column index or name; throws std::out_of_range when unknown).
   Cell value(std::uint64_t local, std::size_t column) const;
   Cell value(std::uint64_t local, std::string_view param) const;
 
  private:
-  void resolve(std::vector<Cell>& cells, std::vector<char>& set) const;
-
   std::string name_;
   BlockKind kind_;
   BlockContext context_;
-  bool scara_ = true;  // ik: the block's problem family
+  std::vector<ParamDef> table_;
   std::vector<ColumnSpec> columns_;
+  RunSpec defaults_;          // the kind's defaults in this context
+  RunSpec base_;              // defaults_ with the fixed values applied (leading ones first)
+  bool leading_swept_ = false;  // a leading parameter is an axis: runs start from defaults_
   std::vector<std::pair<std::size_t, Cell>> fixed_;  // column, value
   std::vector<Axis> axes_;
   std::vector<std::size_t> axis_column_;

@@ -106,6 +106,7 @@ std::string join(const std::vector<std::string>& v, std::string_view sep = ", ")
   }
   return s;
 }
+const std::vector<std::string>& to_strings(const std::vector<std::string>& v) { return v; }
 std::vector<std::string> to_strings(std::span<const std::string_view> v) {
   return std::vector<std::string>(v.begin(), v.end());
 }
@@ -454,7 +455,7 @@ std::string Parser::domain_problem(const std::string& name, double v) {
 
 Cell Parser::convert(const ParamInfo& info, double v, bool scara) const {
   if (info.type == CellType::i64) return std::int64_t(std::llround(v));
-  if (info.file_unit == FileUnit::deg || (info.file_unit == FileUnit::q0_3 && !scara)) return v * kDeg;
+  if (info.file_unit == FileUnit::deg || (info.name == "q0_3" && !scara)) return v * kDeg;
   return v;
 }
 

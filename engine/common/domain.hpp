@@ -1,0 +1,52 @@
+#pragma once
+// The rule a run parameter's value must satisfy, written once next to the field it constrains (see
+// TrajectoryOptions, ik::Options) and read by the field's IsValid, the study parser and the schema
+// listings (`kinesweep schema`, FORMAT.md).
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <string_view>
+
+namespace ks {
+
+struct Domain {
+  enum class Rule { any, positive, nonnegative, at_least };
+  Rule rule = Rule::any;
+  double bound = 0.0;  ///< at_least: the smallest value allowed
+
+  static constexpr Domain any() { return {}; }
+  static constexpr Domain positive() { return {Rule::positive, 0.0}; }
+  static constexpr Domain nonnegative() { return {Rule::nonnegative, 0.0}; }
+  static constexpr Domain at_least(double v) { return {Rule::at_least, v}; }
+
+  /// True when v satisfies the rule (NaN only satisfies `any`).
+  constexpr bool holds(double v) const {
+    switch (rule) {
+      case Rule::any: return true;
+      case Rule::positive: return v > 0.0;
+      case Rule::nonnegative: return v >= 0.0;
+      case Rule::at_least: return v >= bound;
+    }
+    return false;
+  }
+  /// The rule applied to `name`: "name > 0", "name >= 0", "name >= 1"; "" for any.
+  std::string str(std::string_view name) const {
+    char b[32];
+    switch (rule) {
+      case Rule::any: return "";
+      case Rule::positive: return std::string(name) + " > 0";
+      case Rule::nonnegative: return std::string(name) + " >= 0";
+      case Rule::at_least: std::snprintf(b, sizeof b, "%.12g", bound); return std::string(name) + " >= " + b;
+    }
+    return "";
+  }
+  /// "" when v holds, else "name = v; expected <rule>" (v as the user wrote it).
+  std::string problem(std::string_view name, double v) const {
+    if (holds(v)) return "";
+    char b[32];
+    std::snprintf(b, sizeof b, "%.12g", v);
+    return std::string(name) + " = " + b + "; expected " + str(name);
+  }
+};
+
+}  // namespace ks

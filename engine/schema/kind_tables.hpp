@@ -1,0 +1,10 @@
+#pragma once
+// The per-kind tables behind schema/params.hpp (internal to engine/schema).
+#include "schema/params.hpp"
+
+namespace ks {
+std::vector<ParamDef> trajectory_params(const KindContext& context);
+const std::vector<MetricDef>& trajectory_metrics();
+std::vector<ParamDef> ik_params(const KindContext& context);
+const std::vector<MetricDef>& ik_metrics();
+}  // namespace ks

@@ -1,0 +1,121 @@
+// What the kinds share: names, effect rules, columns, defaults, outcomes (see schema/params.hpp).
+#include "schema/params.hpp"
+
+#include <array>
+
+#include "common/name_table.hpp"
+#include "schema/kind_tables.hpp"
+
+namespace ks {
+
+namespace {
+constexpr NameTable<BlockKind, 2> kKinds{{{BlockKind::trajectory, "trajectory"}, {BlockKind::ik, "ik"}}};
+constexpr NameTable<InertiaForm, 2> kInertia{{{InertiaForm::physical, "physical"},
+                                              {InertiaForm::thesis_m11, "thesis_m11"}}};
+constexpr NameTable<IkProblem, 3> kProblems{{{IkProblem::scara, "scara"},
+                                             {IkProblem::planar3r_pose, "planar3r_pose"},
+                                             {IkProblem::planar3r_position, "planar3r_position"}}};
+constexpr NameTable<ZMode, 3> kZModes{{{ZMode::unset, ""}, {ZMode::thesis, "thesis"}, {ZMode::physical, "physical"}}};
+constexpr std::array<BlockKind, 2> kKindList{BlockKind::trajectory, BlockKind::ik};
+constexpr std::array<std::string_view, 4> kTrajectoryStatuses{"ok", "unreachable_start", "singular", "diverged"};
+constexpr std::array<std::string_view, 8> kIkStatuses{"converged", "stalled",  "singular",    "max_iter",
+                                                      "cycle",     "diverged", "unsupported", "no_solution"};
+}  // namespace
+
+std::string_view to_string(BlockKind k) { return name_of(kKinds, k); }
+bool parse(std::string_view n, BlockKind& out) { return value_of(kKinds, n, out); }
+std::string_view to_string(InertiaForm f) { return name_of(kInertia, f); }
+bool parse(std::string_view n, InertiaForm& out) { return value_of(kInertia, n, out); }
+std::string_view to_string(IkProblem p) { return name_of(kProblems, p); }
+bool parse(std::string_view n, IkProblem& out) { return value_of(kProblems, n, out); }
+std::string_view to_string(ZMode z) { return name_of(kZModes, z); }
+bool parse(std::string_view n, ZMode& out) { return value_of(kZModes, n, out); }
+
+bool RunOutcome::good() const {
+  if (const auto* t = std::get_if<TrajectoryMetrics>(&result)) return t->status == RunStatus::ok;
+  return std::get<IkResult>(result).status == ik::Status::converged;
+}
+std::string_view RunOutcome::status() const {
+  if (const auto* t = std::get_if<TrajectoryMetrics>(&result)) return to_string(t->status);
+  return ik::to_string(std::get<IkResult>(result).status);
+}
+
+bool EffectRule::applies(std::string_view v) const {
+  if (always()) return true;
+  for (const auto& w : when)
+    if (w == v) return true;
+  return false;
+}
+std::string EffectRule::str() const {
+  if (always()) return "always";
+  std::string s = "only when " + controller + " is ";
+  for (std::size_t i = 0; i < when.size(); ++i) s += (i ? (i + 1 == when.size() ? " or " : ", ") : "") + when[i];
+  return s;
+}
+
+Cell ParamDef::from_file(double v) const {
+  if (type == CellType::i64) return static_cast<std::int64_t>(std::llround(v));
+  return file_unit == FileUnit::deg ? v * kDeg : v;
+}
+ColumnSpec ParamDef::column(BlockKind kind) const {
+  return {name, type, unit, description, Role::parameter, std::string(to_string(kind))};
+}
+ColumnSpec MetricDef::column(BlockKind kind) const {
+  return {name, type, unit, description, Role::metric, std::string(to_string(kind))};
+}
+
+std::span<const BlockKind> block_kinds() { return kKindList; }
+
+std::vector<ParamDef> params(BlockKind kind, const KindContext& context) {
+  return kind == BlockKind::trajectory ? trajectory_params(context) : ik_params(context);
+}
+const ParamDef* find_param(const std::vector<ParamDef>& table, std::string_view name) {
+  for (const ParamDef& p : table)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+const std::vector<MetricDef>& metrics(BlockKind kind) {
+  return kind == BlockKind::trajectory ? trajectory_metrics() : ik_metrics();
+}
+std::span<const std::string_view> statuses(BlockKind kind) {
+  if (kind == BlockKind::trajectory) return kTrajectoryStatuses;
+  return kIkStatuses;
+}
+
+RunSpec default_run(BlockKind kind, const KindContext& c) {
+  if (kind == BlockKind::ik) return c.scara ? IkRun{} : IkRun::planar_defaults();
+  TrajectoryRun r;
+  r.options.integrator = c.integrator;
+  r.options.dt = c.dt;
+  r.options.vertex_alpha.assign(c.path_vertices >= 1 ? c.path_vertices - 1 : 0, 0.0);
+  r.inertia = c.inertia;
+  return r;
+}
+
+bool has_effect(const ParamDef& p, const std::vector<ParamDef>& table, const RunSpec& r) {
+  if (p.effect.always()) return true;
+  const ParamDef* ctl = find_param(table, p.effect.controller);
+  if (!ctl) return true;
+  const Cell v = ctl->get(r);
+  return p.effect.applies(std::get<std::string>(v));
+}
+
+ColumnSpec run_id_column() { return {"run_id", CellType::i64, "", "global run id (row index)", Role::bookkeeping, ""}; }
+ColumnSpec block_column() {
+  return {"block", CellType::str, "", "name of the study block the run belongs to", Role::bookkeeping, ""};
+}
+ColumnSpec status_column() {
+  std::string d;
+  for (BlockKind k : block_kinds()) {
+    d += (d.empty() ? "" : "; ") + std::string(to_string(k)) + ":";
+    const auto s = statuses(k);
+    for (std::size_t i = 0; i < s.size(); ++i) d += (i ? ", " : " ") + std::string(s[i]);
+  }
+  return {"status", CellType::str, "", d, Role::bookkeeping, ""};
+}
+ColumnSpec wall_time_column() {
+  return {"wall_time", CellType::f64, "s",
+          "wall-clock time of the run (the only column that varies between identical sweeps)", Role::bookkeeping, ""};
+}
+
+}  // namespace ks

@@ -1,0 +1,100 @@
+#pragma once
+// The parameter and metric tables: the only place a run parameter or metric is declared. Each entry
+// names it (the study-file key and /runs column), gives its type, its unit in the study file and as
+// stored, its domain, its default (read from the typed run struct, never written here), the rule
+// under which it has an effect, a one-line description, and accessors to the typed run.
+//
+// Everything that lists parameters or metrics reads these tables: the study parser (keys,
+// validation, did-you-mean, block defaults), the /runs column specs and their attributes,
+// `kinesweep schema` / `info` / `query`, and engine/store/FORMAT.md (checked by a test).
+#include <functional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "common/domain.hpp"
+#include "schema/run_spec.hpp"
+
+namespace ks {
+
+/// How a study file writes a value: as stored, or in degrees (stored in radians).
+enum class FileUnit { none, deg };
+
+/// What a block's tables depend on: its path and the study-wide defaults of [task] and [robot].
+struct KindContext {
+  std::size_t path_vertices = 5;                       ///< vertices of the path (the square: 5)
+  Integrator integrator = TrajectoryOptions{}.integrator;  ///< [task] integrator
+  double dt = TrajectoryOptions{}.dt;                  ///< [task] dt [s]
+  InertiaForm inertia = TrajectoryRun{}.inertia;       ///< [robot] inertia
+  bool scara = true;                                   ///< ik: the block's problem family (units, defaults)
+};
+
+/// When a parameter has an effect: always (no controller), or only while another text parameter
+/// (the controller, e.g. method) takes one of `when`. Sweeping it otherwise would only repeat runs.
+struct EffectRule {
+  std::string controller;
+  std::vector<std::string> when;
+  bool always() const { return controller.empty(); }
+  bool applies(std::string_view controller_value) const;
+  /// "always", or "only when method is lm or lm_adaptive"
+  std::string str() const;
+};
+
+/// A run parameter of one kind.
+struct ParamDef {
+  std::string name;
+  CellType type = CellType::f64;
+  FileUnit file_unit = FileUnit::none;
+  std::string unit;                  ///< stored unit ("rad", "s", "mm", "" ...)
+  std::vector<std::string> choices;  ///< text parameters: the names allowed
+  Domain domain;                     ///< numeric parameters: the rule (from the options struct)
+  std::string description;
+  EffectRule effect;
+  bool leading = false;              ///< applied before the others: its value sets their defaults (preset)
+  std::function<Cell(const RunSpec&)> get;
+  std::function<void(RunSpec&, const Cell&)> set;
+
+  /// The unit as the study file writes it ("deg" for angles).
+  std::string file_unit_name() const { return file_unit == FileUnit::deg ? "deg" : unit; }
+  /// A stored value from a value as the study file writes it (degrees -> radians; integers rounded).
+  Cell from_file(double file_value) const;
+  /// The /runs column (role parameter).
+  ColumnSpec column(BlockKind kind) const;
+};
+
+/// A metric of one kind, read from a run's outcome.
+struct MetricDef {
+  std::string name;
+  CellType type = CellType::f64;
+  std::string unit;
+  std::string description;
+  bool gridded = false;  ///< also kept in /landscapes
+  std::function<Cell(const RunOutcome&)> get;
+  ColumnSpec column(BlockKind kind) const;
+};
+
+/// The kinds, in order; their names are the study file's `kind` values.
+std::span<const BlockKind> block_kinds();
+/// The parameters of a kind, in /runs column order. Trajectory: preset, method, k, alpha1A, K_N,
+/// vertex_alpha_2 .. vertex_alpha_<path_vertices>, integrator, dt, torque_bound, inertia. IK:
+/// problem, method, lambda, q0_1 .. q0_3, target_x, target_y, target_z, target_alpha, tol, max_iter, z_mode.
+std::vector<ParamDef> params(BlockKind kind, const KindContext& context = {});
+/// The parameter named `name` in `table`, or nullptr.
+const ParamDef* find_param(const std::vector<ParamDef>& table, std::string_view name);
+/// The metrics of a kind, in /runs column order.
+const std::vector<MetricDef>& metrics(BlockKind kind);
+/// The status names of a kind, in enum order (the first is the good one: ok / converged).
+std::span<const std::string_view> statuses(BlockKind kind);
+/// A run of the kind with every default (the typed structs' own, with the context's study defaults).
+RunSpec default_run(BlockKind kind, const KindContext& context = {});
+/// True when parameter `p` of `table` has an effect on run `r` (its EffectRule).
+bool has_effect(const ParamDef& p, const std::vector<ParamDef>& table, const RunSpec& r);
+
+/// The bookkeeping columns of /runs.
+ColumnSpec run_id_column();
+ColumnSpec block_column();
+ColumnSpec status_column();
+ColumnSpec wall_time_column();
+
+}  // namespace ks

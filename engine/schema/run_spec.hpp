@@ -1,0 +1,86 @@
+#pragma once
+// Typed runs: what one run of each kind is (its parameters as the typed options of the method that
+// executes it) and what it returns (its metrics and an enum status). Names only appear at the edges:
+// the parameter and metric tables (schema/params.hpp) convert to and from /runs cells.
+#include <Eigen/Core>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <string_view>
+#include <variant>
+
+#include "ik/solve.hpp"
+#include "methods/trajectory.hpp"
+#include "model/arm.hpp"
+#include "store/record.hpp"
+
+namespace ks {
+
+/// Degrees to radians: the one conversion of study files, presets and defaults.
+inline constexpr double kDeg = std::numbers::pi / 180.0;
+
+/// The kinds of run a study block holds.
+enum class BlockKind { trajectory, ik };
+std::string_view to_string(BlockKind k);
+bool parse(std::string_view name, BlockKind& out);
+std::string_view to_string(InertiaForm f);
+bool parse(std::string_view name, InertiaForm& out);
+
+/// One redundancy-resolution run along the study's path.
+struct TrajectoryRun {
+  std::string preset;                            ///< seed 000 Table 4 row ("" when none)
+  TrajectoryOptions options;                     ///< method, k, alpha1A, K_N, vertex_alpha, integrator, dt, ...
+  InertiaForm inertia = InertiaForm::physical;   ///< closed form of M(q)
+};
+
+/// The IK problems of seed 001 (SCARA, lengths in mm) and the planar 3R arm (m, rad).
+enum class IkProblem { scara, planar3r_pose, planar3r_position };
+std::string_view to_string(IkProblem p);
+bool parse(std::string_view name, IkProblem& out);
+/// The SCARA's z residual; `unset` for the planar problems (stored as "").
+enum class ZMode { unset, thesis, physical };
+std::string_view to_string(ZMode z);
+bool parse(std::string_view name, ZMode& out);
+
+/// One numerical IK solve from an initial guess. Defaults: seed 001's SCARA problem; the planar 3R
+/// problems start from planar_defaults().
+struct IkRun {
+  IkProblem problem = IkProblem::scara;
+  ik::Options options;                    ///< method, lambda, tol, max_iter, ...
+  /// initial guess: theta1, theta2 [rad], then d [mm] (scara) or theta3 [rad]
+  Eigen::Vector3d q0{60.0 * kDeg, 45.0 * kDeg, 50.0};
+  /// target x, y, z [mm] (scara) or x, y [m] (planar; z unused: NaN)
+  Eigen::Vector3d target{50.0, -80.0, 10.0};
+  double target_alpha = std::numeric_limits<double>::quiet_NaN();  ///< planar3r_pose: orientation [rad]
+  ZMode z_mode = ZMode::thesis;
+
+  /// The defaults of the planar 3R problems (the seed arm reaching (1.5, 1.5) m, alpha 0, from
+  /// (0, 90, -90) deg).
+  static IkRun planar_defaults();
+  bool scara() const { return problem == IkProblem::scara; }
+};
+
+using RunSpec = std::variant<TrajectoryRun, IkRun>;
+inline BlockKind kind_of(const RunSpec& r) { return r.index() == 0 ? BlockKind::trajectory : BlockKind::ik; }
+
+/// What an IK solve returns to the store (the Summary less its history).
+struct IkResult {
+  ik::Status status = ik::Status::max_iter;
+  int iterations = 0, rejected = 0, solution = -1;
+  double error = 0.0, min_rcond = 1.0;
+  Eigen::Vector3d q = Eigen::Vector3d::Zero();
+};
+
+/// The outcome of one run: its metrics with an enum status, and its history (empty when off).
+struct RunOutcome {
+  std::variant<TrajectoryMetrics, IkResult> result;
+  RunHistory history;
+
+  BlockKind kind() const { return result.index() == 0 ? BlockKind::trajectory : BlockKind::ik; }
+  /// ok (trajectory) or converged (ik)
+  bool good() const;
+  /// The status name stored in /runs.
+  std::string_view status() const;
+};
+
+}  // namespace ks
