@@ -12,11 +12,7 @@
 #include <optional>
 #include <thread>
 
-#include "runner/optimize_blocks.hpp"
-#include "runner/sweep.hpp"
-#ifdef KINESWEEP_HAVE_MPI
-#include "runner/mpi_sweep.hpp"
-#endif
+#include "runner/run_study.hpp"
 #include "store/store.hpp"
 #include "study/study.hpp"
 
@@ -97,7 +93,7 @@ int dry_run(const Study& study, const StudySchema& schema, const HistoryPolicy& 
             << human_bytes(total * (per_run_b + 9.0 * schema.columns.size())) << "; estimated time: "
             << human_time(total * per_run_s / std::max(1, n)) << " on " << n << " threads (from " << samples
             << " sample runs)\n";
-  for (const OptimizeBlock& ob : study.optimizations) {  // issue 6: run after the sweep
+  for (const OptimizeBlock& ob : study.optimizations) {  // run after the sweep
     std::cout << "  optimization " << ob.name << ": minimise " << ob.objective_text << " over";
     for (const auto& v : ob.variables) std::cout << ' ' << v.name;
     if (!ob.polish_block.empty()) std::cout << "; sweep " << ob.polish_block << " (best " << ob.polish_best << ")";
@@ -173,93 +169,26 @@ int run_command(const RunArgs& a) {
     std::cerr << "kinesweep run: --resume and --overwrite exclude each other\n";
     return 2;
   }
-  const StudySchema schema = make_schema(study);
-  if (a.dry_run) return dry_run(study, schema, histories, a.threads, a.compression);
+  if (a.dry_run) return dry_run(study, make_schema(study), histories, a.threads, a.compression);
 
-  const std::string out = a.output.empty() ? study.output : a.output;
-#ifdef KINESWEEP_HAVE_MPI
-  if (launched_under_mpi()) {  // mpirun / srun: shards per rank, merged by rank 0 (runner/mpi_sweep.hpp)
-    DistributedRun d;
-    d.output = out;
-    d.study_arg = a.study;
-    d.resume = a.resume;
-    d.overwrite = a.overwrite;
-    d.quiet = a.quiet;
-    d.options.threads = a.threads;
-    d.options.histories = histories;
-    d.options.compression = a.compression;
-    d.options.stop = &g_stop;
-    ProgressDisplay progress(a.quiet);
-    d.options.on_progress = [&](const SweepProgress& p) { progress(p); };
-    std::signal(SIGINT, on_sigint);
-    std::signal(SIGTERM, on_sigint);
-    const int code = run_distributed(study, schema, d, std::cout, std::cerr);
-    std::signal(SIGINT, SIG_DFL);
-    return code;
-  }
-#endif
-  try {
-    std::unique_ptr<store::ResultsWriter> writer;
-    std::optional<PreviousRuns> previous;
-    const bool exists = std::filesystem::exists(out);
-    store::StoreOptions so;  // commits every second (see StoreOptions)
-    so.overwrite = a.overwrite;
-    if (exists && a.resume) {
-      previous = read_previous(out, schema);
-      writer = std::move(store::ResultsWriter::open_for_resume(out, study.sha256, so).writer);
-    } else {
-      if (exists && !a.overwrite) {
-        std::cerr << "kinesweep run: " << out << " exists; use --resume to complete it or --overwrite to replace it\n";
-        return 1;
-      }
-      if (!std::filesystem::path(out).parent_path().empty()) std::filesystem::create_directories(std::filesystem::path(out).parent_path());
-      store::StoreMeta meta;
-      meta.study_name = study.name;
-      meta.study_path = study.file;
-      meta.study_text = study.text;
-      meta.study_sha256 = study.sha256;
-      writer = store::ResultsWriter::create(out, meta, schema.columns, static_cast<std::int64_t>(study.run_count()), so);
-    }
-    SweepOptions o;
-    o.threads = a.threads;
-    o.histories = histories;
-    o.compression = a.compression;
-    o.stop = &g_stop;
-    ProgressDisplay progress(a.quiet);
-    o.on_progress = [&](const SweepProgress& p) { progress(p); };
-    std::signal(SIGINT, on_sigint);
-    std::signal(SIGTERM, on_sigint);
-    const SweepReport report = run_sweep(study, schema, *writer, o, previous ? &*previous : nullptr);
-    if (!report.interrupted && !study.optimizations.empty()) {  // issue 6: [[optimize]] blocks, after the sweep
-      print_report(std::cout, study, report);
-      std::optional<store::ResultsReader> cells;  // the landscape cells for polish_from, as just written
-      try {
-        cells.emplace(out);
-      } catch (const store::StoreError&) {
-      }
-      OptimizeRunOptions oo;
-      oo.threads = a.threads;
-      oo.cells = cells ? &*cells : nullptr;
-      run_optimizations(study, writer.get(), oo, &std::cout);
-    }
-    writer->close();
-    std::signal(SIGINT, SIG_DFL);
-    if (report.interrupted || study.optimizations.empty()) print_report(std::cout, study, report);
-    if (report.interrupted) {
-      std::cout << "interrupted: " << report.written + report.skipped << " of " << report.total
-                << " runs are in " << out << "\nresume with: kinesweep run " << a.study << " -o " << out
-                << " --resume\n";
-      return 130;
-    }
-    std::cout << "results: " << out << '\n';
-    return 0;
-  } catch (const store::StoreError& e) {
-    std::cerr << "kinesweep run: " << e.what() << '\n';
-    return 1;
-  } catch (const std::filesystem::filesystem_error& e) {
-    std::cerr << "kinesweep run: " << e.what() << '\n';
-    return 1;
-  }
+  RunRequest r;
+  r.study_arg = a.study;
+  r.output = a.output.empty() ? study.output : a.output;
+  r.resume = a.resume;
+  r.overwrite = a.overwrite;
+  r.quiet = a.quiet;
+  r.options.threads = a.threads;
+  r.options.histories = histories;
+  r.options.compression = a.compression;
+  r.options.stop = &g_stop;
+  ProgressDisplay progress(a.quiet);
+  r.options.on_progress = [&](const SweepProgress& p) { progress(p); };
+  std::signal(SIGINT, on_sigint);
+  std::signal(SIGTERM, on_sigint);
+  const int code = run_study(study, r, std::cout, std::cerr);
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  return code;
 }
 
 }  // namespace ks::cli

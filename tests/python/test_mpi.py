@@ -161,6 +161,29 @@ class KillOneRank(Base):
         self.assertEqual(glob.glob(out + ".rank*"), [])
 
 
+class OptimizationBlocks(Base):
+    def test_mpirun_runs_the_optimize_blocks_like_one_process(self):
+        """[[optimize]] blocks run under mpirun (on rank 0, after the merge) and give the single
+        process's /optimizations: every dataset and attribute but the wall times, bitwise."""
+        from regression_hashes import hash_results
+        study = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "studies", "optimize_polish.toml")
+        ref, out = os.path.join(self.dir, "ref.h5"), os.path.join(self.dir, "mpi.h5")
+        r = run("run", study, "-o", ref, "-q", "--histories", "none")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        r = mpirun("run", study, "-o", out, "-q", "--histories", "none", "--threads", "1")
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        self.assertIn("distributed: 2 ranks", r.stdout)
+        self.assertEqual(r.stdout.count("\noptimization "), 10, r.stdout)  # each block reported once, by rank 0
+        a, b = hash_results(ref), hash_results(out)
+        opt_a = {k: v for k, v in a.items() if k.startswith("optimizations/")}
+        opt_b = {k: v for k, v in b.items() if k.startswith("optimizations/")}
+        self.assertGreater(len(opt_a), 100)
+        self.assertEqual(opt_a.keys(), opt_b.keys())
+        for k in opt_a:
+            self.assertEqual(opt_a[k], opt_b[k], k)
+        self.assertSameFile(ref, out)
+
+
 if __name__ == "__main__":
     KS = os.path.abspath(sys.argv[1])
     unittest.main(argv=[sys.argv[0], "-v"])

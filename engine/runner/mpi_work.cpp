@@ -1,0 +1,101 @@
+// The run-id source of distributed sweeps (see mpi_work.hpp).
+#include "runner/mpi_work.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <thread>
+
+namespace ks::mpi {
+
+void wait_gently(MPI_Request& request, MPI_Status* status) {
+  int flag = 0;
+  auto pause = std::chrono::microseconds(10);
+  for (;;) {
+    MPI_Test(&request, &flag, status);
+    if (flag) return;
+    std::this_thread::sleep_for(pause);
+    pause = std::min(pause * 2, std::chrono::microseconds(200));
+  }
+}
+
+void bcast_bytes(std::vector<std::uint8_t>& v, MPI_Comm comm) {
+  constexpr std::size_t slice = std::size_t(1) << 30;
+  for (std::size_t at = 0; at < v.size(); at += slice)
+    MPI_Bcast(v.data() + at, static_cast<int>(std::min(slice, v.size() - at)), MPI_UINT8_T, 0, comm);
+}
+
+/// Rank 0's coordinator thread: answers chunk requests until every other rank has retired (got an
+/// empty chunk or said it quits). Request: {quit, runs written so far, threads}.
+void coordinate(MPI_Comm comm, int size, std::size_t batch, WorkPool& pool, std::vector<std::atomic<std::uint64_t>>& remote_done,
+                const std::atomic<bool>* stop) {
+  int active = size - 1;
+  std::vector<char> retired(size, 0);
+  while (active > 0) {
+    std::uint64_t req[3] = {0, 0, 1};
+    MPI_Request r;
+    MPI_Status st;
+    MPI_Irecv(req, 3, MPI_UINT64_T, MPI_ANY_SOURCE, kTagRequest, comm, &r);
+    wait_gently(r, &st);
+    const int src = st.MPI_SOURCE;
+    remote_done[src].store(req[1]);
+    if (req[0]) {
+      if (!retired[src]) retired[src] = 1, --active;
+      continue;
+    }
+    std::vector<std::uint64_t> ids;
+    if (!(stop && stop->load())) ids = pool.take_chunk(req[2], batch);
+    MPI_Send(ids.data(), static_cast<int>(ids.size()), MPI_UINT64_T, src, kTagReply, comm);
+    if (ids.empty()) retired[src] = 1, --active;
+  }
+}
+
+// RemoteSource
+bool RemoteSource::next(std::vector<std::uint64_t>& ids, std::size_t max) {
+  if (outstanding_) poll(false);
+  if (!finished_ && !outstanding_ && queue_.size() <= low_water_) request();
+  while (queue_.empty()) {
+    if (finished_) return false;
+    if (!outstanding_) request();
+    poll(true);
+  }
+  while (!queue_.empty() && ids.size() < max) {
+    ids.push_back(queue_.front());
+    queue_.pop_front();
+  }
+  return true;
+}
+
+void RemoteSource::finish() {
+  if (outstanding_) poll(true);
+  if (!retired_) {
+    std::uint64_t req[3] = {1, written.load(), static_cast<std::uint64_t>(threads_)};
+    MPI_Send(req, 3, MPI_UINT64_T, 0, kTagRequest, comm_);
+    retired_ = true;
+  }
+}
+
+void RemoteSource::request() {
+  MPI_Irecv(reply_.data(), static_cast<int>(reply_.size()), MPI_UINT64_T, 0, kTagReply, comm_, &pending_);
+  std::uint64_t req[3] = {0, written.load(), static_cast<std::uint64_t>(threads_)};
+  MPI_Send(req, 3, MPI_UINT64_T, 0, kTagRequest, comm_);
+  outstanding_ = true;
+}
+
+void RemoteSource::poll(bool wait) {
+  MPI_Status st;
+  int flag = 0;
+  if (wait) {
+    wait_gently(pending_, &st);
+    flag = 1;
+  } else {
+    MPI_Test(&pending_, &flag, &st);
+  }
+  if (!flag) return;
+  outstanding_ = false;
+  int n = 0;
+  MPI_Get_count(&st, MPI_UINT64_T, &n);
+  if (n == 0) finished_ = retired_ = true;
+  queue_.insert(queue_.end(), reply_.begin(), reply_.begin() + n);
+}
+
+}  // namespace ks::mpi

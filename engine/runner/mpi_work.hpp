@@ -1,0 +1,98 @@
+#pragma once
+// The run ids of a distributed sweep (internal to engine/runner): rank 0 holds the ids still to do
+// and hands them out in chunks that shrink as the work runs out (guided scheduling), answering
+// requests from a coordinator thread; every other rank fills its pipeline from a RemoteSource that
+// asks one chunk ahead. MPI threading: the coordinator thread and the workers' pipeline source stage
+// are the only callers of MPI during the sweep, never concurrently within one process.
+#include <mpi.h>
+
+#include <atomic>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <vector>
+
+namespace ks::mpi {
+
+inline constexpr int kTagRequest = 0x6b73;
+inline constexpr int kTagReply = 0x6b74;
+inline constexpr std::uint64_t kMaxChunk = 1024;  ///< largest chunk of run ids handed out at once
+
+/// Wait for a request without spinning a core (Open MPI's blocking waits busy-poll; the cores
+/// belong to the TBB workers).
+void wait_gently(MPI_Request& request, MPI_Status* status);
+/// MPI_Bcast of a byte vector of any size (in slices of 1 GiB) from rank 0.
+void bcast_bytes(std::vector<std::uint8_t>& v, MPI_Comm comm);
+
+/// The run ids still to do, handed out in ascending order (rank 0).
+class WorkPool {
+ public:
+  WorkPool(std::vector<std::uint64_t> todo, int ranks) : todo_(std::move(todo)), ranks_(ranks) {}
+  /// Up to `max` ids for rank 0's own pipeline.
+  std::vector<std::uint64_t> take(std::size_t max) { return slice(max); }
+  /// A chunk for a remote rank with `threads` threads: guided (remaining / 4 ranks), at least two
+  /// rounds of its pipeline, at most kMaxChunk.
+  std::vector<std::uint64_t> take_chunk(std::uint64_t threads, std::size_t batch) {
+    std::lock_guard<std::mutex> lock(m_);
+    const std::uint64_t remaining = todo_.size() - next_;
+    const std::uint64_t lo = std::max<std::uint64_t>(1, 2 * threads * batch);
+    const std::uint64_t n = std::min(kMaxChunk, std::max(lo, remaining / (4 * static_cast<std::uint64_t>(ranks_))));
+    return slice_locked(n);
+  }
+  void halt() {
+    std::lock_guard<std::mutex> lock(m_);
+    halted_ = true;
+  }
+
+ private:
+  std::vector<std::uint64_t> slice(std::size_t n) {
+    std::lock_guard<std::mutex> lock(m_);
+    return slice_locked(n);
+  }
+  std::vector<std::uint64_t> slice_locked(std::size_t n) {
+    if (halted_) return {};
+    n = std::min<std::size_t>(n, todo_.size() - next_);
+    std::vector<std::uint64_t> ids(todo_.begin() + next_, todo_.begin() + next_ + n);
+    next_ += n;
+    return ids;
+  }
+  std::mutex m_;
+  std::vector<std::uint64_t> todo_;
+  std::size_t next_ = 0;
+  int ranks_;
+  bool halted_ = false;
+};
+
+/// Rank 0's coordinator thread: answers chunk requests until every other rank has retired (got an
+/// empty chunk or said it quits). Request:;
+
+/// Rank 0's coordinator thread: answers chunk requests until every other rank has retired (got an
+/// empty chunk or said it quits). Request: {quit, runs written so far, threads}.
+void coordinate(MPI_Comm comm, int size, std::size_t batch, WorkPool& pool,
+                std::vector<std::atomic<std::uint64_t>>& remote_done, const std::atomic<bool>* stop);
+
+/// A worker rank's SweepOptions::source: a local queue refilled from rank 0, one request ahead.
+class RemoteSource {
+ public:
+  RemoteSource(MPI_Comm comm, int threads, std::size_t batch)
+      : comm_(comm), threads_(threads), low_water_(2 * static_cast<std::size_t>(threads) * batch), reply_(kMaxChunk) {}
+  /// Up to `max` ids; false when the work is finished.
+  bool next(std::vector<std::uint64_t>& ids, std::size_t max);
+  /// After the sweep (finished, interrupted or failed): settle the protocol with rank 0.
+  void finish();
+  std::atomic<std::uint64_t> written{0};
+
+ private:
+  void request();
+  void poll(bool wait);
+
+  MPI_Comm comm_;
+  int threads_;
+  std::size_t low_water_;
+  std::vector<std::uint64_t> reply_;
+  std::deque<std::uint64_t> queue_;
+  MPI_Request pending_ = MPI_REQUEST_NULL;
+  bool outstanding_ = false, finished_ = false, retired_ = false;
+};
+
+}  // namespace ks::mpi

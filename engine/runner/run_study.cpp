@@ -1,0 +1,134 @@
+// One "run a study" path (see run_study.hpp) and the local backend (this process's threads).
+#include "runner/run_study.hpp"
+
+#include <filesystem>
+#include <optional>
+#include <ostream>
+
+#include "runner/optimize_blocks.hpp"
+#include "runner/sweep_backend.hpp"
+
+namespace ks {
+
+namespace fs = std::filesystem;
+
+store::StoreMeta store_meta(const Study& study) {
+  store::StoreMeta meta;
+  meta.study_name = study.name;
+  meta.study_path = study.file;
+  meta.study_text = study.text;
+  meta.study_sha256 = study.sha256;
+  return meta;
+}
+
+std::string refuse_existing(const std::string& out, bool exists, const std::string& what, const RunRequest& r) {
+  if (!exists || r.resume || r.overwrite) return "";
+  return out + " " + what + "; use --resume to complete it or --overwrite to replace it";
+}
+
+namespace {
+
+class LocalBackend final : public SweepBackend {
+ public:
+  bool leader() const override { return true; }
+
+  int open(const Study& study, const StudySchema& schema, const RunRequest& r, std::ostream& err) override {
+    const std::string& out = r.output;
+    const bool exists = fs::exists(out);
+    if (const std::string why = refuse_existing(out, exists, "exists", r); !why.empty()) {
+      err << "kinesweep run: " << why << '\n';
+      return 1;
+    }
+    store::StoreOptions so;  // commits every second (see StoreOptions)
+    so.overwrite = r.overwrite;
+    if (exists && r.resume) {
+      previous_ = read_previous(out, schema);
+      writer_ = std::move(store::ResultsWriter::open_for_resume(out, study.sha256, so).writer);
+    } else {
+      if (!fs::path(out).parent_path().empty()) fs::create_directories(fs::path(out).parent_path());
+      writer_ = store::ResultsWriter::create(out, store_meta(study), schema.columns,
+                                             static_cast<std::int64_t>(study.run_count()), so);
+    }
+    return 0;
+  }
+
+  SweepResult sweep(const Study& study, const StudySchema& schema, const RunRequest& r, std::ostream&,
+                    std::ostream&) override {
+    SweepResult res;
+    SweepOptions o = r.options;
+    if (r.quiet) o.on_progress = nullptr;
+    res.report = run_sweep(study, schema, *writer_, o, previous_ ? &*previous_ : nullptr);
+    previous_.reset();
+    res.code = res.report.interrupted ? 130 : 0;
+    res.writer = std::move(writer_);
+    return res;
+  }
+
+  std::string kept_in(const RunRequest& r) const override { return r.output; }
+  std::string resume_command(const RunRequest& r) const override {
+    return "kinesweep run " + r.study_arg + " -o " + r.output + " --resume";
+  }
+  int finish(int code) override { return code; }
+
+ private:
+  std::optional<PreviousRuns> previous_;
+  std::unique_ptr<store::ResultsWriter> writer_;
+};
+
+/// The leader after the sweep: optimisation blocks into the same file, the report, the exit code.
+int conclude(const Study& study, const RunRequest& r, SweepBackend& backend, SweepResult& res, std::ostream& out) {
+  const SweepReport& report = res.report;
+  if (res.code != 0) {
+    if (res.writer) res.writer->close();
+    if (res.code == 130) print_report(out, study, report);
+    out << (res.code == 130 ? "interrupted" : "failed") << ": " << report.written + report.skipped << " of "
+        << report.total << " runs are kept in " << backend.kept_in(r) << "\nresume with: " << backend.resume_command(r)
+        << '\n';
+    return res.code;
+  }
+  print_report(out, study, report);
+  if (!study.optimizations.empty()) {
+    std::optional<store::ResultsReader> cells;  // the landscape cells for polish_from, as just written
+    try {
+      cells.emplace(r.output);
+    } catch (const store::StoreError&) {
+    }
+    OptimizeRunOptions oo;
+    oo.threads = backend.threads(r);
+    oo.cells = cells ? &*cells : nullptr;
+    run_optimizations(study, res.writer.get(), oo, &out);
+  }
+  res.writer->close();
+  out << "results: " << r.output << '\n' << std::flush;
+  return 0;
+}
+
+}  // namespace
+
+std::unique_ptr<SweepBackend> local_backend() { return std::make_unique<LocalBackend>(); }
+
+int run_study(const Study& study, const RunRequest& request, std::ostream& out, std::ostream& err) {
+  const StudySchema schema = make_schema(study);
+#ifdef KINESWEEP_HAVE_MPI
+  std::unique_ptr<SweepBackend> backend = launched_under_mpi() ? mpi_backend() : local_backend();
+#else
+  std::unique_ptr<SweepBackend> backend = local_backend();
+#endif
+  int code = 0;
+  try {
+    code = backend->open(study, schema, request, err);
+    if (code == 0) {
+      SweepResult res = backend->sweep(study, schema, request, out, err);
+      code = backend->leader() ? conclude(study, request, *backend, res, out) : res.code;
+    }
+  } catch (const store::StoreError& e) {
+    err << "kinesweep run: " << e.what() << '\n';
+    code = 1;
+  } catch (const fs::filesystem_error& e) {
+    err << "kinesweep run: " << e.what() << '\n';
+    code = 1;
+  }
+  return backend->finish(code);
+}
+
+}  // namespace ks

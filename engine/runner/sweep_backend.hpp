@@ -1,0 +1,53 @@
+#pragma once
+// Where a study's runs are computed and stored (internal to engine/runner): this process's threads
+// into the results file, or MPI ranks into shards merged by rank 0. run_study drives either through
+// the same steps: open, sweep, then (leader only) optimisations and report, then finish.
+#include <memory>
+#include <ostream>
+#include <string>
+
+#include "runner/run_study.hpp"
+
+namespace ks {
+
+struct SweepResult {
+  int code = 0;          ///< 0 done, 1 failed, 130 interrupted (the same on every rank)
+  SweepReport report;    ///< the leader's report of the whole sweep
+  std::unique_ptr<store::ResultsWriter> writer;  ///< leader, done: the final file, still open
+};
+
+class SweepBackend {
+ public:
+  virtual ~SweepBackend() = default;
+  /// True on the process that prints and runs the optimisation blocks.
+  virtual bool leader() const = 0;
+  /// Check the output against --resume / --overwrite and open what the sweep writes into. Returns 0,
+  /// or an exit code after printing the problem to `err`. May throw store::StoreError.
+  virtual int open(const Study& study, const StudySchema& schema, const RunRequest& request, std::ostream& err) = 0;
+  /// Compute the runs not done yet. May throw store::StoreError.
+  virtual SweepResult sweep(const Study& study, const StudySchema& schema, const RunRequest& request,
+                            std::ostream& out, std::ostream& err) = 0;
+  /// Threads for the optimisation blocks on the leader.
+  virtual int threads(const RunRequest& request) const { return request.options.threads; }
+  /// Where an interrupted sweep keeps its runs, and the command that resumes it.
+  virtual std::string kept_in(const RunRequest& request) const = 0;
+  virtual std::string resume_command(const RunRequest& request) const = 0;
+  /// The exit code every process returns, given the leader's `code` (MPI: broadcast, finalise).
+  virtual int finish(int code) = 0;
+};
+
+/// This process's threads, writing the results file directly.
+std::unique_ptr<SweepBackend> local_backend();
+#ifdef KINESWEEP_HAVE_MPI
+/// MPI ranks (MPI_Init here, MPI_Finalize in finish()).
+std::unique_ptr<SweepBackend> mpi_backend();
+/// True when an MPI launcher (mpirun/mpiexec of Open MPI or MPICH, srun with PMI/PMIx) started this
+/// process, judged from its environment (no MPI call).
+bool launched_under_mpi();
+#endif
+
+/// "exists; use --resume ... or --overwrite ..." when `out` (or its `what`) exists and neither was
+/// asked for; "" otherwise.
+std::string refuse_existing(const std::string& out, bool exists, const std::string& what, const RunRequest& request);
+
+}  // namespace ks
