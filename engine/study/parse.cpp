@@ -24,7 +24,8 @@ std::size_t Study::block_index(std::string_view n) const {
   return Block::npos;
 }
 
-Study study_parse::Parser::run(std::string_view text) {
+Study study_parse::Parser::run() {
+  const std::string_view text = text_;
   Study s;
   s.file = file_;
   s.text = std::string(text);
@@ -52,13 +53,18 @@ Study study_parse::Parser::run(std::string_view text) {
 }
 
 Study parse_study(std::string_view text, std::string_view file, const StudyOptions& options) {
-  return study_parse::Parser(std::string(file), options).run(text);
+  return study_parse::Parser(std::string(file), text, options).run();
 }
 
 Study load_study(const std::filesystem::path& file, const StudyOptions& options) {
   std::ifstream in(file, std::ios::binary);
-  if (!in)
-    throw StudyError({{file.string(), 1, 1, "cannot read the study file; expected a readable TOML file"}});
+  if (!in) {
+    StudyDiagnostic d;  // no source line: the headline alone
+    d.file = file.string();
+    d.line = d.column = 1;
+    d.message = "cannot read the study file; expected a readable TOML file";
+    throw StudyError({d});
+  }
   std::ostringstream ss;
   ss << in.rdbuf();
   return parse_study(ss.str(), file.string(), options);

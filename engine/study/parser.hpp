@@ -35,9 +35,11 @@ std::vector<std::string> objective_names(BlockKind k);
 
 class Parser : public ParserCore {
  public:
-  Parser(std::string file, StudyOptions options) : ParserCore(std::move(file)), options_(options) {}
+  /// `text` must outlive the parser.
+  Parser(std::string file, std::string_view text, StudyOptions options)
+      : ParserCore(std::move(file), text), text_(text), options_(options) {}
 
-  Study run(std::string_view text);
+  Study run();
 
  private:
   // study_tables.cpp
@@ -67,6 +69,7 @@ class Parser : public ParserCore {
   std::string domain_problem(const std::string& name, double file_value);
   Cell convert(const ParamInfo& info, double file_value, bool scara) const;
 
+  std::string_view text_;
   StudyOptions options_;
   std::uint64_t max_runs_ = 0;
   double path_duration_ = 2.0;  // [s], the task's; bounds the samples a dt asks for

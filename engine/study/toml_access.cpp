@@ -89,6 +89,10 @@ Pos pos_of(const toml::source_region& r) {
   Pos p;
   if (r.begin.line > 0) p.line = int(r.begin.line);
   if (r.begin.column > 0) p.column = int(r.begin.column);
+  if (r.begin.line > 0 && r.end.line == r.begin.line && r.end.column > r.begin.column)
+    p.length = int(r.end.column - r.begin.column);  // toml++'s end is one past the region
+  else if (r.begin.line > 0 && r.end.line > r.begin.line)
+    p.length = 0;
   return p;
 }
 
@@ -104,9 +108,65 @@ std::vector<std::pair<const toml::key*, const toml::node*>> ordered(const toml::
 }
 
 // ---------------------------------------------------------------------------------------------------
+namespace {
+/// Code points in s (UTF-8: every byte that is not a continuation byte starts one).
+int code_points(std::string_view s) {
+  return int(std::count_if(s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
+}
+
+/// `p.length`, with 0 (to the end of the line) resolved against the line's text, trailing blanks not
+/// counted; at least 1.
+int underline_length(const Pos& p, const std::optional<std::string>& line) {
+  if (p.length > 0) return p.length;
+  if (!line) return 1;
+  std::string_view rest = *line;
+  std::size_t i = 0;  // byte offset of code point p.column - 1
+  for (int cp = 1; cp < p.column && i < rest.size(); ++cp) {
+    ++i;
+    while (i < rest.size() && (static_cast<unsigned char>(rest[i]) & 0xC0) == 0x80) ++i;
+  }
+  rest.remove_prefix(i);
+  while (!rest.empty() && (rest.back() == ' ' || rest.back() == '\t')) rest.remove_suffix(1);
+  return std::max(1, code_points(rest));
+}
+}  // namespace
+
+ParserCore::ParserCore(std::string file, std::string_view text) : file_(std::move(file)) {
+  for (std::size_t begin = 0;;) {
+    const std::size_t end = text.find('\n', begin);
+    std::string_view line = text.substr(begin, end == std::string_view::npos ? std::string_view::npos : end - begin);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    lines_.push_back(line);
+    if (end == std::string_view::npos) break;
+    begin = end + 1;
+  }
+}
+
+std::optional<std::string> ParserCore::line_text(int line) const {
+  if (line < 1 || std::size_t(line) > lines_.size()) return std::nullopt;
+  return std::string(lines_[std::size_t(line) - 1]);
+}
+
 StudyDiagnostic& ParserCore::error(Pos p, std::string msg) {
-  diags_.push_back({file_, p.line, p.column, std::move(msg)});
+  StudyDiagnostic d;
+  d.file = file_;
+  d.line = p.line;
+  d.column = p.column;
+  d.message = std::move(msg);
+  d.source_line = line_text(p.line);
+  d.length = underline_length(p, d.source_line);
+  diags_.push_back(std::move(d));
   return diags_.back();
+}
+
+void ParserCore::note(StudyDiagnostic& d, Pos p, std::string msg) const {
+  StudyDiagnostic::Note n;
+  n.line = p.line;
+  n.column = p.column;
+  n.message = std::move(msg);
+  n.source_line = line_text(p.line);
+  n.length = underline_length(p, n.source_line);
+  d.notes.push_back(std::move(n));
 }
 
 void ParserCore::check_keys(const toml::table& t, const std::vector<std::string>& allowed, std::string_view where) {

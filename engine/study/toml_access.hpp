@@ -20,11 +20,12 @@ namespace ks::study_parse {
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 /// A place in the study text: 1-based line and column (columns count Unicode code points, as toml++
-/// does).
+/// does), and how many code points of the line a diagnostic underlines (0: to the end of the line).
 struct Pos {
   int line = 1, column = 1;
+  int length = 1;
 };
-/// The start of `r`.
+/// The start of `r`, underlining the region when it lies on one line, else the rest of its first line.
 Pos pos_of(const toml::source_region& r);
 
 /// A table's entries in file order (toml++ tables iterate by key).
@@ -44,17 +45,21 @@ std::string type_name(const toml::node& n);
 /// A number as a message shows it (12 significant digits).
 std::string fmt(double v);
 
-/// Collects the diagnostics of one study text and reads typed values.
+/// Collects the diagnostics of one study text, each with its source line, and reads typed values.
 class ParserCore {
  public:
-  explicit ParserCore(std::string file) : file_(std::move(file)) {}
+  /// `text` must outlive the parser.
+  ParserCore(std::string file, std::string_view text);
 
  protected:
-  /// Record an error at `p` (or at a TOML region, node or key).
+  /// Record an error at `p` (or at a TOML region, node or key); the returned diagnostic takes notes
+  /// (valid until the next error).
   StudyDiagnostic& error(Pos p, std::string msg);
   StudyDiagnostic& error(const toml::source_region& r, std::string msg) { return error(pos_of(r), std::move(msg)); }
   StudyDiagnostic& error(const toml::node& n, std::string msg) { return error(n.source(), std::move(msg)); }
   StudyDiagnostic& error(const toml::key& k, std::string msg) { return error(k.source(), std::move(msg)); }
+  /// Add a secondary note pointing at `p` (with its source line) to `d`.
+  void note(StudyDiagnostic& d, Pos p, std::string msg) const;
   /// Report keys of `t` not in `allowed` (with a suggestion).
   void check_keys(const toml::table& t, const std::vector<std::string>& allowed, std::string_view where);
 
@@ -68,6 +73,12 @@ class ParserCore {
 
   std::string file_;
   std::vector<StudyDiagnostic> diags_;
+
+ private:
+  /// The text of `line` (1-based) without its line break; nullopt past the end of the text.
+  std::optional<std::string> line_text(int line) const;
+
+  std::vector<std::string_view> lines_;
 };
 
 }  // namespace ks::study_parse
