@@ -21,15 +21,17 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
     const Pos np = pos_of(b.get("name")->source());
     if (v->empty()) error(np, "block name is empty; expected a non-empty, unique name");
     else if (auto it = names.find(*v); it != names.end())
-      error(np, "duplicate block name '" + *v + "' (first at line " + std::to_string(it->second.line) +
-                    "); expected unique block names");
+      note(error(np, "duplicate block name '" + *v + "' (first at line " + std::to_string(it->second.line) +
+                         "); expected unique block names"),
+           it->second, std::string(optimize ? "optimisation '" : "block '") + *v + "' first defined here");
     else names.emplace(*v, np);
     spec.name = *v;
   } else if (!b.get("name") && optimize && b.get("preset") && b.get("preset")->as_string()) {
     spec.name = b.get("preset")->as_string()->get();  // an optimisation of a seed row is named after it
     if (auto it = names.find(spec.name); it != names.end())
-      error(bpos, label + " is named '" + spec.name + "' after its preset, like the one at line " +
-                      std::to_string(it->second.line) + "; expected unique names (give name = \"...\")");
+      note(error(bpos, label + " is named '" + spec.name + "' after its preset, like the one at line " +
+                           std::to_string(it->second.line) + "; expected unique names (give name = \"...\")"),
+           it->second, "'" + spec.name + "' first defined here");
     else names.emplace(spec.name, bpos);
   } else if (!b.get("name")) {
     error(bpos, label + " has no name; expected name = \"...\" (unique)" + (optimize ? " or a preset" : ""));
@@ -97,8 +99,12 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
     if (!axes_t) error(*an, "axes is " + type_name(*an) + "; expected a table [block.axes] of parameter = values");
   }
   std::set<std::string> axis_names;
+  std::map<std::string, Pos> axis_keys;  // where each axis is written
   if (axes_t)
-    for (auto&& [k, n] : *axes_t) axis_names.insert(std::string(k.str()));
+    for (auto&& [k, n] : *axes_t) {
+      axis_names.insert(std::string(k.str()));
+      axis_keys.emplace(std::string(k.str()), pos_of(k.source()));
+    }
 
   // IK problem family, needed for q0_3's unit: from the fixed problem or the problem axis.
   bool scara = true;
@@ -119,8 +125,11 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
       scara = ik_problem_is_scara(probs.front().first);
       for (const auto& [p, node] : probs)
         if (ik_problem_is_scara(p) != scara) {
-          error(*node, "problem '" + p + "' mixes the SCARA (mm) with the planar 3R (m, deg) problems in one block; "
-                       "expected separate blocks for scara and planar3r_* problems");
+          note(error(*node, "problem '" + p + "' mixes the SCARA (mm) with the planar 3R (m, deg) problems in one "
+                            "block; expected separate blocks for scara and planar3r_* problems"),
+               pos_of(probs.front().second->source()),
+               "the block's first problem, '" + probs.front().first + "', is " +
+                   (scara ? "the SCARA problem (mm)" : "a planar 3R problem (m, deg)"));
           break;
         }
     }
@@ -140,7 +149,11 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
       for (std::size_t i = 0; i < a->size(); ++i) {
         const std::string pname = "vertex_alpha_" + std::to_string(i + 2);
         if (b.get(pname) || axis_names.count(pname)) {
-          error(*k, "vertex_alpha and " + pname + " both given; expected one or the other");
+          auto& d = error(*k, "vertex_alpha and " + pname + " both given; expected one or the other");
+          if (auto it = b.find(pname); it != b.end()) note(d, pos_of(it->first.source()), pname + " given here");
+          else note(d, axis_keys.at(pname), pname + " is an axis here");
+          note(d, Pos{0, 0}, "vertex_alpha = [...] is shorthand for vertex_alpha_2 .. vertex_alpha_" +
+                                 std::to_string(nverts));
           continue;
         }
         if (auto c = param_value(*info_of(pname), *a->get(i), scara)) spec.fixed.emplace_back(pname, *c);
@@ -150,7 +163,8 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
     const ParamInfo* info = info_of(key);
     if (!info) continue;
     if (axis_names.count(key)) {
-      error(*k, "'" + key + "' is both a fixed parameter and an axis; expected one or the other");
+      note(error(*k, "'" + key + "' is both a fixed parameter and an axis; expected one or the other"),
+           axis_keys.at(key), "'" + key + "' is an axis here");
       continue;
     }
     if (auto c = param_value(*info, *n, scara)) spec.fixed.emplace_back(key, *c);
@@ -232,7 +246,7 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
     const auto* za = zn->as_array();
     if (!za) error(*zn, "zip is " + type_name(*zn) + "; expected zip = [[\"a\", \"b\"], ...]");
     else {
-      std::set<std::string> zipped;
+      std::map<std::string, Pos> zipped;  // axis -> its first zip entry
       std::vector<std::string> all_axes(axis_names.begin(), axis_names.end());
       for (const auto& g : *za) {
         const auto* ga = g.as_array();
@@ -246,6 +260,7 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
         }
         std::vector<std::string> group;
         std::vector<std::string> lens;
+        std::vector<std::pair<Pos, std::string>> len_notes;  // at each axis: its length
         std::optional<std::size_t> len;
         bool unequal = false, ok = true;
         for (const auto& e : *ga) {
@@ -262,8 +277,9 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
             ok = false;
             continue;
           }
-          if (!zipped.insert(nm).second) {
-            error(e, "axis '" + nm + "' is zipped twice; expected each axis in at most one zip group");
+          if (auto [first, fresh] = zipped.emplace(nm, pos_of(e.source())); !fresh) {
+            note(error(e, "axis '" + nm + "' is zipped twice; expected each axis in at most one zip group"),
+                 first->second, "'" + nm + "' first zipped here");
             ok = false;
             continue;
           }
@@ -278,12 +294,15 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
             continue;
           }
           lens.push_back(nm + " (" + std::to_string(it->axis.values.size()) + ")");
+          len_notes.emplace_back(it->pos, "axis '" + nm + "' has " + std::to_string(it->axis.values.size()) +
+                                              (it->axis.values.size() == 1 ? " value" : " values"));
           if (len && *len != it->axis.values.size()) unequal = true;
           len = it->axis.values.size();
           group.push_back(nm);
         }
         if (unequal) {
-          error(g, "zipped axes have different lengths: " + join(lens) + "; expected equal lengths");
+          auto& d = error(g, "zipped axes have different lengths: " + join(lens) + "; expected equal lengths");
+          for (const auto& [at, msg] : len_notes) note(d, at, msg);
           ok = false;
         }
         if (ok) spec.groups.push_back(group);
