@@ -161,7 +161,7 @@ TEST(StudyErrors, CollectsEveryError) {
   EXPECT_EQ(e.diagnostics()[1].line, 5);
   EXPECT_EQ(e.diagnostics()[2].line, 7);
   const std::string w = e.what();
-  EXPECT_EQ(std::count(w.begin(), w.end(), '\n'), 2);
+  EXPECT_EQ(std::count(w.begin(), w.end(), '\n'), 2 + 3 * 3 + 2);  // 3 headlines, 3 lines of source each, 2 blank lines
 }
 
 TEST(StudyErrors, UnreadableFile) {
@@ -170,6 +170,169 @@ TEST(StudyErrors, UnreadableFile) {
     FAIL();
   } catch (const StudyError& e) {
     EXPECT_EQ(std::string(e.what()).rfind("/nonexistent/dir/x.toml:1:1: error: cannot read", 0), 0u);
+  }
+}
+
+// ---- Diagnostics as rustc shows them: the source line, a caret under the column, notes ----
+// Columns count Unicode code points, as toml++ counts them (not bytes): 'ü' or '→' is one column, a tab
+// is one column. The caret line counts terminal cells: a tab is shown as 4 spaces, an East Asian wide
+// character takes 2 cells.
+namespace {
+std::vector<std::string> lines_of(const std::string& s) {
+  std::vector<std::string> v;
+  std::istringstream in(s);
+  for (std::string l; std::getline(in, l);) v.push_back(l);
+  return v;
+}
+
+/// The first diagnostic of `text` is on `line`; rendered, it shows that line in the gutter and carets
+/// under `token` (whose first occurrence in the line starts `cells` terminal cells in; default: its
+/// byte offset, for ASCII lines), one per cell of the token.
+StudyDiagnostic expect_caret(const std::string& text, int line, const std::string& token, int cells = -1) {
+  const StudyError e = error_of(text);
+  if (e.diagnostics().empty()) return {};
+  const StudyDiagnostic& d = e.diagnostics().front();
+  EXPECT_EQ(d.line, line) << e.what();
+  const std::string source = lines_of(text).at(std::size_t(line - 1));
+  const std::size_t at = source.find(token);
+  EXPECT_NE(at, std::string::npos);
+  if (cells < 0) cells = int(at);
+  const std::string n = std::to_string(line), pad(n.size(), ' ');
+  const auto r = lines_of(d.str());
+  EXPECT_EQ(r.size(), 4u) << d.str();
+  if (r.size() < 4) return d;
+  EXPECT_EQ(r[0], d.headline());
+  EXPECT_EQ(r[1], pad + " |");
+  EXPECT_EQ(r[2].rfind(n + " | ", 0), 0u) << d.str();
+  EXPECT_EQ(r[3], pad + " | " + std::string(std::size_t(cells), ' ') + std::string(token.size(), '^')) << d.str();
+  return d;
+}
+}  // namespace
+
+TEST(StudyDiagnostics, CaretUnderAnUnknownKey) {
+  const std::string text = kTraj + "k = 0.5\n  alpah1A = 3\n";
+  const StudyDiagnostic d = expect_caret(text, 5, "alpah1A");
+  EXPECT_EQ(d.column, 3);
+  EXPECT_EQ(d.str(), "bad.toml:5:3: error: " + d.message + "\n  |\n5 |   alpah1A = 3\n  |   ^^^^^^^");
+}
+
+TEST(StudyDiagnostics, CaretUnderAnUnknownAxis) {
+  const StudyDiagnostic d = expect_caret(kTraj + "[block.axes]\nk = [0, 1]\n    alpha1a = [1, 2]\n", 6, "alpha1a");
+  EXPECT_EQ(d.column, 5);
+  EXPECT_NE(d.message.find("unknown axis 'alpha1a'"), std::string::npos);
+}
+
+TEST(StudyDiagnostics, CaretUnderABadValueInAnInlineTable) {
+  const StudyDiagnostic d = expect_caret(kTraj + "[block.axes]\nk = { from = 0, to = 1, count = 2.5 }\n", 5, "2.5");
+  EXPECT_EQ(d.column, 33);
+  EXPECT_NE(d.message.find("count is a float; expected an integer"), std::string::npos);
+  // A bad string value underlines the string with its quotes.
+  expect_caret("study = { name = \"s\", histories = \"sometimes\" }\n" + kTraj, 1, "\"sometimes\"");
+}
+
+TEST(StudyDiagnostics, SourceLineIsPrintedForSyntaxErrorsToo) {
+  const StudyError e = error_of(kTraj + "k = \n");
+  const auto r = lines_of(e.diagnostics().front().str());
+  ASSERT_EQ(r.size(), 4u) << e.what();
+  EXPECT_EQ(r[2], "4 | k =");  // no trailing blank
+  EXPECT_EQ(r[3], "  |     ^");
+  EXPECT_EQ(e.diagnostics().front().source_line, "k = ");
+}
+
+TEST(StudyDiagnostics, MultiByteCharactersBeforeTheErrorDoNotMoveTheCaret) {
+  // 'ü', '→' and 'ö' are 2, 3 and 2 bytes but one column (code point) and one cell each.
+  const std::string line = "study = { description = \"Zürich → Köln\", histories = \"sometimes\" }";
+  const std::string prefix = "study = { description = \"Zurich - Koln\", histories = ";  // same code points
+  const StudyDiagnostic d = expect_caret(line + "\n" + kTraj, 1, "\"sometimes\"", int(prefix.size()));
+  EXPECT_EQ(d.column, int(prefix.size()) + 1);                        // code points, not bytes:
+  EXPECT_EQ(line.find("\"sometimes\"") + 1, prefix.size() + 1 + 4);  // the byte column would be 4 more
+  // A tab is one column but shown as 4 spaces; CJK characters are one column but 2 cells wide.
+  const StudyDiagnostic t = expect_caret(kTraj + "\tk = \"half\"\n", 4, "\"half\"", 4 + 4);
+  EXPECT_EQ(t.column, 6);
+  const std::string wide = "study = { description = \"東京\", histories = \"x\" }";
+  const std::string as_columns = "study = { description = \"TK\", histories = ";   // 東京: 2 columns,
+  const std::string as_cells = "study = { description = \"TOKY\", histories = ";   // 4 cells
+  const StudyDiagnostic w = expect_caret(wide + "\n" + kTraj, 1, "\"x\"", int(as_cells.size()));
+  EXPECT_EQ(w.column, int(as_columns.size()) + 1);
+}
+
+TEST(StudyDiagnostics, DuplicateBlockNameNotesTheFirstDefinition) {
+  const StudyError e = error_of(kTraj + "[[block]]\nname = \"b\"\nkind = \"ik\"\n");
+  const StudyDiagnostic& d = e.diagnostics().front();
+  ASSERT_EQ(d.notes.size(), 1u) << e.what();
+  EXPECT_EQ(d.notes[0].line, 2);
+  EXPECT_EQ(d.notes[0].column, 8);
+  EXPECT_EQ(d.str(), "bad.toml:5:8: error: duplicate block name 'b' (first at line 2); expected unique block names\n"
+                     "  |\n"
+                     "5 | name = \"b\"\n"
+                     "  |        ^^^\n"
+                     "note: bad.toml:2:8: block 'b' first defined here\n"
+                     "  |\n"
+                     "2 | name = \"b\"\n"
+                     "  |        ^^^");
+  // [[optimize]] names too, also when taken from the preset.
+  const StudyError o = error_of(kTraj + "[[optimize]]\npreset = \"1g\"\n[[optimize]]\npreset = \"1g\"\n");
+  ASSERT_EQ(o.diagnostics().front().notes.size(), 1u) << o.what();
+  EXPECT_EQ(o.diagnostics().front().line, 6);
+  EXPECT_EQ(o.diagnostics().front().notes[0].line, 4);
+}
+
+TEST(StudyDiagnostics, NotesAtTheOtherPlaceOfAConflict) {
+  // fixed and an axis: the note is at the axis
+  StudyError e = error_of(kTraj + "k = 0.5\n[block.axes]\nk = [0, 1]\n");
+  ASSERT_EQ(e.diagnostics().front().notes.size(), 1u) << e.what();
+  EXPECT_EQ(e.diagnostics().front().notes[0].line, 6);
+  // vertex_alpha and vertex_alpha_3: a note at vertex_alpha_3, and one without a place
+  e = error_of(kTraj + "vertex_alpha = [1, 2, 3, 4]\nvertex_alpha_3 = 7\n");
+  const auto& notes = e.diagnostics().front().notes;
+  ASSERT_EQ(notes.size(), 2u) << e.what();
+  EXPECT_EQ(notes[0].line, 5);
+  EXPECT_EQ(notes[1].line, 0);
+  EXPECT_NE(std::string(e.what()).find("\n  = note: vertex_alpha = [...] is shorthand"), std::string::npos) << e.what();
+  // zip groups of unequal length: each axis with its length, at its line
+  e = error_of(kTraj + "zip = [[\"alpha1A\", \"k\"]]\n[block.axes]\nalpha1A = [1, 2, 3]\nk = [0, 1]\n");
+  const auto& z = e.diagnostics().front().notes;
+  ASSERT_EQ(z.size(), 2u) << e.what();
+  EXPECT_EQ(z[0].line, 6);
+  EXPECT_EQ(z[0].message, "axis 'alpha1A' has 3 values");
+  EXPECT_EQ(z[1].line, 7);
+  EXPECT_EQ(z[1].message, "axis 'k' has 2 values");
+  // mixed SCARA / planar problems: at the first problem
+  e = error_of(kIk + "[block.axes]\nproblem = [\"scara\", \"planar3r_pose\"]\n");
+  ASSERT_EQ(e.diagnostics().front().notes.size(), 1u) << e.what();
+  EXPECT_EQ(e.diagnostics().front().notes[0].column, 12);
+  EXPECT_NE(e.diagnostics().front().notes[0].message.find("'scara'"), std::string::npos);
+}
+
+TEST(StudyDiagnostics, LongLinesAreClippedAroundTheColumn) {
+  StudyDiagnostic d;
+  d.file = "f.toml";
+  d.line = 3;
+  d.column = 301;
+  d.length = 5;
+  d.message = "m";
+  d.source_line = std::string(300, 'a') + "TOKEN" + std::string(300, 'b');
+  const auto r = lines_of(d.str());
+  ASSERT_EQ(r.size(), 4u);
+  const std::string shown = r[2].substr(4), carets = r[3].substr(4);
+  EXPECT_EQ(shown.substr(0, 3), "...");
+  EXPECT_EQ(shown.substr(shown.size() - 3), "...");
+  EXPECT_LE(shown.size(), 106u);
+  const std::size_t at = carets.find('^');
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_EQ(shown.substr(at, 5), "TOKEN");
+  EXPECT_EQ(carets.substr(at), "^^^^^");
+}
+
+TEST(StudyDiagnostics, UnreadableFileHasNoGutter) {
+  try {
+    load_study("/nonexistent/dir/x.toml");
+    FAIL();
+  } catch (const StudyError& e) {
+    ASSERT_EQ(e.diagnostics().size(), 1u);
+    EXPECT_FALSE(e.diagnostics().front().source_line.has_value());
+    EXPECT_EQ(std::string(e.what()),
+              "/nonexistent/dir/x.toml:1:1: error: cannot read the study file; expected a readable TOML file");
   }
 }
 

@@ -1,10 +1,11 @@
-// kinesweep: the command-line front end (run, table4; info and query read results files).
+// kinesweep: the command-line front end (run, table4, schema; info and query read results files).
 #include <CLI/CLI.hpp>
 #include <iostream>
 
 #include "cli/info_command.hpp"
 #include "cli/query_command.hpp"
 #include "cli/run_command.hpp"
+#include "cli/schema_command.hpp"
 #include "cli/table4.hpp"
 
 int main(int argc, char** argv) {
@@ -14,6 +15,7 @@ int main(int argc, char** argv) {
   ks::cli::RunArgs& run = ks::cli::add_run_command(app);
   ks::cli::InfoArgs& info = ks::cli::add_info_command(app);
   ks::cli::QueryArgs& query = ks::cli::add_query_command(app);
+  ks::cli::SchemaArgs& schema = ks::cli::add_schema_command(app);
   auto* table4 = app.add_subcommand("table4", "Print seed 000's Table 4 beside kinesweep's figures (no file)");
   try {
     app.parse(argc, argv);
@@ -28,5 +30,6 @@ int main(int argc, char** argv) {
   if (app.got_subcommand("run")) return ks::cli::run_command(run);
   if (app.got_subcommand("info")) return ks::cli::info_command(info);
   if (app.got_subcommand("query")) return ks::cli::query_command(query);
+  if (app.got_subcommand("schema")) return ks::cli::schema_command(schema);
   return 0;
 }

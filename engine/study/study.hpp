@@ -19,16 +19,36 @@
 
 namespace ks {
 
-/// One problem in a study file.
+/// One problem in a study file. Lines and columns are 1-based; columns count Unicode code points (as
+/// toml++ does), not bytes: a multi-byte UTF-8 character such as 'é' is one column, and so is a tab.
 struct StudyDiagnostic {
+  /// A secondary note: another place that explains the error (e.g. where a duplicate name was first
+  /// defined), or a remark without a place (line 0).
+  struct Note {
+    int line = 0, column = 0;                ///< 0: the note has no place
+    std::string message;
+    std::optional<std::string> source_line;  ///< the text of `line`, when known
+    int length = 1;                          ///< code points underlined from `column`
+  };
+
   std::string file;
-  int line = 0, column = 0;  ///< 1-based
-  std::string message;       ///< "<what was wrong>; expected <what was expected>[; did you mean 'x'?]"
+  int line = 0, column = 0;
+  std::string message;  ///< "<what was wrong>; expected <what was expected>[; did you mean 'x'?]"
+  /// The text of `line` without its line break; nullopt when there is no source (unreadable file).
+  std::optional<std::string> source_line;
+  int length = 1;           ///< code points underlined from `column` (the key or token; at least 1)
+  std::vector<Note> notes;  ///< in the order they explain the error
+
   /// FILE:LINE:COL: error: message
+  std::string headline() const;
+  /// The headline; with a source line, the line in a numbered gutter and a caret (^^^) under the
+  /// column, as rustc shows errors; then the notes ("note: FILE:LINE:COL: ..." with their own line,
+  /// or "= note: ..."). Tabs are expanded; a long line is clipped around the column.
   std::string str() const;
 };
 
-/// A malformed study file. what(): every diagnostic's str(), one per line, in file order.
+/// A malformed study file. what(): every diagnostic's str(), in file order (a blank line between
+/// diagnostics that take more than one line).
 class StudyError : public std::runtime_error {
  public:
   explicit StudyError(std::vector<StudyDiagnostic> diagnostics);
@@ -54,7 +74,7 @@ struct StudyTask {
   Path2 path() const { return Path2(vertices, durations); }
 };
 
-/// An optimisation block ([[optimize]] in a study file; syntax in studies/README.md, issue 6).
+/// An optimisation block ([[optimize]] in a study file; syntax in studies/README.md).
 /// One evaluation = the runs of `base` (its fixed parameters, and its axes as an evaluation set, e.g.
 /// the IK start set) with the variables' columns replaced by x; the objective is the weighted sum of
 /// metrics averaged over those runs (failure_rate: the fraction of runs not converged).

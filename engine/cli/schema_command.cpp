@@ -1,0 +1,163 @@
+#include "cli/schema_command.hpp"
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <iostream>
+
+#include "schema/params.hpp"
+
+namespace ks::cli {
+
+namespace {
+
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.12g", v);
+  return b;
+}
+std::string type_name(CellType t) { return t == CellType::f64 ? "f64" : t == CellType::i64 ? "i64" : "str"; }
+
+/// A parameter's value in run `r`, as the study file writes it (angles in degrees).
+std::string file_value(const ParamDef& p, const RunSpec& r) {
+  const Cell c = p.get(r);
+  if (const double* d = std::get_if<double>(&c)) return num(p.file_unit == FileUnit::deg ? *d / kDeg : *d);
+  if (const std::int64_t* i = std::get_if<std::int64_t>(&c)) return std::to_string(*i);
+  return "\"" + std::get<std::string>(c) + "\"";
+}
+
+std::string json_str(std::string_view s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    o += c;
+  }
+  return o + "\"";
+}
+
+/// The contexts a kind's table is listed for: trajectory on the seed's square; ik for the SCARA and
+/// for the planar 3R problems (their units and defaults differ).
+struct Listed {
+  BlockKind kind;
+  std::string family;
+  KindContext context;
+};
+std::vector<Listed> listed() {
+  KindContext planar;
+  planar.scara = false;
+  return {{BlockKind::trajectory, "", {}}, {BlockKind::ik, "scara", {}}, {BlockKind::ik, "planar3r", planar}};
+}
+
+}  // namespace
+
+void print_schema_markdown(std::ostream& os) {
+  const auto all = listed();
+  for (BlockKind kind : block_kinds()) {
+    os << "Parameters of `" << to_string(kind) << "` runs (units: in the study file / as stored";
+    if (kind == BlockKind::ik) os << "; where they differ, planar3r problems after the semicolon";
+    os << "):\n\n| column | type | unit | domain | default | has an effect | description |\n"
+          "|---|---|---|---|---|---|---|\n";
+    std::vector<const Listed*> ctx;
+    for (const Listed& l : all)
+      if (l.kind == kind) ctx.push_back(&l);
+    std::vector<std::vector<ParamDef>> tables;
+    std::vector<RunSpec> defaults;
+    for (const Listed* l : ctx) {
+      tables.push_back(params(kind, l->context));
+      defaults.push_back(default_run(kind, l->context));
+    }
+    for (std::size_t i = 0; i < tables[0].size(); ++i) {
+      auto joined = [&](auto f) {
+        std::string s = f(tables[0][i], defaults[0]);
+        for (std::size_t c = 1; c < tables.size(); ++c)
+          if (const std::string o = f(tables[c][i], defaults[c]); o != s) s += "; " + o;
+        return s;
+      };
+      const ParamDef& p = tables[0][i];
+      const std::string unit = joined([](const ParamDef& q, const RunSpec&) {
+        return q.file_unit_name() == q.unit ? (q.unit.empty() ? "-" : q.unit) : q.file_unit_name() + " / " + q.unit;
+      });
+      std::string domain = p.domain.str(p.name);
+      if (!p.choices.empty()) {
+        domain = "one of";
+        for (const auto& c : p.choices) domain += " `" + c + "`";
+      }
+      const std::string dflt = joined([](const ParamDef& q, const RunSpec& r) { return file_value(q, r); });
+      os << "| `" << p.name << "` | " << type_name(p.type) << " | " << unit << " | " << (domain.empty() ? "any" : domain)
+         << " | " << dflt << " | " << p.effect.str() << " | " << p.description << (p.leading ? " (applied first)" : "")
+         << " |\n";
+    }
+    os << "\nMetrics of `" << to_string(kind) << "` runs:\n\n| column | type | unit | in /landscapes | description |\n"
+          "|---|---|---|---|---|\n";
+    for (const MetricDef& m : metrics(kind))
+      os << "| `" << m.name << "` | " << type_name(m.type) << " | " << (m.unit.empty() ? "-" : m.unit) << " | "
+         << (m.gridded ? "yes" : "no") << " | " << m.description << " |\n";
+    os << "\nStatuses of `" << to_string(kind) << "` runs:";
+    for (auto s : statuses(kind)) os << " `" << s << "`";
+    os << "\n\n";
+  }
+  os << "Bookkeeping columns (every run):\n\n| column | type | unit | description |\n|---|---|---|---|\n";
+  for (const ColumnSpec& c : {run_id_column(), block_column(), status_column(), wall_time_column()})
+    os << "| `" << c.name << "` | " << type_name(c.type) << " | " << (c.unit.empty() ? "-" : c.unit) << " | "
+       << c.description << " |\n";
+}
+
+void print_schema_json(std::ostream& os) {
+  os << "{\"kinds\": [";
+  bool first_kind = true;
+  for (const Listed& l : listed()) {
+    const auto table = params(l.kind, l.context);
+    const RunSpec d = default_run(l.kind, l.context);
+    os << (first_kind ? "" : ",") << "\n {\"kind\": " << json_str(to_string(l.kind)) << ", \"family\": "
+       << json_str(l.family) << ", \"params\": [";
+    first_kind = false;
+    for (std::size_t i = 0; i < table.size(); ++i) {
+      const ParamDef& p = table[i];
+      const Cell c = p.get(d);
+      std::string dv;
+      if (const double* x = std::get_if<double>(&c)) dv = std::isfinite(*x) ? num(*x) : "null";
+      else if (const std::int64_t* n = std::get_if<std::int64_t>(&c)) dv = std::to_string(*n);
+      else dv = json_str(std::get<std::string>(c));
+      os << (i ? "," : "") << "\n  {\"name\": " << json_str(p.name) << ", \"type\": " << json_str(type_name(p.type))
+         << ", \"file_unit\": " << json_str(p.file_unit_name()) << ", \"unit\": " << json_str(p.unit)
+         << ", \"domain\": " << json_str(p.domain.str(p.name)) << ", \"default\": " << dv
+         << ", \"effect_controller\": " << json_str(p.effect.controller) << ", \"effect_when\": [";
+      for (std::size_t w = 0; w < p.effect.when.size(); ++w) os << (w ? ", " : "") << json_str(p.effect.when[w]);
+      os << "], \"choices\": [";
+      for (std::size_t w = 0; w < p.choices.size(); ++w) os << (w ? ", " : "") << json_str(p.choices[w]);
+      os << "], \"leading\": " << (p.leading ? "true" : "false") << ", \"description\": " << json_str(p.description)
+         << "}";
+    }
+    os << "],\n  \"metrics\": [";
+    const auto& ms = metrics(l.kind);
+    for (std::size_t i = 0; i < ms.size(); ++i)
+      os << (i ? "," : "") << "\n  {\"name\": " << json_str(ms[i].name) << ", \"type\": " << json_str(type_name(ms[i].type))
+         << ", \"unit\": " << json_str(ms[i].unit) << ", \"gridded\": " << (ms[i].gridded ? "true" : "false")
+         << ", \"description\": " << json_str(ms[i].description) << "}";
+    os << "],\n  \"statuses\": [";
+    const auto st = statuses(l.kind);
+    for (std::size_t i = 0; i < st.size(); ++i) os << (i ? ", " : "") << json_str(st[i]);
+    os << "]}";
+  }
+  os << "],\n \"bookkeeping\": [";
+  bool first = true;
+  for (const ColumnSpec& c : {run_id_column(), block_column(), status_column(), wall_time_column()}) {
+    os << (first ? "" : ", ") << json_str(c.name);
+    first = false;
+  }
+  os << "]}\n";
+}
+
+SchemaArgs& add_schema_command(CLI::App& app) {
+  static SchemaArgs a;
+  auto* c = app.add_subcommand("schema", "List every run parameter and metric (name, type, units, domain, default)");
+  c->add_option("--format", a.format, "markdown | json")->check(CLI::IsMember({"markdown", "json"}));
+  return a;
+}
+
+int schema_command(const SchemaArgs& a) {
+  if (a.format == "json") print_schema_json(std::cout);
+  else print_schema_markdown(std::cout);
+  return 0;
+}
+
+}  // namespace ks::cli

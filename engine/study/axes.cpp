@@ -1,0 +1,254 @@
+// Parameter values (type, choices, unit, domain) and the axis forms of [block.axes]: value lists,
+// range, linspace, random and Latin-hypercube axes.
+#include <algorithm>
+#include <cmath>
+
+#include "study/parser.hpp"
+
+namespace ks::study_parse {
+
+std::string Parser::domain_problem(const ParamInfo& info, double v) {
+  if (auto p = info.domain.problem(info.name, v); !p.empty()) return p;
+  if (info.name == "dt" && path_duration_ / v + 1 > kMaxSamples)  // the path's samples bound dt from below
+    return "dt = " + fmt(v) + " gives " + fmt(std::floor(path_duration_ / v) + 1) + " samples on the " +
+           fmt(path_duration_) + " s path; expected at most " + fmt(kMaxSamples) + " (dt >= " +
+           fmt(path_duration_ / (kMaxSamples - 1)) + ")";
+  return "";
+}
+
+std::optional<Cell> Parser::param_value(const ParamInfo& info, const toml::node& n) {
+  if (info.type == CellType::str) {
+    const auto* s = n.as_string();
+    if (!s) {
+      error(n, info.name + " is " + type_name(n) + "; expected a string" +
+                   (info.choices.empty() ? "" : " (one of " + join(info.choices) + ")"));
+      return std::nullopt;
+    }
+    const std::string v = s->get();
+    if (!info.choices.empty() && std::find(info.choices.begin(), info.choices.end(), v) == info.choices.end()) {
+      error(n, "unknown " + info.name + " '" + v + "'; expected one of " + join(info.choices) +
+                   suggest(v, info.choices));
+      return std::nullopt;
+    }
+    return Cell(v);
+  }
+  if (info.type == CellType::i64) {
+    auto v = get_integer(n, info.name);
+    if (!v) return std::nullopt;
+    if (auto p = domain_problem(info, double(*v)); !p.empty()) {
+      error(n, p);
+      return std::nullopt;
+    }
+    return Cell(*v);
+  }
+  auto v = get_number(n, info.name);
+  if (!v) return std::nullopt;
+  if (auto p = domain_problem(info, *v); !p.empty()) {
+    error(n, p);
+    return std::nullopt;
+  }
+  return info.from_file(*v);
+}
+
+// ---------------------------------------------------------------------------------------------------
+std::optional<AxisDraft> Parser::parse_axis(const ParamInfo& info_ref, const toml::key& key_node, const toml::node& node,
+                                          const toml::node* lhs_node) {
+  const ParamInfo* info = &info_ref;
+  const toml::node* n = &node;
+  const std::string key(key_node.str());
+  AxisDraft d;
+  d.axis.name = key;
+  d.pos = pos_of(key_node.source());
+  const std::string what = "axis '" + key + "'";
+  const std::string forms =
+      info->type == CellType::str
+          ? "a list of names [\"a\", \"b\"] or { values = [...] }"
+          : "a list [...], { values = [...] }, { from, to, step }, { from, to, count }, { random = { from, to, count, seed } } or { lhs = { from, to } }";
+  const toml::array* list = n->as_array();
+  const toml::table* t = n->as_table();
+  if (t && t->get("values")) {
+    check_keys(*t, {"values"}, what + " (a value list)");
+    list = t->get("values")->as_array();
+    if (!list) {
+      error(*t->get("values"), what + " values is " + type_name(*t->get("values")) + "; expected an array");
+      return std::nullopt;
+    }
+    t = nullptr;
+  }
+  bool ok = true;
+  if (list) {
+    d.axis.form = "values";
+    if (list->empty()) {
+      error(*n, what + " has an empty value list; expected at least one value");
+      return std::nullopt;
+    }
+    for (const auto& e : *list) {
+      auto c = param_value(*info, e);
+      if (!c) ok = false;
+      else d.axis.values.push_back(std::move(*c));
+    }
+  } else if (t) {
+    if (info->type == CellType::str) {
+      error(*n, what + " is a numeric range but " + key + " is a name; expected " + forms);
+      return std::nullopt;
+    }
+    const bool is_int = info->type == CellType::i64;
+    auto gen_check = [&](const std::vector<double>& vals, const toml::node& at) {
+      for (double v : vals) {
+        if (is_int && std::abs(v - std::round(v)) > 1e-9 * std::max(1.0, std::abs(v))) {
+          error(at, what + " yields " + fmt(v) + "; expected integer values for " + key);
+          return false;
+        }
+        if (auto p = domain_problem(*info, v); !p.empty()) {
+          error(at, what + " yields " + p);
+          return false;
+        }
+      }
+      return true;
+    };
+    auto fill = [&](const std::vector<double>& vals) {
+      for (double v : vals) d.axis.values.push_back(info->from_file(v));
+    };
+    if (const toml::node* rn = t->get("random")) {
+      check_keys(*t, {"random"}, what + " (random)");
+      d.axis.form = "random";
+      const auto* rt = rn->as_table();
+      if (!rt) {
+        error(*rn, what + " random is " + type_name(*rn) + "; expected random = { from, to, count, seed }");
+        return std::nullopt;
+      }
+      if (is_int) {
+        error(*rn, what + ": random draws give non-integers; expected a list or an integer range for " + key);
+        return std::nullopt;
+      }
+      check_keys(*rt, {"from", "to", "count", "seed"}, what + " random");
+      auto from = get_number(*rt, "from", "from"), to = get_number(*rt, "to", "to");
+      std::optional<std::int64_t> count, seed;
+      if (rt->get("count")) count = get_integer(*rt->get("count"), "count");
+      if (rt->get("seed")) seed = get_integer(*rt->get("seed"), "seed");
+      for (const char* req : {"from", "to", "count", "seed"})
+        if (!rt->get(req))
+          error(*rn, what + " random has no " + req + "; expected random = { from, to, count, seed }");
+      if (!from || !to || !count || !seed) return std::nullopt;
+      if (*count < 1) {
+        error(*rt->get("count"), what + " count = " + std::to_string(*count) + "; expected count >= 1");
+        return std::nullopt;
+      }
+      if (*seed < 0) {
+        error(*rt->get("seed"), what + " seed = " + std::to_string(*seed) + "; expected seed >= 0");
+        return std::nullopt;
+      }
+      if (*from > *to) {
+        error(*rn, what + " has from = " + fmt(*from) + " > to = " + fmt(*to) + "; expected from <= to");
+        return std::nullopt;
+      }
+      if (std::uint64_t(*count) > max_runs_) {
+        error(*rt->get("count"), what + " count = " + std::to_string(*count) + "; expected at most max_runs = " +
+                                     std::to_string(max_runs_));
+        return std::nullopt;
+      }
+      const auto vals = uniform_draws(std::uint64_t(*seed), std::uint64_t(*count), *from, *to);
+      if (!gen_check(vals, *rn)) return std::nullopt;
+      fill(vals);
+    } else if (const toml::node* ln = t->get("lhs")) {
+      check_keys(*t, {"lhs"}, what + " (lhs)");
+      d.axis.form = "lhs";
+      d.lhs = true;
+      const auto* lt = ln->as_table();
+      if (!lt) {
+        error(*ln, what + " lhs is " + type_name(*ln) + "; expected lhs = { from, to }");
+        return std::nullopt;
+      }
+      if (is_int) {
+        error(*ln, what + ": LHS draws give non-integers; expected a list or an integer range for " + key);
+        return std::nullopt;
+      }
+      check_keys(*lt, {"from", "to"}, what + " lhs");
+      auto from = get_number(*lt, "from", "from"), to = get_number(*lt, "to", "to");
+      if (!lt->get("from") || !lt->get("to")) error(*ln, what + " lhs lacks from or to; expected lhs = { from, to }");
+      if (!from || !to) return std::nullopt;
+      if (*from > *to) {
+        error(*ln, what + " has from = " + fmt(*from) + " > to = " + fmt(*to) + "; expected from <= to");
+        return std::nullopt;
+      }
+      if (!gen_check({*from, *to}, *ln)) return std::nullopt;
+      if (!lhs_node) {
+        error(*ln, what + " uses lhs but the block has no lhs settings; expected lhs = { count = N, seed = S } in the block");
+        return std::nullopt;
+      }
+      d.lhs_range = {*from, *to};
+    } else if (t->get("step") || t->get("count")) {
+      const bool is_range = t->get("step") != nullptr;
+      d.axis.form = is_range ? "range" : "linspace";
+      if (t->get("step") && t->get("count")) {
+        error(*n, what + " has both step and count; expected { from, to, step } or { from, to, count }");
+        return std::nullopt;
+      }
+      check_keys(*t, {"from", "to", is_range ? "step" : "count"}, what + (is_range ? " (range)" : " (linspace)"));
+      if (!t->get("from") || !t->get("to")) {
+        error(*n, what + " lacks from or to; expected { from, to, " + (is_range ? "step }" : "count }"));
+        return std::nullopt;
+      }
+      auto from = get_number(*t, "from", "from"), to = get_number(*t, "to", "to");
+      if (!from || !to) return std::nullopt;
+      std::vector<double> vals;
+      if (is_range) {
+        auto step = get_number(*t, "step", "step");
+        if (!step) return std::nullopt;
+        if (*step == 0) {
+          error(*t->get("step"), what + " has step = 0; expected a nonzero step");
+          return std::nullopt;
+        }
+        const std::uint64_t cnt = range_count(*from, *to, *step);
+        if (cnt == 0) {
+          error(*n, what + " is an empty range: from = " + fmt(*from) + (*step > 0 ? " > " : " < ") + "to = " +
+                        fmt(*to) + " with step = " + fmt(*step) + "; expected from " + (*step > 0 ? "<=" : ">=") +
+                        " to (or a step of the other sign)");
+          return std::nullopt;
+        }
+        if (cnt > max_runs_) {
+          error(*n, what + " has " + std::to_string(cnt) + " values; expected at most max_runs = " +
+                        std::to_string(max_runs_));
+          return std::nullopt;
+        }
+        vals = range_values(*from, *to, *step);
+      } else {
+        if (is_int) {
+          error(*t->get("count"), what + ": linspace gives non-integers in general; expected a list or { from, to, step } for " + key);
+          return std::nullopt;
+        }
+        auto count = get_integer(*t->get("count"), "count");
+        if (!count) return std::nullopt;
+        if (*count < 1) {
+          error(*t->get("count"), what + " count = " + std::to_string(*count) + "; expected count >= 1");
+          return std::nullopt;
+        }
+        if (*from > *to) {
+          error(*n, what + " has from = " + fmt(*from) + " > to = " + fmt(*to) + "; expected from <= to");
+          return std::nullopt;
+        }
+        if (std::uint64_t(*count) > max_runs_) {
+          error(*t->get("count"), what + " count = " + std::to_string(*count) + "; expected at most max_runs = " +
+                                      std::to_string(max_runs_));
+          return std::nullopt;
+        }
+        vals = linspace_values(*from, *to, std::uint64_t(*count));
+      }
+      if (!gen_check(vals, *n)) return std::nullopt;
+      fill(vals);
+    } else {
+      std::vector<std::string> axis_keys{"values", "from", "to", "step", "count", "random", "lhs"};
+      check_keys(*t, axis_keys, what);
+      error(*n, what + " gives no values; expected " + forms);
+      return std::nullopt;
+    }
+  } else {
+    error(*n, what + " is " + type_name(*n) + " (a single value); expected " + forms +
+                  " (a fixed value belongs in the block, outside [block.axes])");
+    return std::nullopt;
+  }
+  if (!ok) return std::nullopt;
+  return d;
+}
+
+}  // namespace ks::study_parse
