@@ -15,6 +15,12 @@ std::string num(double v) {
   std::snprintf(b, sizeof b, "%.12g", v);
   return b;
 }
+/// `s` in a markdown table cell.
+std::string cell(std::string_view s) {
+  std::string o;
+  for (char c : s) o += c == '|' ? std::string("\\|") : std::string(1, c);
+  return o;
+}
 std::string type_name(CellType t) { return t == CellType::f64 ? "f64" : t == CellType::i64 ? "i64" : "str"; }
 
 /// A parameter's value in run `r`, as the study file writes it (angles in degrees).
@@ -54,7 +60,9 @@ void print_schema_markdown(std::ostream& os) {
   for (BlockKind kind : block_kinds()) {
     os << "Parameters of `" << to_string(kind) << "` runs (units: in the study file / as stored";
     if (kind == BlockKind::ik) os << "; where they differ, planar3r problems after the semicolon";
-    os << "):\n\n| column | type | unit | domain | default | has an effect | description |\n"
+    os << ")";
+    if (kind == BlockKind::trajectory) os << "; one `vertex_alpha_<i>` per path vertex after the first (the square: 2 .. 5)";
+    os << ":\n\n| column | type | unit | domain | default | has an effect | description |\n"
           "|---|---|---|---|---|---|---|\n";
     std::vector<const Listed*> ctx;
     for (const Listed& l : all)
@@ -83,14 +91,14 @@ void print_schema_markdown(std::ostream& os) {
       }
       const std::string dflt = joined([](const ParamDef& q, const RunSpec& r) { return file_value(q, r); });
       os << "| `" << p.name << "` | " << type_name(p.type) << " | " << unit << " | " << (domain.empty() ? "any" : domain)
-         << " | " << dflt << " | " << p.effect.str() << " | " << p.description << (p.leading ? " (applied first)" : "")
+         << " | " << dflt << " | " << p.effect.str() << " | " << cell(p.description) << (p.leading ? " (applied first)" : "")
          << " |\n";
     }
     os << "\nMetrics of `" << to_string(kind) << "` runs:\n\n| column | type | unit | in /landscapes | description |\n"
           "|---|---|---|---|---|\n";
     for (const MetricDef& m : metrics(kind))
       os << "| `" << m.name << "` | " << type_name(m.type) << " | " << (m.unit.empty() ? "-" : m.unit) << " | "
-         << (m.gridded ? "yes" : "no") << " | " << m.description << " |\n";
+         << (m.gridded ? "yes" : "no") << " | " << cell(m.description) << " |\n";
     os << "\nStatuses of `" << to_string(kind) << "` runs:";
     for (auto s : statuses(kind)) os << " `" << s << "`";
     os << "\n\n";
@@ -98,7 +106,7 @@ void print_schema_markdown(std::ostream& os) {
   os << "Bookkeeping columns (every run):\n\n| column | type | unit | description |\n|---|---|---|---|\n";
   for (const ColumnSpec& c : {run_id_column(), block_column(), status_column(), wall_time_column()})
     os << "| `" << c.name << "` | " << type_name(c.type) << " | " << (c.unit.empty() ? "-" : c.unit) << " | "
-       << c.description << " |\n";
+       << cell(c.description) << " |\n";
 }
 
 void print_schema_json(std::ostream& os) {
