@@ -4,6 +4,7 @@
 // listings (`kinesweep schema`, FORMAT.md).
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <string>
 #include <string_view>
 
@@ -48,5 +49,24 @@ struct Domain {
     return std::string(name) + " = " + b + "; expected " + str(name);
   }
 };
+
+/// One field of an options struct, for IsValid: its name, value and rule.
+struct FieldRule {
+  const char* name;
+  double value;
+  Domain rule;
+};
+/// True when every field is finite and within its rule; otherwise false, with `why` (when given)
+/// naming the first field that is not and its rule.
+inline bool fields_valid(std::initializer_list<FieldRule> fields, std::string* why) {
+  for (const FieldRule& f : fields) {
+    std::string p = std::isfinite(f.value) ? f.rule.problem(f.name, f.value)
+                                           : std::string(f.name) + " is not finite; expected a finite number";
+    if (p.empty()) continue;
+    if (why) *why = std::move(p);
+    return false;
+  }
+  return true;
+}
 
 }  // namespace ks

@@ -16,29 +16,22 @@ template std::ostream& operator<<(std::ostream&, const Summary<3, 2>&);
 namespace ks::ik {
 
 bool Options::IsValid(std::string* why) const {
-  auto bad = [&](std::string msg) {
-    if (why) *why = std::move(msg);
+  if (!fields_valid({{"tolerance", tolerance, tolerance_rule},
+                     {"max_iter", double(max_iter), max_iter_rule},
+                     {"step_floor", step_floor, step_floor_rule},
+                     {"lambda", lambda, lambda_rule},
+                     {"lambda_scale", lambda_scale, lambda_scale_rule},
+                     {"rcond_min", rcond_min, rcond_min_rule},
+                     {"divergence_bound", divergence_bound, divergence_bound_rule},
+                     {"cycle_tolerance", cycle_tolerance, cycle_tolerance_rule},
+                     {"match_tolerance", match_tolerance, match_tolerance_rule}},
+                    why))
     return false;
-  };
-  const std::pair<const char*, std::pair<double, Domain>> fields[] = {
-      {"tolerance", {tolerance, tolerance_rule}},
-      {"max_iter", {double(max_iter), max_iter_rule}},
-      {"step_floor", {step_floor, step_floor_rule}},
-      {"lambda", {lambda, lambda_rule}},
-      {"lambda_scale", {lambda_scale, lambda_scale_rule}},
-      {"rcond_min", {rcond_min, rcond_min_rule}},
-      {"divergence_bound", {divergence_bound, divergence_bound_rule}},
-      {"cycle_tolerance", {cycle_tolerance, cycle_tolerance_rule}},
-      {"match_tolerance", {match_tolerance, match_tolerance_rule}},
-  };
-  for (const auto& [name, vr] : fields) {
-    if (!std::isfinite(vr.first)) return bad(std::string(name) + " is not finite; expected a finite number");
-    if (auto p = vr.second.problem(name, vr.first); !p.empty()) return bad(p);
-  }
-  if (cycle_window < 0 || cycle_window > max_cycle_window)
-    return bad("cycle_window = " + std::to_string(cycle_window) + "; expected cycle_window within [0, " +
-               std::to_string(max_cycle_window) + "]");
-  return true;
+  if (cycle_window >= 0 && cycle_window <= max_cycle_window) return true;
+  if (why)
+    *why = "cycle_window = " + std::to_string(cycle_window) + "; expected cycle_window within [0, " +
+           std::to_string(max_cycle_window) + "]";
+  return false;
 }
 
 }  // namespace ks::ik

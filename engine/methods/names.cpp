@@ -31,24 +31,19 @@ bool parse(std::string_view n, RunStatus& out) { return value_of(kStatuses, n, o
 namespace ks {
 
 bool TrajectoryOptions::IsValid(std::string* why) const {
-  auto bad = [&](std::string msg) {
-    if (why) *why = std::move(msg);
+  if (!fields_valid({{"k", k, Domain::any()},
+                     {"alpha1A", alpha1A, Domain::any()},
+                     {"null_damping", null_damping, null_damping_rule},
+                     {"dt", dt, dt_rule},
+                     {"torque_bound", torque_bound, torque_bound_rule},
+                     {"singular_tolerance", singular_tolerance, singular_tolerance_rule}},
+                    why))
     return false;
-  };
-  const std::pair<const char*, std::pair<double, Domain>> fields[] = {
-      {"k", {k, Domain::any()}},
-      {"alpha1A", {alpha1A, Domain::any()}},
-      {"null_damping", {null_damping, null_damping_rule}},
-      {"dt", {dt, dt_rule}},
-      {"torque_bound", {torque_bound, torque_bound_rule}},
-      {"singular_tolerance", {singular_tolerance, singular_tolerance_rule}},
-  };
-  for (const auto& [name, vr] : fields) {
-    if (!std::isfinite(vr.first)) return bad(std::string(name) + " is not finite; expected a finite number");
-    if (auto p = vr.second.problem(name, vr.first); !p.empty()) return bad(p);
-  }
   for (double a : vertex_alpha)
-    if (!std::isfinite(a)) return bad("vertex_alpha has a value that is not finite; expected finite angles [rad]");
+    if (!std::isfinite(a)) {
+      if (why) *why = "vertex_alpha has a value that is not finite; expected finite angles [rad]";
+      return false;
+    }
   return true;
 }
 
