@@ -35,6 +35,16 @@ StudySchema make_schema(const Study& study) {
     for (const ColumnSpec& m : metric_columns(b.kind())) mc.push_back(add(c, m));
     s.metric_column.push_back(std::move(mc));
   }
+  for (std::size_t b = 0; b < study.blocks.size(); ++b) {  // role and kinds (run_id, block, status, wall_time: defaults)
+    const std::string kind(to_string(study.blocks[b].kind()));
+    auto mark = [&](std::size_t i, Role role) {
+      c[i].role = role;
+      if (("," + c[i].kinds + ",").find("," + kind + ",") == std::string::npos)
+        c[i].kinds += (c[i].kinds.empty() ? "" : ",") + kind;
+    };
+    for (std::size_t i : s.param_column[b]) mark(i, Role::parameter);
+    for (std::size_t i : s.metric_column[b]) mark(i, Role::metric);
+  }
   s.status = add(c, {"status", CellType::str, "",
                      "trajectory: ok, unreachable_start, singular, diverged; ik: converged, stalled, singular, "
                      "max_iter, cycle, diverged, unsupported, no_solution"});
