@@ -118,33 +118,36 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
   write_i64_attr(runs, "n_runs", n_runs);
   hsize_t n = static_cast<hsize_t>(n_runs);
   Hid space(H5Screate_simple(1, &n, nullptr));
-  auto make = [&](const std::string& name, hid_t ftype, hid_t mtype, const void* fill, const std::string& unit,
-                  const std::string& desc, const char* type_attr) {
+  auto make = [&](const ColumnSpec& c, hid_t ftype, hid_t mtype, const void* fill, const char* type_attr) {
     Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
     H5Pset_layout(dcpl, H5D_CONTIGUOUS);
     H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY);  // rows live at fixed addresses from creation on
     H5Pset_fill_time(dcpl, H5D_FILL_TIME_ALLOC);
     if (fill) H5Pset_fill_value(dcpl, mtype, fill);
-    Hid d(check(H5Dcreate2(runs, name.c_str(), ftype, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), path,
-                "create /runs/" + name));
-    write_str_attr(d, "unit", unit);
-    write_str_attr(d, "description", desc);
+    Hid d(check(H5Dcreate2(runs, c.name.c_str(), ftype, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), path,
+                "create /runs/" + c.name));
+    write_str_attr(d, "unit", c.unit);
+    write_str_attr(d, "description", c.description);
     write_str_attr(d, "type", type_attr);
+    write_str_attr(d, "role", std::string(to_string(c.role)));
+    write_str_attr(d, "kinds", c.kinds);
   };
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::int64_t minus1 = -1;
   for (auto& c : columns) {
     Hid ft(file_type_of(c.type));
     switch (c.type) {
-      case CellType::f64: make(c.name, ft, H5T_NATIVE_DOUBLE, &nan, c.unit, c.description, "f64"); break;
-      case CellType::i64: make(c.name, ft, H5T_NATIVE_INT64, &minus1, c.unit, c.description, "i64"); break;
-      case CellType::str: make(c.name, ft, ft, nullptr, c.unit, c.description, "str"); break;  // null = ""
+      case CellType::f64: make(c, ft, H5T_NATIVE_DOUBLE, &nan, "f64"); break;
+      case CellType::i64: make(c, ft, H5T_NATIVE_INT64, &minus1, "i64"); break;
+      case CellType::str: make(c, ft, ft, nullptr, "str"); break;  // null = ""
     }
   }
   const std::uint8_t zero = 0;
-  make("done", H5T_STD_U8LE, H5T_NATIVE_UINT8, &zero, "",
-       "1: the run's row and history are committed; 0: not done (the row holds missing values, or values "
-       "whose done flag was not committed before a crash; resume rewrites it)", "u8");
+  const ColumnSpec done{"done", CellType::i64 /* stored as u8: the arguments below */, "",
+                        "1: the run's row and history are committed; 0: not done (the row holds missing values, or "
+                        "values whose done flag was not committed before a crash; resume rewrites it)",
+                        Role::bookkeeping, ""};
+  make(done, H5T_STD_U8LE, H5T_NATIVE_UINT8, &zero, "u8");
 
   Hid h(check(H5Gcreate2(file, "histories", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /histories"));
   Hid l(check(H5Gcreate2(file, "landscapes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /landscapes"));
