@@ -213,12 +213,13 @@ int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
       cols.push_back(c);
     }
   } else {
-    // Compact default: id, block (when several), the parameters that vary, key metrics, status.
+    // Compact default: run id, block (when several), the parameters that vary, the key metrics of
+    // the kinds of the rows shown, status (roles and kinds: the columns' attributes).
     std::set<std::string> kinds;
     for (auto r : selected) kinds.insert(t.kind(r));
-    std::set<std::string> key_metrics;
-    if (kinds.count("trajectory")) key_metrics.insert({"E", "E_M", "tau_inf"});
-    if (kinds.count("ik")) key_metrics.insert({"iterations", "error", "solution"});
+    std::set<const RunsColumn*> key_metrics;
+    for (const auto& kind : kinds)
+      for (const RunsColumn* c : t.key_metrics(kind)) key_metrics.insert(c);
     auto varies = [&](const RunsColumn& c) {
       for (std::size_t i = 1; i < selected.size(); ++i) {
         const auto r0 = selected[0], r = selected[i];
@@ -230,11 +231,9 @@ int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
       return false;
     };
     for (auto& c : t.cols) {
-      const ColumnRole role = RunsTable::role(c.name);
-      bool take = mentioned.count(&c) > 0;
-      if (role == ColumnRole::id || role == ColumnRole::status) take = true;
-      if ((role == ColumnRole::block || role == ColumnRole::parameter) && varies(c)) take = true;
-      if (role == ColumnRole::metric && key_metrics.count(c.name)) take = true;
+      bool take = mentioned.count(&c) > 0 || key_metrics.count(&c) > 0;
+      if (c.name == "run_id" || c.name == "status") take = true;  // bookkeeping shown always
+      if ((c.name == "block" || c.role == Role::parameter) && varies(c)) take = true;
       if (take) cols.push_back(&c);
     }
   }
@@ -331,7 +330,7 @@ int query_command(const QueryArgs& a) {
       throw ArgError("--optimization prints one optimisation's evaluations; --run, --history, --where, --sort, "
                      "--columns and --include-pending do not apply to it (--format, --limit and --radians do)");
     const Format fmt = *parse_format(a.format.empty() ? (history ? "csv" : "table") : a.format);
-    store::ResultsReader reader(a.file);
+    store::ResultsReader reader(a.file, v1_column_roles);
     if (optimization) return optimization_mode(a, reader, fmt);
     return history ? history_mode(a, reader, fmt) : rows_mode(a, reader, fmt);
   } catch (const ArgError& e) {
