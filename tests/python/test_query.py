@@ -97,6 +97,12 @@ def make_v1(src, dst):
         f.attrs.modify("format_version", np.int64(1))
 
 
+def import_ksread():
+    sys.path.insert(0, os.path.join(ROOT, "analysis"))
+    import ksread
+    return ksread
+
+
 def read_csv(text):
     rows = list(csv.reader(io.StringIO(text)))
     return rows[0], rows[1:]
@@ -251,6 +257,20 @@ class QueryTest(unittest.TestCase):
                 v = t[c][t["block"] == block]
                 missing = np.isnan(v) if v.dtype.kind == "f" else (v == -1) if v.dtype.kind == "i" else (v == "")
                 self.assertTrue(np.all(missing), (c, block))
+        # ksread reads the same roles and each row's kind
+        ksread = import_ksread()
+        with ksread.open_results(self.h5) as r:
+            self.assertEqual(r.roles(), {c: a["role"] for c, a in attrs.items() if c != "done"})
+            self.assertEqual(r.metrics("ik"), ["iterations", "error", "solution", "rejected", "min_rcond",
+                                               "q_final_1", "q_final_2", "q_final_3"])
+            self.assertIn("method", r.parameters("trajectory"))
+            self.assertIn("method", r.parameters("ik"))
+            self.assertEqual(r.bookkeeping(), ["run_id", "block", "status", "wall_time"])
+            runs = r.runs(columns=["block"])
+            kinds = r.row_kinds()
+            self.assertEqual(set(zip(runs["block"], kinds)), {("weighted", "trajectory"), ("basin", "ik")})
+            self.assertEqual(runs.roles["block"], "bookkeeping")
+            self.assertEqual((r.landscape("weighted").kind, r.landscape("basin").kind), ("trajectory", "ik"))
 
     def _group(self, f, run):
         return f["histories"][str(run).zfill(max(6, len(str(len(f["runs"]["done"]) - 1))))]
@@ -352,7 +372,7 @@ class QueryTest(unittest.TestCase):
 
 class Version1FileTest(unittest.TestCase):
     """A results file of format_version 1 (no role / kinds attributes): info and query still read it,
-    with the roles of the engine's tables; --resume refuses it, naming the version."""
+    with the roles of the engine's tables; ksread and --resume refuse it, naming the version."""
 
     @classmethod
     def setUpClass(cls):
@@ -388,6 +408,18 @@ class Version1FileTest(unittest.TestCase):
         self.assertEqual(same(a.stdout), same(b.stdout))
         self.assertIn("weighted  trajectory", a.stdout)
         self.assertIn("basin     ik", a.stdout)
+
+    def test_ksread_refuses_it_naming_the_version(self):
+        ksread = import_ksread()
+        with self.assertRaises(ksread.FormatVersionError) as e:
+            ksread.open_results(self.v1)
+        msg = str(e.exception)
+        self.assertIn(self.v1, msg)
+        self.assertIn("format v1", msg)
+        self.assertIn("kinesweep query", msg)
+        self.assertIn("--overwrite", msg)
+        with ksread.open_results(self.v2) as r:  # the v2 file opens
+            self.assertGreater(len(r.runs()), 0)
 
     def test_resume_is_refused_and_the_file_untouched(self):
         before = sha256(self.v1), os.stat(self.v1).st_mtime_ns
