@@ -167,6 +167,8 @@ int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
   std::set<const RunsColumn*> mentioned;
   for (const auto& w : a.where)
     for (auto& c : parse_where(w, t)) mentioned.insert(c.col), conds.push_back(std::move(c));
+  for (const std::string& note : unheld_value_notes(conds, t, a.include_pending))
+    std::cerr << "kinesweep query: note: " << note << '\n';
   // Sort keys.
   std::vector<SortKey> keys;
   for (const auto& s : a.sort) {
@@ -305,7 +307,7 @@ QueryArgs& add_query_command(CLI::App& app) {
       ->allow_extra_args(false);
   q->add_option("-c,--columns", a.columns, "comma-separated columns, or 'all' (default: table: a compact set; csv/json: all)");
   q->add_option("-s,--sort", a.sort, "sort by COL or COL:desc (repeatable or comma list; NaN last)")->allow_extra_args(false);
-  q->add_option("-n,--limit", a.limit, "print at most N rows");
+  q->add_option("-n,--limit", a.limit, "print at most N rows (N >= 0)")->check(CLI::Validator(check_count, "N>=0"));
   q->add_option("-f,--format", a.format, "table | csv | json (default: table; csv for --history)")
       ->check(CLI::IsMember({"table", "csv", "json"}));
   q->add_flag("--radians", a.radians, "show and filter angles in radians (as stored) instead of degrees");

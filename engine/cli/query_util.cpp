@@ -193,6 +193,14 @@ std::string join(const std::vector<std::string>& v, const std::string& sep) {
   return o;
 }
 
+std::string check_count(std::string& value) {
+  const std::string v = value.substr(std::min(value.size(), value.find_first_not_of(" \t")));
+  char* end = nullptr;
+  const double d = std::strtod(v.c_str(), &end);
+  if (end != v.c_str() && d < 0) return "a count of 0 or more is expected, not " + v;
+  return "";  // CLI11's conversion rejects what is no number
+}
+
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates) {
   auto lower = [](std::string s) {
     for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));

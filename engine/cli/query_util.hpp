@@ -92,6 +92,9 @@ std::string csv_field(const std::string& s);
 /// Closest candidate by edit distance (empty when none is close).
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates);
 std::string join(const std::vector<std::string>& v, const std::string& sep);
+/// CLI11 check of a count option (--best, --limit): "" when `value` is not a negative number, else the
+/// error ("a count of 0 or more is expected, not -3"; CLI11 then exits with code 2).
+std::string check_count(std::string& value);
 
 inline constexpr double kRadToDeg = 57.295779513082320876798154814105;
 

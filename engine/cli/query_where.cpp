@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <set>
 
 namespace ks::cli {
 
@@ -166,6 +167,29 @@ std::vector<Condition> parse_where(const std::string& expr, const RunsTable& t) 
   auto b = make(c, o[1], operands[2]);
   a.insert(a.end(), b.begin(), b.end());
   return a;
+}
+
+std::vector<std::string> unheld_value_notes(const std::vector<Condition>& conditions, const RunsTable& t,
+                                            bool include_pending) {
+  std::vector<std::string> notes;
+  std::set<std::pair<const RunsColumn*, std::string>> said;
+  for (const Condition& k : conditions) {
+    if (k.col->type != CellType::str || (k.op != Op::eq && k.op != Op::ne)) continue;
+    std::set<std::string> held;  // the values the rows in question hold
+    for (std::int64_t r = 0; r < t.n_runs; ++r)
+      if (include_pending || t.done[static_cast<std::size_t>(r)]) held.insert(k.col->s[r]);
+    if (held.empty()) continue;  // no row at all: nothing to hint at
+    for (const std::string& v : k.strs) {
+      if (held.count(v) || !said.insert({k.col, v}).second) continue;
+      std::string m = "no row has " + k.col->name + " = '" + v + "'";
+      const std::vector<std::string> values(held.begin(), held.end());
+      const std::string dym = did_you_mean(v, values);
+      if (!dym.empty()) m += "; did you mean '" + dym + "'?";
+      else if (!values.empty() && values.size() <= 12) m += " (values: " + join(values, ", ") + ")";
+      notes.push_back(m);
+    }
+  }
+  return notes;
 }
 
 }  // namespace ks::cli

@@ -1,6 +1,6 @@
 #pragma once
-// `kinesweep query` argument parsing: --where expressions into conditions on /runs columns, and
-// the row test. Output formatting: query_util.hpp.
+// `kinesweep query` argument parsing: --where expressions into conditions on /runs columns, the
+// row test, and the notes on values no row holds. Output formatting: query_util.hpp.
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
@@ -48,5 +48,11 @@ struct Selector {
 ///   COL=LO..HI            LO <= COL <= HI (!=: outside)
 ///   LO<COL<=HI            chained range (< or <=, or > / >= descending)
 std::vector<Condition> parse_where(const std::string& expr, const RunsTable& t);
+
+/// For each text value of an = / != condition that no row holds (among the done rows, or all rows
+/// with `include_pending`): "no row has method = 'local_weightd'; did you mean 'local_weighted'?"
+/// (or the values the column holds, when few and none is close).
+std::vector<std::string> unheld_value_notes(const std::vector<Condition>& conditions, const RunsTable& t,
+                                            bool include_pending);
 
 }  // namespace ks::cli

@@ -224,6 +224,48 @@ class QueryTest(unittest.TestCase):
         self.assertEqual(ks("query", bogus).returncode, 1)
         self.assertEqual(ks("info", bogus).returncode, 1)
 
+    def test_a_study_file_is_named_as_no_results_file(self):
+        study = os.path.join(self.tmp.name, "x.toml")
+        with open(study, "w") as f:
+            f.write(STUDY)
+        for cmd in ("query", "info"):
+            t0 = time.time()
+            r = ks(cmd, study)
+            self.assertEqual(r.returncode, 1, r.stderr)
+            self.assertEqual(r.stdout, "")
+            lines = r.stderr.strip().splitlines()
+            self.assertEqual(len(lines), 1, r.stderr)  # one line, no HDF5 error stack
+            self.assertIn(study, lines[0])
+            self.assertIn("not an HDF5 file", lines[0])
+            self.assertIn("expected a kinesweep results file", lines[0])
+            self.assertNotIn("HDF5-DIAG", r.stderr)
+            self.assertLess(time.time() - t0, 1.0, "no retries for a file that is no results file")
+
+    def test_negative_counts_are_rejected(self):
+        for args in (["info", self.h5, "--best", "-1"], ["query", self.h5, "-n", "-3"],
+                     ["query", self.h5, "--limit=-3"], ["query", self.h5, "--optimization", "x", "-n", "-1"]):
+            r = ks(*args)
+            self.assertEqual(r.returncode, 2, (args, r.stdout, r.stderr))
+            self.assertIn("0 or more", r.stderr)
+            self.assertEqual(r.stdout, "")
+        self.assertEqual(ks("info", self.h5, "--best", "0").returncode, 0)
+        r = ks("query", self.h5, "-n", "0", "-c", "run_id", "-f", "csv")
+        self.assertEqual((r.returncode, r.stdout), (0, "run_id\n"))
+
+    def test_value_no_row_holds_gets_a_hint(self):
+        r = ks("query", self.h5, "-w", "method=local_weightd")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("(0 of 0 matching rows", r.stdout)
+        self.assertIn("no row has method = 'local_weightd'; did you mean 'local_weighted'?", r.stderr)
+        r = ks("query", self.h5, "-w", "block=weighted,basni", "-c", "run_id", "-f", "csv")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(len(read_csv(r.stdout)[1]), int((self.t["block"] == "weighted").sum()))
+        self.assertIn("no row has block = 'basni'; did you mean 'basin'?", r.stderr)
+        r = ks("query", self.h5, "-w", "status=zzz")
+        self.assertIn("no row has status = 'zzz' (values: ", r.stderr)
+        r = ks("query", self.h5, "-w", "method=newton", "-c", "run_id")  # a held value: no note
+        self.assertEqual(r.stderr, "")
+
     def test_column_attributes_describe_every_column(self):
         """role / kinds / unit / description of every /runs column (h5py) against what the engine writes."""
         with h5py.File(self.h5, "r") as f:
