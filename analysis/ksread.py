@@ -4,6 +4,8 @@
     r = ksread.open_results("results/thesis_table4.h5")
     runs = r.runs()                      # dict of numpy arrays (done rows only), .units / .descriptions
     runs["E"], runs.units["E"]           # array, "Nm"
+    r.parameters(), r.metrics("ik")      # column names by role (and run kind), from the file's attributes
+    r.row_kinds()                        # each (done) row's run kind: "trajectory", "ik"
     df = r.runs(pandas=True)             # a pandas.DataFrame when pandas is installed (units in df.attrs)
     h = r.history(3)                     # dict of 2-D arrays (rows x components) with .units
     ls = r.landscape("local")            # axes (name, unit, values, labels) and gridded metrics
@@ -12,6 +14,10 @@
 
 Angles are stored in radians (unit "rad"); pass degrees=True to runs()/history()/landscape()/optimization() to get
 them in degrees (their unit then reads "deg"). Run with Debian's interpreter: /usr/bin/python3.
+
+Column roles (parameter, metric, bookkeeping) and the run kinds a column applies to are the /runs
+datasets' `role` and `kinds` attributes (FORMAT.md, format_version 2); files of format_version 1 lack
+them and are refused with FormatVersionError (kinesweep info / query still read them).
 """
 import os
 
@@ -19,6 +25,8 @@ import h5py
 import numpy as np
 
 RAD2DEG = 180.0 / np.pi
+FORMAT_VERSION = 2  # the results format this module reads (engine/store/FORMAT.md)
+ROLES = ("parameter", "metric", "bookkeeping")
 
 # Seed 000, Table 4 (copied from engine/methods/seed_cases.cpp, checked against it by the tests):
 # case -> (method, k, alpha1A [deg], thesis E [Nm], thesis (|tau1|inf, |tau2|inf, |tau3|inf) [Nm]).
@@ -60,13 +68,20 @@ def _s(v):
     return v.decode() if isinstance(v, bytes) else str(v)
 
 
+class FormatVersionError(ValueError):
+    """A results file of a format_version this module does not read."""
+
+
 class Table(dict):
-    """dict of column name -> 1-D numpy array, with .units and .descriptions dicts."""
+    """dict of column name -> 1-D numpy array, with .units and .descriptions dicts (runs(): also .roles,
+    column -> "parameter" | "metric" | "bookkeeping", and .kinds, column -> list of run kinds, [] = all)."""
 
     def __init__(self, *a, **kw):
         super().__init__(*a, **kw)
         self.units = {}
         self.descriptions = {}
+        self.roles = {}
+        self.kinds = {}
 
     def __len__(self):  # number of rows, as for a DataFrame
         return len(next(iter(self.values()))) if dict.__len__(self) else 0
@@ -95,10 +110,12 @@ class Axis:
 
 class Landscape:
     """A block's gridded metrics: .axes (list of Axis), .metrics (name -> N-D array, NaN = no value),
-    .units / .descriptions (name -> str). metrics[m][i, j, ...] is at axes[0].values[i], ..."""
+    .units / .descriptions (name -> str), .kind (the block's run kind, from its /runs rows).
+    metrics[m][i, j, ...] is at axes[0].values[i], ..."""
 
-    def __init__(self, block, axes, metrics, units, descriptions):
+    def __init__(self, block, axes, metrics, units, descriptions, kind=""):
         self.block, self.axes, self.metrics, self.units, self.descriptions = block, axes, metrics, units, descriptions
+        self._kind = kind
 
     def axis(self, name):
         for a in self.axes:
@@ -111,7 +128,7 @@ class Landscape:
 
     @property
     def kind(self):
-        return "ik" if "converged" in self.metrics else "trajectory"
+        return self._kind
 
     @property
     def statuses(self):
@@ -212,12 +229,34 @@ class Results:
             raise FileNotFoundError(path)
         self.path = path
         self.f = h5py.File(path, "r")
-        a = self.f.attrs
-        if _s(a.get("format", "")) != "kinesweep-results":
-            raise ValueError(f"{path}: not a kinesweep results file")
-        self.meta = {k: (_s(v) if isinstance(v, (bytes, str)) else v.item() if hasattr(v, "item") else v)
-                     for k, v in a.items()}
-        self.study_text = _s(self.f["study"]["text"][()])
+        try:
+            a = self.f.attrs
+            if _s(a.get("format", "")) != "kinesweep-results":
+                raise ValueError(f"{path}: not a kinesweep results file")
+            self.meta = {k: (_s(v) if isinstance(v, (bytes, str)) else v.item() if hasattr(v, "item") else v)
+                         for k, v in a.items()}
+            version = int(self.meta.get("format_version", -1))
+            if version != FORMAT_VERSION:
+                engine = self.meta.get("engine_version", "?")
+                what = (f"{path}: results file format v{version} (written by kinesweep {engine}); ksread reads "
+                        f"v{FORMAT_VERSION} only")
+                if version < FORMAT_VERSION:
+                    what += (" (v1 files have no role/kinds attributes on their /runs columns). `kinesweep query` "
+                             "and `kinesweep info` still read this file; to use it here, rerun its study: "
+                             "kinesweep run STUDY.toml --overwrite")
+                raise FormatVersionError(what)
+            self.study_text = _s(self.f["study"]["text"][()])
+            self._roles, self._kinds = {}, {}
+            for c in self.columns():
+                attrs = self.f["runs"][c].attrs
+                role = _s(attrs.get("role", ""))
+                if role not in ROLES or "kinds" not in attrs:
+                    raise ValueError(f"{path}: /runs/{c} has no valid role/kinds attributes (role {role!r})")
+                self._roles[c] = role
+                self._kinds[c] = [k for k in _s(attrs["kinds"]).split(",") if k]
+        except Exception:
+            self.f.close()
+            raise
 
     def close(self):
         self.f.close()
@@ -238,6 +277,64 @@ class Results:
     def units(self):
         return {c: _s(self.f["runs"][c].attrs.get("unit", "")) for c in self.columns()}
 
+    def roles(self):
+        """column -> "parameter" | "metric" | "bookkeeping" (the /runs datasets' role attribute)."""
+        return dict(self._roles)
+
+    def kinds(self):
+        """column -> the run kinds it applies to (its kinds attribute split at commas; [] = every run)."""
+        return {c: list(k) for c, k in self._kinds.items()}
+
+    def run_kinds(self):
+        """The run kinds the columns name ("trajectory", "ik"), first seen first."""
+        out = []
+        for ks in self._kinds.values():
+            out += [k for k in ks if k not in out]
+        return out
+
+    def _by_role(self, role, kind):
+        return [c for c in self.columns() if self._roles[c] == role and (kind is None or not self._kinds[c]
+                                                                        or kind in self._kinds[c])]
+
+    def parameters(self, kind=None):
+        """Parameter columns in file order (of one run kind, when given)."""
+        return self._by_role("parameter", kind)
+
+    def metrics(self, kind=None):
+        """Metric columns in file order (of one run kind, when given)."""
+        return self._by_role("metric", kind)
+
+    def bookkeeping(self):
+        """The bookkeeping columns (run_id, block, status, wall_time)."""
+        return self._by_role("bookkeeping", None)
+
+    def row_kinds(self, done_only=True):
+        """Each row's run kind, an object array aligned with runs(done_only=...): the kind of the
+        single-kind parameter (else metric) columns that hold a value in the row; "" when none does
+        (a row not done yet). A file of one kind: that kind for every row."""
+        g = self.f["runs"]
+        done = g["done"][()].astype(bool)
+        kinds = self.run_kinds()
+        out = np.full(len(done), kinds[0] if len(kinds) == 1 else "", dtype=object)
+        if len(kinds) > 1:
+            for role in ("parameter", "metric"):
+                for c in self._by_role(role, None):
+                    if len(self._kinds[c]) != 1:
+                        continue
+                    v = g[c][()]
+                    if v.dtype.kind == "f":
+                        held = ~np.isnan(v)
+                    elif v.dtype.kind in "iu":
+                        held = v != -1
+                    else:
+                        held = np.array([len(x) > 0 for x in v], dtype=bool)
+                    out[(out == "") & held] = self._kinds[c][0]
+        return out[done] if done_only else out
+
+    def row_kind(self, run_id):
+        """The run kind of one row (see row_kinds)."""
+        return self.row_kinds(done_only=False)[int(run_id)]
+
     def runs(self, columns=None, done_only=True, degrees=False, pandas=False):
         """The /runs table: Table (dict of arrays; strings as str objects) or a pandas DataFrame."""
         g = self.f["runs"]
@@ -257,9 +354,12 @@ class Results:
             t[c] = v[done] if done_only else v
             t.units[c] = unit
             t.descriptions[c] = _s(d.attrs.get("description", ""))
+            t.roles[c] = self._roles[c]
+            t.kinds[c] = list(self._kinds[c])
         if not done_only:
             t["done"] = done
             t.units["done"] = ""
+            t.roles["done"], t.kinds["done"] = "bookkeeping", []
         return t.to_pandas() if pandas else t
 
     def has_history(self, run_id):
@@ -321,7 +421,17 @@ class Results:
             metrics[m] = np.array(g[m][()], dtype=float)
             units[m] = _s(g[m].attrs.get("unit", ""))
             desc[m] = _s(g[m].attrs.get("description", ""))
-        return Landscape(block, axes, metrics, units, desc)
+        return Landscape(block, axes, metrics, units, desc, self._block_kind(block))
+
+    def _block_kind(self, block):
+        """The run kind of a block's (done) rows, "" when it has none."""
+        if "block" not in self._roles:
+            return self.run_kinds()[0] if len(self.run_kinds()) == 1 else ""
+        blocks = np.array([_s(x) for x in self.f["runs"]["block"][()]], dtype=object)
+        done = self.f["runs"]["done"][()].astype(bool)
+        kinds = self.row_kinds(done_only=False)[(blocks == block) & done]
+        kinds = [k for k in kinds if k]
+        return kinds[0] if kinds else ""
 
 
     def optimizations(self):

@@ -11,11 +11,11 @@
 namespace ks::store_test {
 
 std::vector<ColumnSpec> test_columns() {
-  return {{"alpha", CellType::f64, "rad", "first swept angle"},
-          {"E", CellType::f64, "Nm", "energy-like metric"},
-          {"iters", CellType::i64, "", "iterations used"},
-          {"status", CellType::str, "", "outcome word"},
-          {"method", CellType::str, "", "redundancy resolution"}};
+  return {{"alpha", CellType::f64, "rad", "first swept angle", Role::parameter, "trajectory"},
+          {"E", CellType::f64, "Nm", "energy-like metric", Role::metric, "trajectory"},
+          {"iters", CellType::i64, "", "iterations used", Role::metric, "ik"},
+          {"status", CellType::str, "", "outcome word", Role::bookkeeping, ""},
+          {"method", CellType::str, "", "redundancy resolution", Role::parameter, "trajectory,ik"}};
 }
 
 Record test_record(std::int64_t id) {

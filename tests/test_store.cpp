@@ -211,7 +211,7 @@ TEST(Store, RoundTripRowsHistoriesLandscapeAndMetadata) {
   ResultsReader r(path);
   const auto m = test_meta();
   EXPECT_EQ(r.meta().format, "kinesweep-results");
-  EXPECT_EQ(r.meta().format_version, 1);
+  EXPECT_EQ(r.meta().format_version, kFormatVersion);
   EXPECT_EQ(r.meta().study_name, m.study_name);
   EXPECT_EQ(r.meta().study_path, m.study_path);
   EXPECT_EQ(r.meta().study_text, m.study_text);
@@ -226,6 +226,8 @@ TEST(Store, RoundTripRowsHistoriesLandscapeAndMetadata) {
     EXPECT_EQ(r.columns()[c].type, test_columns()[c].type);
     EXPECT_EQ(r.columns()[c].unit, test_columns()[c].unit);
     EXPECT_EQ(r.columns()[c].description, test_columns()[c].description);
+    EXPECT_EQ(r.columns()[c].role, test_columns()[c].role);
+    EXPECT_EQ(r.columns()[c].kinds, test_columns()[c].kinds);
   }
   EXPECT_EQ(r.n_runs(), n);
   EXPECT_EQ(verify_done_runs(r), n);

@@ -59,8 +59,8 @@ std::string seconds(double s) {
   return o.str();
 }
 
-/// The /optimizations section (nothing when the file has none).
-void print_optimizations(store::ResultsReader& reader, std::ostream& os) {
+/// The /optimizations section (nothing when the file has none). Metric units: the /runs columns'.
+void print_optimizations(store::ResultsReader& reader, const RunsTable& t, std::ostream& os) {
   const auto names = consistent_read(reader, [&] { return reader.optimizations(); });
   if (names.empty()) return;
   os << "optimizations " << names.size() << "  (kinesweep query FILE --optimization NAME: every evaluation)\n";
@@ -98,12 +98,16 @@ void print_optimizations(store::ResultsReader& reader, std::ostream& os) {
           if (n == k) return &v;
         return nullptr;
       };
+      auto with_unit = [&](const std::string& k, double v) {
+        const RunsColumn* c = t.find(k);
+        return format_double(v) + (c && !c->unit.empty() ? " " + c->unit : "");
+      };
       std::vector<std::string> parts;
-      if (const double* e = metric("E")) parts.push_back("E = " + format_double(*e) + " Nm");
+      if (const double* e = metric("E")) parts.push_back("E = " + with_unit("E", *e));
       if (o.objective.find("E_M") != std::string::npos)
-        if (const double* e = metric("E_M")) parts.push_back("E_M = " + format_double(*e));
-      if (const double* t = metric("tau_inf")) {
-        std::string s = "|tau|inf = " + format_double(*t) + " Nm";
+        if (const double* e = metric("E_M")) parts.push_back("E_M = " + with_unit("E_M", *e));
+      if (const double* tau = metric("tau_inf")) {
+        std::string s = "|tau|inf = " + with_unit("tau_inf", *tau);
         std::vector<std::string> taus;
         for (const char* k : {"tau1_inf", "tau2_inf", "tau3_inf"})
           if (const double* p = metric(k)) taus.push_back(format_double(*p));
@@ -161,7 +165,7 @@ std::string axis_text(const store::LandscapeAxis& a) {
 }
 
 int run_info(const InfoArgs& args) {
-  store::ResultsReader reader(args.file);
+  store::ResultsReader reader(args.file, v1_column_roles);
   const RunsTable t = load_runs(reader);
   const store::StoreMeta& m = t.meta;
   std::ostream& os = std::cout;
@@ -171,6 +175,9 @@ int run_info(const InfoArgs& args) {
   os << "sha256      " << m.study_sha256 << "  (of the study file's text, stored in /study/text)\n";
   os << "engine      kinesweep " << m.engine_version << "; format " << m.format << " v" << m.format_version
      << "; created " << m.created << '\n';
+  if (m.format_version < store::kFormatVersion)
+    os << "note        format v" << m.format_version << " stores no column roles: taken from this kinesweep's "
+       << "tables (kinesweep run --overwrite rewrites the file as v" << store::kFormatVersion << ")\n";
   os << "runs        " << n_done << " of " << t.n_runs << " done";
   if (n_done < t.n_runs) os << " (" << (t.n_runs - n_done) << " pending: a sweep is running, was interrupted, or resume is needed)";
   os << '\n';
@@ -222,8 +229,13 @@ int run_info(const InfoArgs& args) {
   for (const auto& b : blocks) {
     if (b.done == 0 || b.name == "(pending)") continue;
     const bool ik = b.kind == "ik";
-    const RunsColumn* key = t.find(ik ? "iterations" : "E");
-    const RunsColumn* tie = ik ? t.find("error") : nullptr;
+    if (!ik && b.kind != "trajectory") continue;  // no ranking defined for another kind
+    auto metric = [&](const char* name) {  // a metric column of the block's kind, or null
+      const RunsColumn* c = t.find(name);
+      return c && c->role == Role::metric && c->applies_to(b.kind) ? c : nullptr;
+    };
+    const RunsColumn* key = metric(ik ? "iterations" : "E");
+    const RunsColumn* tie = ik ? metric("error") : nullptr;
     const std::string good = ik ? "converged" : "ok";
     if (!key || !status) continue;
     std::vector<std::int64_t> cand;
@@ -240,7 +252,7 @@ int run_info(const InfoArgs& args) {
     // Parameters that vary within the block identify a row.
     std::vector<const RunsColumn*> varying;
     for (const auto& c : t.cols) {
-      if (RunsTable::role(c.name) != ColumnRole::parameter) continue;
+      if (c.role != Role::parameter || !c.applies_to(b.kind)) continue;
       for (auto r : b.rows)
         if (t.done[static_cast<std::size_t>(r)] && !same(c, r, b.rows.front())) {
           varying.push_back(&c);
@@ -311,7 +323,7 @@ int run_info(const InfoArgs& args) {
     for (std::size_t j = 0; j < spec.metrics.size(); ++j) os << (j ? ", " : "") << spec.metrics[j].name;
     os << '\n';
   }
-  print_optimizations(reader, os);
+  print_optimizations(reader, t, os);
   return 0;
 }
 
@@ -322,7 +334,7 @@ InfoArgs& add_info_command(CLI::App& app) {
   auto* s = app.add_subcommand("info", "Summarise a results file: study, runs by block and status, best rows, "
                                        "histories, landscapes, optimisations");
   s->add_option("file", a.file, "results file (.h5); may be one a sweep is still writing")->required();
-  s->add_option("--best", a.best, "best rows shown per block (default 3)");
+  s->add_option("--best", a.best, "best rows shown per block (default 3; N >= 0)")->check(CLI::Validator(check_count, "N>=0"));
   return a;
 }
 

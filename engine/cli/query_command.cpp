@@ -1,3 +1,5 @@
+// `kinesweep query`: the three modes (rows of /runs, one run's history, one optimisation's
+// evaluations). Argument and --where parsing: query_where.cpp; output formatting: query_util.cpp.
 #include "cli/query_command.hpp"
 
 #include <CLI/CLI.hpp>
@@ -9,194 +11,12 @@
 #include <set>
 
 #include "cli/query_util.hpp"
+#include "cli/query_where.hpp"
 #include "store/store.hpp"
 
 namespace ks::cli {
 
 namespace {
-
-/// A bad argument (exit code 2).
-struct ArgError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
-
-std::vector<std::string> split(const std::string& s, char sep) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char c : s) {
-    if (c == sep) out.push_back(trim(cur)), cur.clear();
-    else cur += c;
-  }
-  out.push_back(trim(cur));
-  return out;
-}
-
-std::string unknown_column_message(const std::string& name, const RunsTable& t, const std::string& where) {
-  std::string m = "unknown column '" + name + "'" + where;
-  const std::string dym = did_you_mean(name, t.names());
-  if (!dym.empty()) m += "; did you mean '" + dym + "'?";
-  return m + "\nvalid columns: " + join(t.names(), ", ");
-}
-
-enum class Op { eq, ne, lt, le, gt, ge };
-
-std::optional<Op> parse_op(const std::string& s) {
-  if (s == "=" || s == "==") return Op::eq;
-  if (s == "!=") return Op::ne;
-  if (s == "<") return Op::lt;
-  if (s == "<=") return Op::le;
-  if (s == ">") return Op::gt;
-  if (s == ">=") return Op::ge;
-  return std::nullopt;
-}
-Op flip(Op o) {
-  switch (o) {
-    case Op::lt: return Op::gt;
-    case Op::le: return Op::ge;
-    case Op::gt: return Op::lt;
-    case Op::ge: return Op::le;
-    default: return o;
-  }
-}
-
-/// One condition on one column: `op` against each value (eq: any of them; ne: none of them).
-struct Condition {
-  const RunsColumn* col = nullptr;
-  Op op = Op::eq;
-  std::vector<double> nums;
-  std::vector<std::string> strs;
-  bool or_prev = false;  ///< OR with the previous condition (COL!=LO..HI: below LO or above HI)
-};
-
-bool num_eq(double x, double v) {
-  if (std::isnan(v)) return std::isnan(x);
-  return x == v || std::abs(x - v) <= 1e-9 * std::max(std::abs(x), std::abs(v));
-}
-
-struct Selector {
-  const RunsTable& t;
-  bool radians;
-
-  double value(const RunsColumn& c, std::int64_t r) const {
-    if (c.type == CellType::i64) return static_cast<double>(c.i[r]);
-    return c.angle() && !radians ? c.f[r] * kRadToDeg : c.f[r];
-  }
-
-  bool test(const Condition& k, std::int64_t r) const {
-    const RunsColumn& c = *k.col;
-    if (c.type == CellType::str) {
-      const std::string& x = c.s[r];
-      switch (k.op) {
-        case Op::eq: return std::find(k.strs.begin(), k.strs.end(), x) != k.strs.end();
-        case Op::ne: return std::find(k.strs.begin(), k.strs.end(), x) == k.strs.end();
-        case Op::lt: return x < k.strs[0];
-        case Op::le: return x <= k.strs[0];
-        case Op::gt: return x > k.strs[0];
-        case Op::ge: return x >= k.strs[0];
-      }
-    }
-    const double x = value(c, r);
-    switch (k.op) {
-      case Op::eq: return std::any_of(k.nums.begin(), k.nums.end(), [&](double v) { return num_eq(x, v); });
-      case Op::ne: return std::none_of(k.nums.begin(), k.nums.end(), [&](double v) { return num_eq(x, v); });
-      case Op::lt: return x < k.nums[0];
-      case Op::le: return x <= k.nums[0];
-      case Op::gt: return x > k.nums[0];
-      case Op::ge: return x >= k.nums[0];
-    }
-    return false;
-  }
-};
-
-double parse_number(const std::string& s, const RunsColumn& c, const std::string& expr) {
-  const std::string v = trim(s);
-  char* end = nullptr;
-  const double d = std::strtod(v.c_str(), &end);
-  if (v.empty() || end != v.c_str() + v.size())
-    throw ArgError("--where '" + expr + "': column " + c.name + " is numeric; '" + v + "' is not a number");
-  return d;
-}
-
-/// Parse one --where expression into conditions (a range gives two).
-///   COL OP VALUE          OP: = == != < <= > >=   (VALUE OP COL also works)
-///   COL=V1,V2,...         any of the values (!=: none of them)
-///   COL=LO..HI            LO <= COL <= HI (!=: outside)
-///   LO<COL<=HI            chained range (< or <=, or > / >= descending)
-std::vector<Condition> parse_where(const std::string& expr, const RunsTable& t) {
-  std::vector<std::string> operands, ops;
-  std::string cur;
-  for (std::size_t i = 0; i < expr.size();) {
-    if (std::string("<>=!").find(expr[i]) != std::string::npos) {
-      std::size_t j = i;
-      while (j < expr.size() && std::string("<>=!").find(expr[j]) != std::string::npos) ++j;
-      operands.push_back(trim(cur));
-      cur.clear();
-      ops.push_back(expr.substr(i, j - i));
-      i = j;
-    } else {
-      cur += expr[i++];
-    }
-  }
-  operands.push_back(trim(cur));
-  const std::string syntax =
-      "; expected COL OP VALUE (OP one of = != < <= > >=), COL=A,B,C, COL=LO..HI or LO<=COL<=HI";
-  if (ops.empty() || ops.size() > 2) throw ArgError("--where '" + expr + "': cannot parse" + syntax);
-  std::vector<Op> o;
-  for (auto& s : ops) {
-    auto p = parse_op(s);
-    if (!p) throw ArgError("--where '" + expr + "': unknown operator '" + s + "'" + syntax);
-    o.push_back(*p);
-  }
-  for (auto& s : operands)
-    if (s.empty()) throw ArgError("--where '" + expr + "': missing operand" + syntax);
-
-  auto make = [&](const RunsColumn* c, Op op, const std::string& rhs) {
-    std::vector<Condition> out;
-    const bool str = c->type == CellType::str;
-    const auto dots = rhs.find("..");
-    if (!str && dots != std::string::npos && (op == Op::eq || op == Op::ne)) {
-      const double lo = parse_number(rhs.substr(0, dots), *c, expr), hi = parse_number(rhs.substr(dots + 2), *c, expr);
-      if (op == Op::eq) {
-        out.push_back({c, Op::ge, {lo}, {}});
-        out.push_back({c, Op::le, {hi}, {}});
-      } else {
-        out.push_back({c, Op::lt, {lo}, {}});
-        out.push_back({c, Op::gt, {hi}, {}, true});
-      }
-      return out;
-    }
-    Condition k{c, op, {}, {}};
-    const auto values = (op == Op::eq || op == Op::ne) ? split(rhs, ',') : std::vector<std::string>{rhs};
-    for (auto& v : values) {
-      if (str) k.strs.push_back(v);
-      else k.nums.push_back(parse_number(v, *c, expr));
-    }
-    out.push_back(k);
-    return out;
-  };
-
-  if (o.size() == 1) {
-    if (const RunsColumn* c = t.find(operands[0])) return make(c, o[0], operands[1]);
-    if (const RunsColumn* c = t.find(operands[1]); c && o[0] != Op::eq && o[0] != Op::ne)
-      return make(c, flip(o[0]), operands[0]);
-    throw ArgError(unknown_column_message(operands[0], t, " in --where '" + expr + "'"));
-  }
-  const RunsColumn* c = t.find(operands[1]);
-  if (!c) throw ArgError(unknown_column_message(operands[1], t, " in --where '" + expr + "'"));
-  const bool up = (o[0] == Op::lt || o[0] == Op::le) && (o[1] == Op::lt || o[1] == Op::le);
-  const bool down = (o[0] == Op::gt || o[0] == Op::ge) && (o[1] == Op::gt || o[1] == Op::ge);
-  if (!up && !down) throw ArgError("--where '" + expr + "': a range needs two < / <= (or two > / >=)" + syntax);
-  auto a = make(c, flip(o[0]), operands[0]);
-  auto b = make(c, o[1], operands[2]);
-  a.insert(a.end(), b.begin(), b.end());
-  return a;
-}
 
 struct SortKey {
   const RunsColumn* col;
@@ -347,6 +167,8 @@ int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
   std::set<const RunsColumn*> mentioned;
   for (const auto& w : a.where)
     for (auto& c : parse_where(w, t)) mentioned.insert(c.col), conds.push_back(std::move(c));
+  for (const std::string& note : unheld_value_notes(conds, t, a.include_pending))
+    std::cerr << "kinesweep query: note: " << note << '\n';
   // Sort keys.
   std::vector<SortKey> keys;
   for (const auto& s : a.sort) {
@@ -393,12 +215,13 @@ int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
       cols.push_back(c);
     }
   } else {
-    // Compact default: id, block (when several), the parameters that vary, key metrics, status.
+    // Compact default: run id, block (when several), the parameters that vary, the key metrics of
+    // the kinds of the rows shown, status (roles and kinds: the columns' attributes).
     std::set<std::string> kinds;
     for (auto r : selected) kinds.insert(t.kind(r));
-    std::set<std::string> key_metrics;
-    if (kinds.count("trajectory")) key_metrics.insert({"E", "E_M", "tau_inf"});
-    if (kinds.count("ik")) key_metrics.insert({"iterations", "error", "solution"});
+    std::set<const RunsColumn*> key_metrics;
+    for (const auto& kind : kinds)
+      for (const RunsColumn* c : t.key_metrics(kind)) key_metrics.insert(c);
     auto varies = [&](const RunsColumn& c) {
       for (std::size_t i = 1; i < selected.size(); ++i) {
         const auto r0 = selected[0], r = selected[i];
@@ -410,11 +233,9 @@ int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
       return false;
     };
     for (auto& c : t.cols) {
-      const ColumnRole role = RunsTable::role(c.name);
-      bool take = mentioned.count(&c) > 0;
-      if (role == ColumnRole::id || role == ColumnRole::status) take = true;
-      if ((role == ColumnRole::block || role == ColumnRole::parameter) && varies(c)) take = true;
-      if (role == ColumnRole::metric && key_metrics.count(c.name)) take = true;
+      bool take = mentioned.count(&c) > 0 || key_metrics.count(&c) > 0;
+      if (c.name == "run_id" || c.name == "status") take = true;  // bookkeeping shown always
+      if ((c.name == "block" || c.role == Role::parameter) && varies(c)) take = true;
       if (take) cols.push_back(&c);
     }
   }
@@ -486,7 +307,7 @@ QueryArgs& add_query_command(CLI::App& app) {
       ->allow_extra_args(false);
   q->add_option("-c,--columns", a.columns, "comma-separated columns, or 'all' (default: table: a compact set; csv/json: all)");
   q->add_option("-s,--sort", a.sort, "sort by COL or COL:desc (repeatable or comma list; NaN last)")->allow_extra_args(false);
-  q->add_option("-n,--limit", a.limit, "print at most N rows");
+  q->add_option("-n,--limit", a.limit, "print at most N rows (N >= 0)")->check(CLI::Validator(check_count, "N>=0"));
   q->add_option("-f,--format", a.format, "table | csv | json (default: table; csv for --history)")
       ->check(CLI::IsMember({"table", "csv", "json"}));
   q->add_flag("--radians", a.radians, "show and filter angles in radians (as stored) instead of degrees");
@@ -511,7 +332,7 @@ int query_command(const QueryArgs& a) {
       throw ArgError("--optimization prints one optimisation's evaluations; --run, --history, --where, --sort, "
                      "--columns and --include-pending do not apply to it (--format, --limit and --radians do)");
     const Format fmt = *parse_format(a.format.empty() ? (history ? "csv" : "table") : a.format);
-    store::ResultsReader reader(a.file);
+    store::ResultsReader reader(a.file, v1_column_roles);
     if (optimization) return optimization_mode(a, reader, fmt);
     return history ? history_mode(a, reader, fmt) : rows_mode(a, reader, fmt);
   } catch (const ArgError& e) {

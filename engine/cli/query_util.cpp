@@ -1,13 +1,16 @@
 #include "cli/query_util.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <ostream>
 #include <set>
 
 #include "schema/params.hpp"
+#include "space/space.hpp"
 
 namespace ks::cli {
 
@@ -23,24 +26,69 @@ std::vector<std::string> RunsTable::names() const {
   return out;
 }
 
-ColumnRole RunsTable::role(const std::string& name) {
-  if (name == "run_id") return ColumnRole::id;
-  if (name == "block") return ColumnRole::block;
-  if (name == "status") return ColumnRole::status;
-  if (name == "wall_time" || name == "done") return ColumnRole::other;
-  static const std::set<std::string> metric_names = [] {
-    std::set<std::string> m;
-    for (BlockKind k : block_kinds())
-      for (const auto& c : ks::metrics(k)) m.insert(c.name);
-    return m;
-  }();
-  return metric_names.count(name) ? ColumnRole::metric : ColumnRole::parameter;
+bool RunsColumn::applies_to(const std::string& kind) const {
+  return kinds.empty() || std::find(kinds.begin(), kinds.end(), kind) != kinds.end();
+}
+
+bool RunsColumn::missing(std::int64_t row) const {
+  switch (type) {
+    case CellType::f64: return std::isnan(f[row]);
+    case CellType::i64: return i[row] == -1;
+    case CellType::str: return s[row].empty();
+  }
+  return true;
 }
 
 std::string RunsTable::kind(std::int64_t row) const {
-  if (const RunsColumn* it = find("iterations"); it && it->type == CellType::i64 && it->i[row] >= 0) return "ik";
-  if (const RunsColumn* p = find("problem"); p && p->type == CellType::str && !p->s[row].empty()) return "ik";
-  return "trajectory";
+  if (kinds.size() == 1) return kinds.front();
+  for (const Role role : {Role::parameter, Role::metric})
+    for (const auto& c : cols)
+      if (c.role == role && c.kinds.size() == 1 && !c.missing(row)) return c.kinds.front();
+  return "";
+}
+
+std::vector<const RunsColumn*> RunsTable::key_metrics(const std::string& kind) const {
+  static const std::map<std::string, std::vector<std::string>> chosen = {
+      {"trajectory", {"E", "E_M", "tau_inf"}}, {"ik", {"iterations", "error", "solution"}}};
+  std::vector<const RunsColumn*> out;
+  const auto it = chosen.find(kind);
+  for (const auto& c : cols) {
+    if (c.role != Role::metric || !c.applies_to(kind)) continue;
+    if (it != chosen.end() ? std::count(it->second.begin(), it->second.end(), c.name) > 0 : out.size() < 3)
+      out.push_back(&c);
+  }
+  return out;
+}
+
+void v1_column_roles(std::vector<ColumnSpec>& columns) {
+  std::size_t vertices = 5;  // vertex_alpha_2 .. _<vertices>: a study's path may have more than the square's 5
+  for (const auto& c : columns) {
+    const std::string prefix = "vertex_alpha_";
+    std::size_t v = 0;
+    if (c.name.rfind(prefix, 0) == 0 &&
+        std::from_chars(c.name.data() + prefix.size(), c.name.data() + c.name.size(), v).ec == std::errc())
+      vertices = std::max(vertices, v);
+  }
+  std::set<std::string> names;
+  for (const auto& c : columns) names.insert(c.name);
+  std::map<std::string, std::pair<Role, std::string>> table;  // name -> role, kinds
+  auto enter = [&](const std::string& name, Role role, const std::string& kind) {
+    auto [it, fresh] = table.try_emplace(name, role, kind);
+    if (!fresh) it->second.second += "," + kind;
+  };
+  for (const BlockKind k : block_kinds()) {
+    const auto& ms = metrics(k);
+    if (std::none_of(ms.begin(), ms.end(), [&](const MetricDef& m) { return names.count(m.name) > 0; }))
+      continue;  // no block of this kind in the file
+    const std::string kind(to_string(k));
+    for (const ParamInfo& p : block_params(k, vertices)) enter(p.name, Role::parameter, kind);
+    for (const MetricDef& m : ms) enter(m.name, Role::metric, kind);
+  }
+  for (auto& c : columns) {
+    const auto it = table.find(c.name);
+    c.role = it == table.end() ? Role::bookkeeping : it->second.first;
+    c.kinds = it == table.end() ? std::string() : it->second.second;
+  }
 }
 
 RunsTable load_runs(store::ResultsReader& reader) {
@@ -55,6 +103,15 @@ RunsTable load_runs(store::ResultsReader& reader) {
       c.unit = spec.unit;
       c.description = spec.description;
       c.type = spec.type;
+      c.role = spec.role;
+      for (std::size_t at = 0; at < spec.kinds.size();) {  // "trajectory,ik" -> {"trajectory", "ik"}
+        std::size_t comma = spec.kinds.find(',', at);
+        if (comma == std::string::npos) comma = spec.kinds.size();
+        if (comma > at) c.kinds.push_back(spec.kinds.substr(at, comma - at));
+        at = comma + 1;
+      }
+      for (const auto& k : c.kinds)
+        if (std::find(t.kinds.begin(), t.kinds.end(), k) == t.kinds.end()) t.kinds.push_back(k);
       switch (spec.type) {
         case CellType::f64: c.f = reader.read_f64(spec.name); break;
         case CellType::i64: c.i = reader.read_i64(spec.name); break;
@@ -134,6 +191,14 @@ std::string join(const std::vector<std::string>& v, const std::string& sep) {
   std::string o;
   for (std::size_t i = 0; i < v.size(); ++i) o += (i ? sep : "") + v[i];
   return o;
+}
+
+std::string check_count(std::string& value) {
+  const std::string v = value.substr(std::min(value.size(), value.find_first_not_of(" \t")));
+  char* end = nullptr;
+  const double d = std::strtod(v.c_str(), &end);
+  if (end != v.c_str() && d < 0) return "a count of 0 or more is expected, not " + v;
+  return "";  // CLI11's conversion rejects what is no number
 }
 
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates) {

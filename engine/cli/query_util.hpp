@@ -1,6 +1,7 @@
 #pragma once
 // Shared by `kinesweep info` and `kinesweep query`: a consistent in-memory copy of a results file's
-// /runs (through the public store API only), column classification, and table/CSV/JSON output.
+// /runs (through the public store API only) with each column's role and run kinds (its attributes),
+// and table/CSV/JSON output.
 #include <cstdint>
 #include <iosfwd>
 #include <optional>
@@ -17,27 +18,41 @@ namespace ks::cli {
 struct RunsColumn {
   std::string name, unit, description;
   CellType type = CellType::f64;
+  Role role = Role::bookkeeping;
+  std::vector<std::string> kinds;  ///< run kinds the column applies to; empty: every kind
   std::vector<double> f;
   std::vector<std::int64_t> i;
   std::vector<std::string> s;
   bool angle() const { return unit == "rad"; }  ///< shown in degrees unless --radians
+  bool applies_to(const std::string& kind) const;
+  bool missing(std::int64_t row) const;  ///< NaN, -1 or ""
 };
-
-enum class ColumnRole { id, block, parameter, metric, status, other };
 
 struct RunsTable {
   store::StoreMeta meta;
   std::int64_t n_runs = 0;
   std::vector<std::uint8_t> done;
   std::vector<RunsColumn> cols;
+  std::vector<std::string> kinds;  ///< the run kinds the columns name, first seen first
   bool consistent = true;  ///< false: a writer kept committing during every attempt (rows still done-safe)
 
   const RunsColumn* find(const std::string& name) const;
   std::vector<std::string> names() const;
-  static ColumnRole role(const std::string& name);
-  /// Row's kind: "ik" when it holds IK metrics, else "trajectory".
+  /// A row's run kind: the kind of the parameter (else metric) columns of a single kind that hold a
+  /// value in the row; the file's only kind when it has one; "" when unknown (a pending row).
   std::string kind(std::int64_t row) const;
+  /// The metric columns of `kind` that compact views show (trajectory: E, E_M, tau_inf; ik:
+  /// iterations, error, solution; another kind: its first three metrics).
+  std::vector<const RunsColumn*> key_metrics(const std::string& kind) const;
 };
+
+/// Fills role and kinds of the /runs columns of a format_version 1 results file, which stores
+/// neither (store::ResultsReader::V1ColumnRoles; pass it to every ResultsReader of info and query).
+/// Looked up by name in this kinesweep's own tables: the parameters of each kind (block_params), its
+/// metrics (metrics(kind)), for the kinds whose metrics the file holds; run_id, block, status,
+/// wall_time are bookkeeping. A column found in no table (a file of an older engine whose tables
+/// differed) stays bookkeeping.
+void v1_column_roles(std::vector<ColumnSpec>& columns);
 
 /// Open `path` and read the whole /runs table. Safe on a file a sweep is writing: the done mask is
 /// read before the columns, and the read is repeated (refresh) when a commit happened meanwhile.
@@ -77,6 +92,9 @@ std::string csv_field(const std::string& s);
 /// Closest candidate by edit distance (empty when none is close).
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates);
 std::string join(const std::vector<std::string>& v, const std::string& sep);
+/// CLI11 check of a count option (--best, --limit): "" when `value` is not a negative number, else the
+/// error ("a count of 0 or more is expected, not -3"; CLI11 then exits with code 2).
+std::string check_count(std::string& value);
 
 inline constexpr double kRadToDeg = 57.295779513082320876798154814105;
 

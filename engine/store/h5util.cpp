@@ -119,7 +119,8 @@ std::vector<std::string> read_str_list_attr(hid_t obj, const char* name) {
 
 bool link_exists(hid_t loc, const std::string& path) { return H5Lexists(loc, path.c_str(), H5P_DEFAULT) > 0; }
 
-std::vector<ColumnSpec> read_run_columns(hid_t file, const std::string& path, std::int64_t& n_runs) {
+std::vector<ColumnSpec> read_run_columns(hid_t file, const std::string& path, std::int64_t& n_runs,
+                                         bool roles_stored) {
   Hid runs(check(H5Gopen2(file, "runs", H5P_DEFAULT), path, "open /runs"));
   n_runs = read_i64_attr(runs, "n_runs", -1);
   std::vector<ColumnSpec> columns;
@@ -132,6 +133,15 @@ std::vector<ColumnSpec> read_run_columns(hid_t file, const std::string& path, st
     c.type = cls == H5T_FLOAT ? CellType::f64 : cls == H5T_INTEGER ? CellType::i64 : CellType::str;
     c.unit = read_str_attr(d, "unit");
     c.description = read_str_attr(d, "description");
+    if (roles_stored) {
+      const std::string role = read_str_attr(d, "role");
+      if (!parse(role, c.role))
+        throw StoreError(path, std::string(kBadColumnAttribute) + "/runs/" + name + " has role '" + role +
+                                   "' (expected parameter, metric or bookkeeping)");
+      if (!has_attr(d, "kinds"))
+        throw StoreError(path, std::string(kBadColumnAttribute) + "/runs/" + name + " has no kinds attribute");
+      c.kinds = read_str_attr(d, "kinds");
+    }
     columns.push_back(std::move(c));
   }
   return columns;

@@ -70,8 +70,13 @@ std::string read_str_attr(hid_t obj, const char* name);  // "" when absent
 std::int64_t read_i64_attr(hid_t obj, const char* name, std::int64_t fallback);
 std::vector<std::string> read_str_list_attr(hid_t obj, const char* name);
 bool link_exists(hid_t loc, const std::string& path);
-/// The /runs column specs (name, type, unit, description) in file order, and the n_runs attribute
-/// (-1 when absent). Throws StoreError naming `path` when a column cannot be opened.
-std::vector<ColumnSpec> read_run_columns(hid_t file, const std::string& path, std::int64_t& n_runs);
+/// The /runs column specs (name, type, unit, description, and with `roles_stored` role and kinds) in
+/// file order, and the n_runs attribute (-1 when absent). Format 1 files store no role/kinds: pass
+/// false, and their columns keep the ColumnSpec defaults. Throws StoreError naming `path` when a
+/// column cannot be opened, or (roles_stored) has no valid role attribute or no kinds attribute.
+std::vector<ColumnSpec> read_run_columns(hid_t file, const std::string& path, std::int64_t& n_runs,
+                                         bool roles_stored);
+/// Causes of StoreErrors that re-reading cannot cure (the reader gives up at once on them).
+inline constexpr const char* kBadColumnAttribute = "bad column attribute: ";
 
 }  // namespace ks::store::detail

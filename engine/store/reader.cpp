@@ -18,6 +18,7 @@ struct ResultsReader::Impl {
   std::vector<ColumnSpec> columns;
   std::int64_t n_runs = 0;
   std::string stamp;  // consistency stamp at open
+  V1ColumnRoles v1_roles;
 
   void load() {
     hid_t f = file;
@@ -25,9 +26,12 @@ struct ResultsReader::Impl {
     if (meta.format != kFormatName)
       throw StoreError(path, "not a kinesweep results file (attribute format = '" + meta.format + "')");
     meta.format_version = read_i64_attr(f, "format_version", -1);
-    if (meta.format_version != kFormatVersion)
-      throw StoreError(path, "unsupported format_version " + std::to_string(meta.format_version));
     meta.engine_version = read_str_attr(f, "engine_version");
+    if (meta.format_version < kOldestReadableFormatVersion || meta.format_version > kFormatVersion)
+      throw StoreError(path, "unsupported format_version " + std::to_string(meta.format_version) +
+                                 " (written by kinesweep " + meta.engine_version + "; this kinesweep reads " +
+                                 std::to_string(kOldestReadableFormatVersion) + " to " +
+                                 std::to_string(kFormatVersion) + ")");
     meta.study_sha256 = read_str_attr(f, "study_sha256");
     meta.created = read_str_attr(f, "created");
     meta.study_name = read_str_attr(f, "study_name");
@@ -42,7 +46,8 @@ struct ResultsReader::Impl {
       meta.study_text = p ? p : "";
       H5Dvlen_reclaim(t, s, H5P_DEFAULT, &p);
     }
-    columns = read_run_columns(f, path, n_runs);
+    columns = read_run_columns(f, path, n_runs, meta.format_version >= 2);
+    if (meta.format_version == 1 && v1_roles) v1_roles(columns);
     if (n_runs < 0) {
       Hid d(check(H5Dopen2(f, "runs/done", H5P_DEFAULT), path, "open /runs/done"));
       n_runs = H5Sget_simple_extent_npoints(Hid(H5Dget_space(d)));
@@ -84,8 +89,9 @@ struct ResultsReader::Impl {
   }
 };
 
-ResultsReader::ResultsReader(const std::string& path) : impl_(std::make_unique<Impl>()) {
+ResultsReader::ResultsReader(const std::string& path, V1ColumnRoles v1_roles) : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
+  impl_->v1_roles = std::move(v1_roles);
   refresh();
 }
 
@@ -94,6 +100,8 @@ void ResultsReader::refresh() {
   const std::string path = impl_->path;
   impl_->file.reset();
   if (::access(path.c_str(), F_OK) != 0) throw StoreError(path, "no such file");
+  if (H5Fis_hdf5(path.c_str()) == 0)  // a readable file that is no HDF5 file at all (a study file, ...)
+    throw StoreError(path, "not an HDF5 file (expected a kinesweep results file, as written by kinesweep run)");
   // After a crashed writer, bring the file to its last committed state (no-op while a writer lives).
   recover(path);
   // Open between two commits of a live writer: the same consistency stamp before and after.
@@ -113,7 +121,9 @@ void ResultsReader::refresh() {
     } catch (const StoreError& e) {
       last = e.cause();
       impl_->file.reset();
-      if (e.cause().rfind("not a kinesweep", 0) == 0 || e.cause().rfind("unsupported", 0) == 0) throw;
+      if (e.cause().rfind("not a kinesweep", 0) == 0 || e.cause().rfind("unsupported", 0) == 0 ||
+          e.cause().rfind(kBadColumnAttribute, 0) == 0)
+        throw;  // re-reading cannot cure these
       continue;
     }
     impl_->stamp = before;

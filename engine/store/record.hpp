@@ -3,6 +3,7 @@
 // The store is the only code that knows HDF5; runs only fill these plain structures.
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -14,6 +15,23 @@ using Cell = std::variant<double, std::int64_t, std::string>;
 
 /// What a /runs column holds (stored as its `role` attribute: "parameter", "metric", "bookkeeping").
 enum class Role { parameter, metric, bookkeeping };
+/// The attribute word of a role: "parameter", "metric", "bookkeeping".
+inline std::string_view to_string(Role r) {
+  switch (r) {
+    case Role::parameter: return "parameter";
+    case Role::metric: return "metric";
+    case Role::bookkeeping: return "bookkeeping";
+  }
+  return "bookkeeping";
+}
+/// Inverse of to_string(Role); false (out untouched) for any other word.
+inline bool parse(std::string_view word, Role& out) {
+  if (word == "parameter") out = Role::parameter;
+  else if (word == "metric") out = Role::metric;
+  else if (word == "bookkeeping") out = Role::bookkeeping;
+  else return false;
+  return true;
+}
 
 /// A column of /runs: its name (the user's word: "alpha1A", "E", "status", ...), type, unit, meaning,
 /// role and the run kinds it applies to. All are stored as attributes, so readers need no guessing.

@@ -5,6 +5,7 @@
 // A ResultsWriter must be used by one thread (the writer thread) only.
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -32,7 +33,11 @@ class StoreError : public std::runtime_error {
 };
 
 inline constexpr const char* kFormatName = "kinesweep-results";
-inline constexpr std::int64_t kFormatVersion = 1;
+/// The format this kinesweep writes (2: /runs columns carry `role` and `kinds` attributes).
+inline constexpr std::int64_t kFormatVersion = 2;
+/// The oldest format ResultsReader still opens (1: no role/kinds; see ResultsReader's V1ColumnRoles).
+/// Resume (ResultsWriter::open_for_resume) accepts kFormatVersion only.
+inline constexpr std::int64_t kOldestReadableFormatVersion = 1;
 
 /// Root metadata of a results file.
 struct StoreMeta {
@@ -143,7 +148,8 @@ class ResultsWriter {
 
   struct Resumed;
   /// Reopen an existing file to fill its missing runs (recovering it first after a crash). Refuses
-  /// with StoreError when the file's study_sha256 differs from `expected_sha256`.
+  /// with StoreError when the file's study_sha256 differs from `expected_sha256`, or when its
+  /// format_version is not kFormatVersion (checked read-only: a refused file is left untouched).
   static Resumed open_for_resume(const std::string& path, const std::string& expected_sha256,
                                  const StoreOptions& options = {});
 
@@ -187,7 +193,14 @@ struct ResultsWriter::Resumed {
 /// columns). Opening a crashed file first recovers it (when the directory is writable).
 class ResultsReader {
  public:
-  explicit ResultsReader(const std::string& path);
+  /// Fills `role` and `kinds` of the /runs columns of a format_version 1 file, which stores neither.
+  /// The store knows no column tables, so the caller brings them (kinesweep info/query pass
+  /// cli::v1_column_roles). Called with the columns in file order, after every (re)open of a v1 file.
+  using V1ColumnRoles = std::function<void(std::vector<ColumnSpec>&)>;
+
+  /// Opens a results file of format kOldestReadableFormatVersion .. kFormatVersion. Without
+  /// `v1_roles`, the columns of a version 1 file keep the ColumnSpec defaults (bookkeeping, kinds "").
+  explicit ResultsReader(const std::string& path, V1ColumnRoles v1_roles = {});
   ~ResultsReader();
   /// Close and reopen, to see the runs committed since the open.
   ///
@@ -203,7 +216,7 @@ class ResultsReader {
   ResultsReader& operator=(const ResultsReader&) = delete;
 
   const StoreMeta& meta() const;
-  const std::vector<ColumnSpec>& columns() const;  ///< schema order
+  const std::vector<ColumnSpec>& columns() const;  ///< schema order, with role and kinds
   std::int64_t n_runs() const;
   std::vector<std::uint8_t> done_mask() const;
   std::vector<Cell> read_column(const std::string& name) const;

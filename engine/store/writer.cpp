@@ -1,13 +1,11 @@
-// ResultsWriter and encode_history (see store.hpp, FORMAT.md).
+// ResultsWriter: file creation and the /runs columns, rows and commits (see store.hpp, FORMAT.md).
+// Histories, landscapes and encode_history: writer_histories.cpp; resume: writer_resume.cpp.
 #include <fcntl.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#include <libdeflate.h>
-#include <zlib.h>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -22,121 +20,46 @@
 #include "store/store.hpp"
 #include "store/writer_impl.hpp"
 
-
 namespace ks::store {
 using namespace detail;
 
-std::string history_group_name(std::int64_t run_id, std::int64_t n_runs) {
-  std::size_t width = 6;
-  std::string last = std::to_string(n_runs > 0 ? n_runs - 1 : 0);
-  width = std::max(width, last.size());
-  std::string s = std::to_string(run_id);
-  if (s.size() < width) s = std::string(width - s.size(), '0') + s;
-  return s;
-}
-
-namespace {
-/// HDF5's shuffle filter for 8-byte elements: byte j of element i goes to j * n + i.
-void shuffle8(const double* src, std::size_t n, unsigned char* dst) {
-  const unsigned char* s = reinterpret_cast<const unsigned char*>(src);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < 8; ++j) dst[j * n + i] = s[i * 8 + j];
-}
-/// The byte-shuffled array as one zlib stream, the format HDF5's deflate filter reads. The six
-/// low-order byte planes of a history's doubles are close to noise (deflate gains ~4 % on them at
-/// the price of most of its time), so they go into the stream as stored blocks, copied; only the two
-/// high planes (sign, exponent, top of the mantissa: 2.5x and 50x smaller) are deflated, at `level`.
-/// The stream: zlib header, stored blocks (BFINAL = 0, each ending on a byte boundary), libdeflate's
-/// raw deflate of the high planes (its last block final), Adler-32 of all the bytes. Empty on failure.
-std::vector<unsigned char> zlib_stream_high_planes(const unsigned char* shuffled, std::size_t n, int level);
-
-/// One libdeflate compressor per thread and level (allocating one costs more than a small array).
-libdeflate_compressor* compressor(int level) {
-  struct Cache {
-    std::array<libdeflate_compressor*, 10> c{};
-    ~Cache() {
-      for (auto* p : c)
-        if (p) libdeflate_free_compressor(p);
-    }
-  };
-  thread_local Cache cache;
-  if (!cache.c[level]) cache.c[level] = libdeflate_alloc_compressor(level);
-  return cache.c[level];
-}
-
-std::vector<unsigned char> zlib_stream_high_planes(const unsigned char* shuffled, std::size_t n, int level) {
-  const std::size_t total = 8 * n, low = 6 * n;  // planes 0..5 stored, 6..7 deflated
-  libdeflate_compressor* c = compressor(level);
-  if (!c) return {};
-  const std::size_t stored_blocks = (low + 65534) / 65535;
-  std::vector<unsigned char> out(2 + low + 5 * stored_blocks + libdeflate_deflate_compress_bound(c, total - low) + 4);
-  unsigned char* p = out.data();
-  *p++ = 0x78;  // CMF: deflate, 32 KiB window
-  *p++ = 0x01;  // FLG: no dictionary, (0x78 * 256 + 0x01) % 31 == 0
-  for (std::size_t at = 0; at < low;) {
-    const std::size_t len = std::min<std::size_t>(65535, low - at);
-    *p++ = 0x00;  // BFINAL = 0, BTYPE = 00 (stored), then padding to the byte boundary
-    *p++ = static_cast<unsigned char>(len & 0xff);
-    *p++ = static_cast<unsigned char>(len >> 8);
-    *p++ = static_cast<unsigned char>(~len & 0xff);
-    *p++ = static_cast<unsigned char>((~len >> 8) & 0xff);
-    std::memcpy(p, shuffled + at, len);
-    p += len;
-    at += len;
-  }
-  const std::size_t room = static_cast<std::size_t>(out.data() + out.size() - p) - 4;
-  const std::size_t m = libdeflate_deflate_compress(c, shuffled + low, total - low, p, room);
-  if (m == 0) return {};
-  p += m;
-  const std::uint32_t adler = libdeflate_adler32(1, shuffled, total);
-  *p++ = static_cast<unsigned char>(adler >> 24);
-  *p++ = static_cast<unsigned char>(adler >> 16);
-  *p++ = static_cast<unsigned char>(adler >> 8);
-  *p++ = static_cast<unsigned char>(adler);
-  out.resize(static_cast<std::size_t>(p - out.data()));
-  return out;
-}
-}  // namespace
-
-EncodedHistory encode_history(const RunHistory& history, int level) {
-  level = std::clamp(level, 0, 9);
-  EncodedHistory out;
-  out.arrays.reserve(history.arrays.size());
-  std::vector<unsigned char> shuffled;
-  for (const auto& a : history.arrays) {
-    if (a.data.size() != a.rows * a.cols)
-      throw StoreError("", "history array '" + a.name + "' has " + std::to_string(a.data.size()) +
-                               " values, expected rows*cols = " + std::to_string(a.rows * a.cols));
-    EncodedArray e;
-    e.name = a.name; e.unit = a.unit; e.rows = a.rows; e.cols = a.cols; e.level = level;
-    if (!a.data.empty()) {
-      const std::size_t src = a.data.size() * sizeof(double);
-      if (level == 0) {  // no filter: the chunk is the raw little-endian array
-        e.bytes.resize(src);
-        std::memcpy(e.bytes.data(), a.data.data(), src);
-      } else {  // shuffle, then deflate (zlib format, as HDF5's deflate filter writes it)
-        shuffled.resize(src);
-        shuffle8(a.data.data(), a.data.size(), shuffled.data());
-        e.bytes = zlib_stream_high_planes(shuffled.data(), a.data.size(), level);
-        if (e.bytes.empty()) throw StoreError("", "libdeflate failed for history array '" + a.name + "'");
-      }
-    }
-    out.arrays.push_back(std::move(e));
-  }
-  return out;
-}
-
 // ------------------------------------------------------------------------------------------------
-// struct ResultsWriter::Impl: store/writer_impl.hpp (shared with optimizations.cpp)
+// struct ResultsWriter::Impl: store/writer_impl.hpp (shared with writer_histories.cpp,
+// writer_resume.cpp and optimizations.cpp)
 
-namespace {
-
-const char* type_word(CellType t) { return t == CellType::f64 ? "f64" : t == CellType::i64 ? "i64" : "str"; }
+namespace detail {
 
 void validate_name(const std::string& path, const std::string& name, const std::string& what) {
   if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos)
     throw StoreError(path, "invalid " + what + " name '" + name + "' (empty, '.', '..' or contains '/')");
 }
+
+void set_format(hid_t fapl) { H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_V18); }
+
+std::unique_ptr<ResultsWriter::Impl> open_writer_impl(const std::string& path, const StoreOptions& opt) {
+  auto impl = std::make_unique<ResultsWriter::Impl>();
+  impl->path = path;
+  impl->opt = opt;
+  Hid fapl(make_journal_fapl(opt.durable));
+  set_format(fapl);
+  H5Eclear2(H5E_DEFAULT);
+  hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl);
+  if (f < 0) {
+    std::string cause = "cannot open for writing: ";
+    std::string j = journal_last_error();
+    cause += j.empty() ? h5_error_text() : j;
+    H5Eclear2(H5E_DEFAULT);
+    throw StoreError(path, cause);
+  }
+  impl->file = Hid(f);
+  return impl;
+}
+
+}  // namespace detail
+
+namespace {
+
+const char* type_word(CellType t) { return t == CellType::f64 ? "f64" : t == CellType::i64 ? "i64" : "str"; }
 
 std::string now_iso8601() {
   std::time_t t = std::time(nullptr);
@@ -154,10 +77,6 @@ hid_t file_type_of(CellType t) {
     default: return utf8_vlen_type();
   }
 }
-
-/// A file-access property list for the store's on-disk format (see FORMAT.md: 1.8 object formats,
-/// superblock v2, which has no "open for write" flag, so readers can open a file being written).
-void set_format(hid_t fapl) { H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_V18); }
 
 bool journal_locked_by_other(const std::string& jp) {
   int fd = ::open(jp.c_str(), O_RDWR | O_CLOEXEC);
@@ -199,55 +118,39 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
   write_i64_attr(runs, "n_runs", n_runs);
   hsize_t n = static_cast<hsize_t>(n_runs);
   Hid space(H5Screate_simple(1, &n, nullptr));
-  auto make = [&](const std::string& name, hid_t ftype, hid_t mtype, const void* fill, const std::string& unit,
-                  const std::string& desc, const char* type_attr) {
+  auto make = [&](const ColumnSpec& c, hid_t ftype, hid_t mtype, const void* fill, const char* type_attr) {
     Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
     H5Pset_layout(dcpl, H5D_CONTIGUOUS);
     H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY);  // rows live at fixed addresses from creation on
     H5Pset_fill_time(dcpl, H5D_FILL_TIME_ALLOC);
     if (fill) H5Pset_fill_value(dcpl, mtype, fill);
-    Hid d(check(H5Dcreate2(runs, name.c_str(), ftype, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), path,
-                "create /runs/" + name));
-    write_str_attr(d, "unit", unit);
-    write_str_attr(d, "description", desc);
+    Hid d(check(H5Dcreate2(runs, c.name.c_str(), ftype, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), path,
+                "create /runs/" + c.name));
+    write_str_attr(d, "unit", c.unit);
+    write_str_attr(d, "description", c.description);
     write_str_attr(d, "type", type_attr);
+    write_str_attr(d, "role", std::string(to_string(c.role)));
+    write_str_attr(d, "kinds", c.kinds);
   };
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::int64_t minus1 = -1;
   for (auto& c : columns) {
     Hid ft(file_type_of(c.type));
     switch (c.type) {
-      case CellType::f64: make(c.name, ft, H5T_NATIVE_DOUBLE, &nan, c.unit, c.description, "f64"); break;
-      case CellType::i64: make(c.name, ft, H5T_NATIVE_INT64, &minus1, c.unit, c.description, "i64"); break;
-      case CellType::str: make(c.name, ft, ft, nullptr, c.unit, c.description, "str"); break;  // null = ""
+      case CellType::f64: make(c, ft, H5T_NATIVE_DOUBLE, &nan, "f64"); break;
+      case CellType::i64: make(c, ft, H5T_NATIVE_INT64, &minus1, "i64"); break;
+      case CellType::str: make(c, ft, ft, nullptr, "str"); break;  // null = ""
     }
   }
   const std::uint8_t zero = 0;
-  make("done", H5T_STD_U8LE, H5T_NATIVE_UINT8, &zero, "",
-       "1: the run's row and history are committed; 0: not done (the row holds missing values, or values "
-       "whose done flag was not committed before a crash; resume rewrites it)", "u8");
+  const ColumnSpec done{"done", CellType::i64 /* stored as u8: the arguments below */, "",
+                        "1: the run's row and history are committed; 0: not done (the row holds missing values, or "
+                        "values whose done flag was not committed before a crash; resume rewrites it)",
+                        Role::bookkeeping, ""};
+  make(done, H5T_STD_U8LE, H5T_NATIVE_UINT8, &zero, "u8");
 
   Hid h(check(H5Gcreate2(file, "histories", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /histories"));
   Hid l(check(H5Gcreate2(file, "landscapes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /landscapes"));
-}
-
-std::unique_ptr<ResultsWriter::Impl> open_writer_impl(const std::string& path, const StoreOptions& opt) {
-  auto impl = std::make_unique<ResultsWriter::Impl>();
-  impl->path = path;
-  impl->opt = opt;
-  Hid fapl(make_journal_fapl(opt.durable));
-  set_format(fapl);
-  H5Eclear2(H5E_DEFAULT);
-  hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl);
-  if (f < 0) {
-    std::string cause = "cannot open for writing: ";
-    std::string j = journal_last_error();
-    cause += j.empty() ? h5_error_text() : j;
-    H5Eclear2(H5E_DEFAULT);
-    throw StoreError(path, cause);
-  }
-  impl->file = Hid(f);
-  return impl;
 }
 
 }  // namespace
@@ -335,38 +238,6 @@ std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, co
   return std::unique_ptr<ResultsWriter>(new ResultsWriter(std::move(impl)));
 }
 
-ResultsWriter::Resumed ResultsWriter::open_for_resume(const std::string& path, const std::string& expected_sha256,
-                                                      const StoreOptions& options) {
-  QuietHdf5 quiet;
-  struct stat st{};
-  if (::stat(path.c_str(), &st) != 0) throw StoreError(path, std::string("cannot resume: ") + std::strerror(errno));
-  auto impl = open_writer_impl(path, options);
-  hid_t f = impl->file;
-  if (read_str_attr(f, "format") != kFormatName)
-    throw StoreError(path, "not a kinesweep results file (attribute format != kinesweep-results)");
-  if (read_i64_attr(f, "format_version", -1) != kFormatVersion)
-    throw StoreError(path, "unsupported format_version " + std::to_string(read_i64_attr(f, "format_version", -1)));
-  auto lower = [](std::string s) {
-    for (auto& ch : s) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-    return s;
-  };
-  const std::string sha = read_str_attr(f, "study_sha256");
-  if (lower(sha) != lower(expected_sha256))
-    throw StoreError(path, "study sha256 mismatch: the file was written for study " + sha +
-                               ", the study given now has " + expected_sha256 + " (refusing to resume)");
-  impl->columns = read_run_columns(f, path, impl->n_runs);
-  impl->open_objects();
-  if (impl->n_runs < 0) impl->n_runs = H5Sget_simple_extent_npoints(Hid(H5Dget_space(impl->done_dset)));
-  impl->done.assign(static_cast<std::size_t>(impl->n_runs), 0);
-  if (impl->n_runs > 0)
-    check(H5Dread(impl->done_dset, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, impl->done.data()), path,
-          "read /runs/done");
-  Resumed r;
-  for (std::int64_t i = 0; i < impl->n_runs; ++i)
-    if (impl->done[static_cast<std::size_t>(i)]) r.done.push_back(i);
-  r.writer = std::unique_ptr<ResultsWriter>(new ResultsWriter(std::move(impl)));
-  return r;
-}
 
 ResultsWriter::ResultsWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
@@ -386,40 +257,6 @@ bool ResultsWriter::is_done(std::int64_t id) const {
 }
 std::size_t ResultsWriter::pending() const { return impl_->pending.size() + impl_->unflagged.size(); }
 
-void ResultsWriter::Impl::write_history(std::int64_t id, const EncodedHistory& h) {
-  const std::string gname = history_group_name(id, n_runs);
-  if (link_exists(histories, gname) && H5Ldelete(histories, gname.c_str(), H5P_DEFAULT) < 0)
-    fail("cannot replace /histories/" + gname);
-  Hid g(H5Gcreate2(histories, gname.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-  if (!g.ok()) fail("cannot create /histories/" + gname);
-  std::vector<std::string> names;
-  for (const auto& a : h.arrays) {
-    validate_name(path, a.name, "history array");
-    if (std::find(names.begin(), names.end(), a.name) != names.end())
-      throw StoreError(path, "duplicate history array '" + a.name + "' in run " + std::to_string(id));
-    names.push_back(a.name);
-    hsize_t dims[2] = {a.rows, a.cols};
-    Hid space(H5Screate_simple(2, dims, nullptr));
-    Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
-    const bool empty = a.rows == 0 || a.cols == 0;
-    if (!empty) {
-      H5Pset_chunk(dcpl, 2, dims);  // one chunk = the whole array
-      if (a.level > 0) {            // the pipeline encode_history ran: shuffle, then deflate
-        H5Pset_shuffle(dcpl);
-        H5Pset_deflate(dcpl, static_cast<unsigned>(a.level));
-      }
-    }
-    Hid d(H5Dcreate2(g, a.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT));
-    if (!d.ok()) fail("cannot create /histories/" + gname + "/" + a.name);
-    if (!empty) {
-      hsize_t offset[2] = {0, 0};
-      if (H5Dwrite_chunk(d, H5P_DEFAULT, 0, offset, a.bytes.size(), a.bytes.data()) < 0)
-        fail("cannot write /histories/" + gname + "/" + a.name);
-    }
-    write_str_attr(d, "unit", a.unit);
-  }
-  write_str_list_attr(g, "arrays", names);
-}
 
 void ResultsWriter::write_run(std::int64_t run_id, const Record& record, const RunHistory& history, int level) {
   write_run(run_id, record, encode_history(history, level));
@@ -540,59 +377,6 @@ void ResultsWriter::flush() {
   impl_->do_flush();
 }
 
-void ResultsWriter::write_landscape(const LandscapeSpec& spec) {
-  QuietHdf5 quiet;
-  Impl& m = *impl_;
-  m.usable();
-  validate_name(m.path, spec.block, "landscape block");
-  std::size_t cells = 1;
-  std::vector<hsize_t> dims;
-  std::set<std::string> names;
-  std::vector<std::string> axis_names, metric_names;
-  for (auto& a : spec.axes) {
-    validate_name(m.path, a.name, "landscape axis");
-    if (!names.insert(a.name).second) throw StoreError(m.path, "landscape " + spec.block + ": duplicate name " + a.name);
-    dims.push_back(a.values.size());
-    cells *= a.values.size();
-    axis_names.push_back(a.name);
-  }
-  for (auto& mt : spec.metrics) {
-    validate_name(m.path, mt.name, "landscape metric");
-    if (!names.insert(mt.name).second) throw StoreError(m.path, "landscape " + spec.block + ": duplicate name " + mt.name);
-    if (mt.grid.size() != cells)
-      throw StoreError(m.path, "landscape " + spec.block + ": metric " + mt.name + " has " +
-                                   std::to_string(mt.grid.size()) + " values, the axes span " + std::to_string(cells));
-    metric_names.push_back(mt.name);
-  }
-  if (link_exists(m.landscapes, spec.block) && H5Ldelete(m.landscapes, spec.block.c_str(), H5P_DEFAULT) < 0)
-    m.fail("cannot replace /landscapes/" + spec.block);
-  Hid g(H5Gcreate2(m.landscapes, spec.block.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-  if (!g.ok()) m.fail("cannot create /landscapes/" + spec.block);
-  write_str_list_attr(g, "axes", axis_names);
-  write_str_list_attr(g, "metrics", metric_names);
-  for (auto& a : spec.axes) {
-    hsize_t n = a.values.size();
-    Hid space(H5Screate_simple(1, &n, nullptr));
-    Hid d(H5Dcreate2(g, a.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-    if (!d.ok() || (n > 0 && H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.values.data()) < 0))
-      m.fail("cannot write landscape axis " + a.name);
-    write_str_attr(d, "unit", a.unit);
-    write_str_attr(d, "kind", "axis");
-  }
-  for (auto& mt : spec.metrics) {
-    Hid space(dims.empty() ? H5Screate(H5S_SCALAR)
-                           : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr));
-    Hid d(H5Dcreate2(g, mt.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-    if (!d.ok() ||
-        (cells > 0 && H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, mt.grid.data()) < 0))
-      m.fail("cannot write landscape metric " + mt.name);
-    write_str_attr(d, "unit", mt.unit);
-    write_str_attr(d, "description", mt.description);
-    write_str_attr(d, "kind", "metric");
-    write_str_list_attr(d, "axes", axis_names);
-  }
-  m.do_flush();
-}
 
 void ResultsWriter::close() {
   QuietHdf5 quiet;

@@ -1,7 +1,9 @@
 #pragma once
-// Internal: the state of a ResultsWriter, shared by writer.cpp and optimizations.cpp. Only store/*.cpp.
+// Internal: the state of a ResultsWriter, shared by writer.cpp, writer_histories.cpp, writer_resume.cpp
+// and optimizations.cpp. Only store/*.cpp.
 #include <chrono>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -41,5 +43,16 @@ struct ResultsWriter::Impl {
   void write_rows();  // pending rows into the datasets (no commit)
   void do_flush();    // write_rows, commit, set done flags, commit
 };
+
+namespace detail {
+/// Throws StoreError unless `name` is usable as an HDF5 link name ("what": column, history array, ...).
+void validate_name(const std::string& path, const std::string& name, const std::string& what);
+/// A file-access property list for the store's on-disk format (see FORMAT.md: 1.8 object formats,
+/// superblock v2, which has no "open for write" flag, so readers can open a file being written).
+void set_format(hid_t fapl);
+/// Opens an existing results file for writing through the journal driver (which recovers it first
+/// after a crash). Only path, opt and file are set. Throws StoreError.
+std::unique_ptr<ResultsWriter::Impl> open_writer_impl(const std::string& path, const StoreOptions& opt);
+}  // namespace detail
 
 }  // namespace ks::store

@@ -21,6 +21,14 @@ import numpy as np
 
 STATUSES = ["ok", "diverged", "singular", "ok-\u00f1"]
 COLUMNS = [("alpha", "f", "rad"), ("E", "f", "Nm"), ("iters", "i", ""), ("status", "O", ""), ("method", "O", "")]
+# The ColumnSpecs of tests/store_testgen.cpp (test_columns) beyond name and unit: description, role, kinds.
+SPECS = {
+    "alpha": ("first swept angle", "parameter", "trajectory"),
+    "E": ("energy-like metric", "metric", "trajectory"),
+    "iters": ("iterations used", "metric", "ik"),
+    "status": ("outcome word", "bookkeeping", ""),
+    "method": ("redundancy resolution", "parameter", "trajectory,ik"),
+}
 failures = []
 
 
@@ -104,7 +112,7 @@ def check_complete(path, n):
     with h5py.File(path, "r") as f:
         a = f.attrs
         check(as_str(a["format"]) == "kinesweep-results", "format attribute")
-        check(int(a["format_version"]) == 1, "format_version attribute")
+        check(int(a["format_version"]) == 2, "format_version attribute")
         check(len(as_str(a["engine_version"])) > 0, "engine_version attribute")
         check(re.fullmatch(r"[0-9a-f]{64}", as_str(a["study_sha256"])) is not None, "study_sha256 is 64 hex digits")
         check(re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", as_str(a["created"])) is not None, "created ISO 8601")
@@ -119,6 +127,7 @@ def check_complete(path, n):
             check("unit" in d.attrs and "description" in d.attrs, f"/runs/{name} unit/description attributes")
             check(as_str(d.attrs["unit"]) == unit, f"/runs/{name} unit {d.attrs['unit']!r}")
             check(d.dtype.kind == kind, f"/runs/{name} dtype {d.dtype}")
+        check_column_specs(runs)
         check(check_table(f, n, True) == n, "all done")
         for i in range(n):
             check_history(f, i)
@@ -134,6 +143,22 @@ def check_complete(path, n):
             check(len(df) == n, "pandas DataFrame rows")
         except ImportError:
             pass
+
+
+def check_column_specs(runs):
+    """Every /runs dataset's unit, description, role and kinds, as h5py reads them, equal the
+    ColumnSpecs the file was written with (done: bookkeeping, every kind)."""
+    for name in list(runs):
+        d = runs[name]
+        for attr in ("unit", "description", "role", "kinds"):
+            check(attr in d.attrs and isinstance(d.attrs[attr], str), f"/runs/{name} has a string attribute {attr}")
+    for name, _, unit in COLUMNS:
+        desc, role, kinds = SPECS[name]
+        got = tuple(as_str(runs[name].attrs.get(k, "?")) for k in ("unit", "description", "role", "kinds"))
+        check(got == (unit, desc, role, kinds), f"/runs/{name} unit/description/role/kinds {got}")
+    got = tuple(as_str(runs["done"].attrs.get(k, "?")) for k in ("role", "kinds"))
+    check(got == ("bookkeeping", ""), f"/runs/done role/kinds {got}")
+    check(sorted(runs) == sorted([c[0] for c in COLUMNS] + ["done"]), f"/runs datasets {sorted(runs)}")
 
 
 def stamp(path):

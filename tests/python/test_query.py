@@ -3,10 +3,12 @@
 usage: /usr/bin/python3 test_query.py KINESWEEP_BINARY REPO_ROOT
 """
 import csv
+import hashlib
 import io
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -78,6 +80,27 @@ def h5table(path):
         units = {k: f["runs"][k].attrs.get("unit", "") for k in f["runs"]}
         units = {k: (u.decode() if isinstance(u, bytes) else u) for k, u in units.items()}
         return out, units
+
+
+def sha256(path):
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
+def make_v1(src, dst):
+    """A format_version 1 copy of a results file: no role / kinds attributes on /runs, version 1."""
+    shutil.copyfile(src, dst)
+    with h5py.File(dst, "r+") as f:
+        for k in f["runs"]:
+            for a in ("role", "kinds"):
+                del f["runs"][k].attrs[a]
+        f.attrs.modify("format_version", np.int64(1))
+
+
+def import_ksread():
+    sys.path.insert(0, os.path.join(ROOT, "analysis"))
+    import ksread
+    return ksread
 
 
 def read_csv(text):
@@ -201,6 +224,96 @@ class QueryTest(unittest.TestCase):
         self.assertEqual(ks("query", bogus).returncode, 1)
         self.assertEqual(ks("info", bogus).returncode, 1)
 
+    def test_a_study_file_is_named_as_no_results_file(self):
+        study = os.path.join(self.tmp.name, "x.toml")
+        with open(study, "w") as f:
+            f.write(STUDY)
+        for cmd in ("query", "info"):
+            t0 = time.time()
+            r = ks(cmd, study)
+            self.assertEqual(r.returncode, 1, r.stderr)
+            self.assertEqual(r.stdout, "")
+            lines = r.stderr.strip().splitlines()
+            self.assertEqual(len(lines), 1, r.stderr)  # one line, no HDF5 error stack
+            self.assertIn(study, lines[0])
+            self.assertIn("not an HDF5 file", lines[0])
+            self.assertIn("expected a kinesweep results file", lines[0])
+            self.assertNotIn("HDF5-DIAG", r.stderr)
+            self.assertLess(time.time() - t0, 1.0, "no retries for a file that is no results file")
+
+    def test_negative_counts_are_rejected(self):
+        for args in (["info", self.h5, "--best", "-1"], ["query", self.h5, "-n", "-3"],
+                     ["query", self.h5, "--limit=-3"], ["query", self.h5, "--optimization", "x", "-n", "-1"]):
+            r = ks(*args)
+            self.assertEqual(r.returncode, 2, (args, r.stdout, r.stderr))
+            self.assertIn("0 or more", r.stderr)
+            self.assertEqual(r.stdout, "")
+        self.assertEqual(ks("info", self.h5, "--best", "0").returncode, 0)
+        r = ks("query", self.h5, "-n", "0", "-c", "run_id", "-f", "csv")
+        self.assertEqual((r.returncode, r.stdout), (0, "run_id\n"))
+
+    def test_value_no_row_holds_gets_a_hint(self):
+        r = ks("query", self.h5, "-w", "method=local_weightd")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("(0 of 0 matching rows", r.stdout)
+        self.assertIn("no row has method = 'local_weightd'; did you mean 'local_weighted'?", r.stderr)
+        r = ks("query", self.h5, "-w", "block=weighted,basni", "-c", "run_id", "-f", "csv")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(len(read_csv(r.stdout)[1]), int((self.t["block"] == "weighted").sum()))
+        self.assertIn("no row has block = 'basni'; did you mean 'basin'?", r.stderr)
+        r = ks("query", self.h5, "-w", "status=zzz")
+        self.assertIn("no row has status = 'zzz' (values: ", r.stderr)
+        r = ks("query", self.h5, "-w", "method=newton", "-c", "run_id")  # a held value: no note
+        self.assertEqual(r.stderr, "")
+
+    def test_column_attributes_describe_every_column(self):
+        """role / kinds / unit / description of every /runs column (h5py) against what the engine writes."""
+        with h5py.File(self.h5, "r") as f:
+            self.assertEqual(int(f.attrs["format_version"]), 2)
+            runs = f["runs"]
+            attrs = {k: {a: h5s(runs[k].attrs[a]) for a in ("role", "kinds", "unit", "description")} for k in runs}
+        for c in ("run_id", "block", "status", "wall_time", "done"):
+            self.assertEqual((attrs[c]["role"], attrs[c]["kinds"]), ("bookkeeping", ""), c)
+        for c in ("preset", "alpha1A", "k", "K_N", "dt", "inertia", "vertex_alpha_2"):
+            self.assertEqual((attrs[c]["role"], attrs[c]["kinds"]), ("parameter", "trajectory"), c)
+        for c in ("problem", "q0_1", "q0_2", "q0_3", "max_iter", "z_mode"):
+            self.assertEqual((attrs[c]["role"], attrs[c]["kinds"]), ("parameter", "ik"), c)
+        self.assertEqual((attrs["method"]["role"], sorted(attrs["method"]["kinds"].split(","))),
+                         ("parameter", ["ik", "trajectory"]))
+        for c in ("E", "E_M", "tau_inf", "stop_time"):
+            self.assertEqual((attrs[c]["role"], attrs[c]["kinds"]), ("metric", "trajectory"), c)
+        for c in ("iterations", "error", "solution", "q_final_3"):
+            self.assertEqual((attrs[c]["role"], attrs[c]["kinds"]), ("metric", "ik"), c)
+        self.assertEqual((attrs["E"]["unit"], attrs["alpha1A"]["unit"], attrs["wall_time"]["unit"]), ("Nm", "rad", "s"))
+        for c, a in attrs.items():
+            self.assertIn(a["role"], ("parameter", "metric", "bookkeeping"), c)
+            self.assertTrue(a["description"], c)
+        # in a row of kind K, every column that does not apply to K holds the missing value
+        t = self.t
+        for c, a in attrs.items():
+            if not a["kinds"]:
+                continue
+            for kind, block in (("trajectory", "weighted"), ("ik", "basin")):
+                if kind in a["kinds"].split(","):
+                    continue
+                v = t[c][t["block"] == block]
+                missing = np.isnan(v) if v.dtype.kind == "f" else (v == -1) if v.dtype.kind == "i" else (v == "")
+                self.assertTrue(np.all(missing), (c, block))
+        # ksread reads the same roles and each row's kind
+        ksread = import_ksread()
+        with ksread.open_results(self.h5) as r:
+            self.assertEqual(r.roles(), {c: a["role"] for c, a in attrs.items() if c != "done"})
+            self.assertEqual(r.metrics("ik"), ["iterations", "error", "solution", "rejected", "min_rcond",
+                                               "q_final_1", "q_final_2", "q_final_3"])
+            self.assertIn("method", r.parameters("trajectory"))
+            self.assertIn("method", r.parameters("ik"))
+            self.assertEqual(r.bookkeeping(), ["run_id", "block", "status", "wall_time"])
+            runs = r.runs(columns=["block"])
+            kinds = r.row_kinds()
+            self.assertEqual(set(zip(runs["block"], kinds)), {("weighted", "trajectory"), ("basin", "ik")})
+            self.assertEqual(runs.roles["block"], "bookkeeping")
+            self.assertEqual((r.landscape("weighted").kind, r.landscape("basin").kind), ("trajectory", "ik"))
+
     def _group(self, f, run):
         return f["histories"][str(run).zfill(max(6, len(str(len(f["runs"]["done"]) - 1))))]
 
@@ -297,6 +410,68 @@ class QueryTest(unittest.TestCase):
         print(f"\n  live: {len(seen)} reads during the sweep, {len(partial)} of a partial file "
               f"({min(partial) if partial else '-'}..{max(partial) if partial else '-'} of {len(final['done'])} rows)",
               file=sys.stderr)
+
+
+class Version1FileTest(unittest.TestCase):
+    """A results file of format_version 1 (no role / kinds attributes): info and query still read it,
+    with the roles of the engine's tables; ksread and --resume refuse it, naming the version."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.study = os.path.join(cls.tmp.name, "q.toml")
+        with open(cls.study, "w") as f:
+            f.write(STUDY)
+        cls.v2 = os.path.join(cls.tmp.name, "v2.h5")
+        r = ks("run", cls.study, "-o", cls.v2, "-q")
+        assert r.returncode == 0, r.stderr
+        cls.v1 = os.path.join(cls.tmp.name, "v1.h5")
+        make_v1(cls.v2, cls.v1)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_query_reads_it_as_the_v2_file(self):
+        for args in ([], ["-w", "block=basin", "-n", "5"], ["-w", "block=weighted", "--sort", "E"],
+                     ["-f", "csv", "-w", "status=ok"], ["-f", "json", "-n", "7"]):
+            a, b = ks("query", self.v1, *args), ks("query", self.v2, *args)
+            self.assertEqual(a.returncode, 0, a.stderr)
+            self.assertEqual(a.stdout, b.stdout, args)  # same compact columns: same roles and kinds
+        self.assertIn("iterations", ks("query", self.v1, "-w", "block=basin", "-n", "1").stdout)
+
+    def test_info_reads_it_and_says_where_the_roles_come_from(self):
+        a, b = ks("info", self.v1), ks("info", self.v2)
+        self.assertEqual(a.returncode, 0, a.stderr)
+        self.assertIn("format kinesweep-results v1", a.stdout)
+        self.assertIn("format v1 stores no column roles", a.stdout)
+        drop = ("file ", "engine ", "note ")
+        same = lambda out: [x for x in out.splitlines() if not x.startswith(drop)]
+        self.assertEqual(same(a.stdout), same(b.stdout))
+        self.assertIn("weighted  trajectory", a.stdout)
+        self.assertIn("basin     ik", a.stdout)
+
+    def test_ksread_refuses_it_naming_the_version(self):
+        ksread = import_ksread()
+        with self.assertRaises(ksread.FormatVersionError) as e:
+            ksread.open_results(self.v1)
+        msg = str(e.exception)
+        self.assertIn(self.v1, msg)
+        self.assertIn("format v1", msg)
+        self.assertIn("kinesweep query", msg)
+        self.assertIn("--overwrite", msg)
+        with ksread.open_results(self.v2) as r:  # the v2 file opens
+            self.assertGreater(len(r.runs()), 0)
+
+    def test_resume_is_refused_and_the_file_untouched(self):
+        before = sha256(self.v1), os.stat(self.v1).st_mtime_ns
+        r = ks("run", self.study, "-o", self.v1, "--resume", "-q")
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn("results file format v1 (written by kinesweep ", r.stderr)
+        self.assertIn("); this kinesweep writes v2: rerun with --overwrite", r.stderr)
+        self.assertEqual((sha256(self.v1), os.stat(self.v1).st_mtime_ns), before)
+        self.assertFalse(os.path.exists(self.v1 + ".journal"))
+        self.assertEqual(sorted(os.listdir(self.tmp.name)), ["q.toml", "v1.h5", "v2.h5"])
 
 
 def h5s(v):

@@ -1,0 +1,58 @@
+#pragma once
+// `kinesweep query` argument parsing: --where expressions into conditions on /runs columns, the
+// row test, and the notes on values no row holds. Output formatting: query_util.hpp.
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "cli/query_util.hpp"
+
+namespace ks::cli {
+
+/// A bad argument (exit code 2).
+struct ArgError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::string trim(const std::string& s);
+/// Split at `sep`, each part trimmed (an empty string gives one empty part).
+std::vector<std::string> split(const std::string& s, char sep);
+/// "unknown column 'X'<where>; did you mean 'Y'?\nvalid columns: ...".
+std::string unknown_column_message(const std::string& name, const RunsTable& t, const std::string& where);
+
+enum class Op { eq, ne, lt, le, gt, ge };
+
+/// One condition on one column: `op` against each value (eq: any of them; ne: none of them).
+struct Condition {
+  const RunsColumn* col = nullptr;
+  Op op = Op::eq;
+  std::vector<double> nums;
+  std::vector<std::string> strs;
+  bool or_prev = false;  ///< OR with the previous condition (COL!=LO..HI: below LO or above HI)
+};
+
+/// Tests rows against conditions; numbers as shown (angles in degrees unless `radians`).
+struct Selector {
+  const RunsTable& t;
+  bool radians;
+
+  double value(const RunsColumn& c, std::int64_t r) const;
+  bool test(const Condition& k, std::int64_t r) const;
+};
+
+/// Parse one --where expression into conditions (a range gives two). Throws ArgError.
+///   COL OP VALUE          OP: = == != < <= > >=   (VALUE OP COL also works)
+///   COL=V1,V2,...         any of the values (!=: none of them)
+///   COL=LO..HI            LO <= COL <= HI (!=: outside)
+///   LO<COL<=HI            chained range (< or <=, or > / >= descending)
+std::vector<Condition> parse_where(const std::string& expr, const RunsTable& t);
+
+/// For each text value of an = / != condition that no row holds (among the done rows, or all rows
+/// with `include_pending`): "no row has method = 'local_weightd'; did you mean 'local_weighted'?"
+/// (or the values the column holds, when few and none is close).
+std::vector<std::string> unheld_value_notes(const std::vector<Condition>& conditions, const RunsTable& t,
+                                            bool include_pending);
+
+}  // namespace ks::cli

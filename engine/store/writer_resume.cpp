@@ -1,0 +1,89 @@
+// ResultsWriter::open_for_resume (see store.hpp, FORMAT.md "Creation, overwrite, resume").
+#include <sys/stat.h>
+
+#include <cctype>
+#include <cerrno>
+#include <cstring>
+
+#include "store/h5util.hpp"
+#include "store/journal_vfd.hpp"
+#include "store/store.hpp"
+#include "store/writer_impl.hpp"
+
+namespace ks::store {
+using namespace detail;
+
+namespace {
+
+/// The root attributes that decide whether a file can be resumed.
+struct FormatStamp {
+  std::string format, engine_version;
+  std::int64_t version = -1;
+};
+
+FormatStamp read_format_stamp(hid_t file) {
+  return {read_str_attr(file, "format"), read_str_attr(file, "engine_version"),
+          read_i64_attr(file, "format_version", -1)};
+}
+
+/// Throws StoreError unless `s` is a kinesweep results file of the format this kinesweep writes:
+/// resuming must not mix two formats in one file.
+void require_resumable_format(const std::string& path, const FormatStamp& s) {
+  if (s.format != kFormatName)
+    throw StoreError(path, "not a kinesweep results file (attribute format != kinesweep-results)");
+  if (s.version == kFormatVersion) return;
+  const std::string v = "v" + std::to_string(kFormatVersion);
+  std::string m = "results file format v" + std::to_string(s.version) + " (written by kinesweep " +
+                  (s.engine_version.empty() ? std::string("?") : s.engine_version) + "); this kinesweep writes " + v;
+  if (s.version < kFormatVersion) m += ": rerun with --overwrite";
+  else m += ": resume it with the kinesweep that wrote it, or rerun with --overwrite";
+  throw StoreError(path, m);
+}
+
+/// Checks the format read-only, before anything opens the file for writing (which would touch it).
+/// Skipped when the file cannot be opened read-only as it is (a commit waiting in its journal): the
+/// check after the recovering open below catches that case.
+void check_format_read_only(const std::string& path) {
+  Hid f(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
+  if (!f.ok()) {
+    H5Eclear2(H5E_DEFAULT);
+    return;
+  }
+  require_resumable_format(path, read_format_stamp(f));
+}
+
+std::string lower(std::string s) {
+  for (auto& ch : s) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return s;
+}
+
+}  // namespace
+
+ResultsWriter::Resumed ResultsWriter::open_for_resume(const std::string& path, const std::string& expected_sha256,
+                                                      const StoreOptions& options) {
+  QuietHdf5 quiet;
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0) throw StoreError(path, std::string("cannot resume: ") + std::strerror(errno));
+  if (!journal_has_pending_commit(path)) check_format_read_only(path);
+  auto impl = open_writer_impl(path, options);
+  hid_t f = impl->file;
+  require_resumable_format(path, read_format_stamp(f));
+  const std::string sha = read_str_attr(f, "study_sha256");
+  if (lower(sha) != lower(expected_sha256))
+    throw StoreError(path, "study sha256 mismatch: the file was written for study " + sha +
+                               ", the study given now has " + expected_sha256 + " (refusing to resume)");
+  impl->columns = read_run_columns(f, path, impl->n_runs, true);
+  impl->open_objects();
+  if (impl->n_runs < 0) impl->n_runs = H5Sget_simple_extent_npoints(Hid(H5Dget_space(impl->done_dset)));
+  impl->done.assign(static_cast<std::size_t>(impl->n_runs), 0);
+  if (impl->n_runs > 0)
+    check(H5Dread(impl->done_dset, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, impl->done.data()), path,
+          "read /runs/done");
+  Resumed r;
+  for (std::int64_t i = 0; i < impl->n_runs; ++i)
+    if (impl->done[static_cast<std::size_t>(i)]) r.done.push_back(i);
+  r.writer = std::unique_ptr<ResultsWriter>(new ResultsWriter(std::move(impl)));
+  return r;
+}
+
+}  // namespace ks::store
