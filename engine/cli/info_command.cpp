@@ -60,6 +60,26 @@ std::string seconds(double s) {
 }
 
 /// The /optimizations section (nothing when the file has none). Metric units: the /runs columns'.
+/// The /runs columns by role and run kind, with their units (from the columns' attributes).
+void print_columns(const RunsTable& t, std::ostream& os) {
+  std::vector<std::string> kinds;
+  for (const RunsColumn& c : t.cols)
+    for (const std::string& k : c.kinds)
+      if (std::find(kinds.begin(), kinds.end(), k) == kinds.end()) kinds.push_back(k);
+  auto line = [&](const char* label, Role role, const std::string* kind) {
+    std::string names;
+    for (const RunsColumn& c : t.cols)
+      if (c.role == role && (!kind || c.applies_to(*kind)))
+        names += (names.empty() ? "" : ", ") + c.name + (c.unit.empty() ? "" : " [" + c.unit + "]");
+    if (names.empty()) return;
+    os << "            " << label << (kind ? " " + *kind : std::string()) << ": " << names << '\n';
+  };
+  os << "columns     (role and kinds from the columns' attributes; kinesweep schema describes each)\n";
+  for (const std::string& k : kinds) line("parameters", Role::parameter, &k);
+  for (const std::string& k : kinds) line("metrics", Role::metric, &k);
+  line("bookkeeping", Role::bookkeeping, nullptr);
+}
+
 void print_optimizations(store::ResultsReader& reader, const RunsTable& t, std::ostream& os) {
   const auto names = consistent_read(reader, [&] { return reader.optimizations(); });
   if (names.empty()) return;
@@ -294,6 +314,7 @@ int run_info(const InfoArgs& args) {
     }
     return 0;
   });
+  print_columns(t, os);
   os << "histories   ";
   if (with == 0) {
     os << "none\n";

@@ -10,9 +10,10 @@ namespace ks::cli {
 
 namespace {
 
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.12g", v);
+/// v with `digits` significant digits (12 for reading, 17 to round-trip a double).
+std::string num(double v, int digits = 12) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.*g", digits, v);
   return b;
 }
 /// `s` in a markdown table cell.
@@ -122,7 +123,7 @@ void print_schema_json(std::ostream& os) {
       const ParamDef& p = table[i];
       const Cell c = p.get(d);
       std::string dv;
-      if (const double* x = std::get_if<double>(&c)) dv = std::isfinite(*x) ? num(*x) : "null";
+      if (const double* x = std::get_if<double>(&c)) dv = std::isfinite(*x) ? num(*x, 17) : "null";
       else if (const std::int64_t* n = std::get_if<std::int64_t>(&c)) dv = std::to_string(*n);
       else dv = json_str(std::get<std::string>(c));
       os << (i ? "," : "") << "\n  {\"name\": " << json_str(p.name) << ", \"type\": " << json_str(type_name(p.type))

@@ -12,13 +12,18 @@ Cell missing(CellType t) {
     default: return std::string();
   }
 }
-/// Index of column c.name, adding it (or the kinds of c to it) as needed.
+/// Index of column c.name, adding it (or the kind of c, with its description, to it) as needed.
 std::size_t add(std::vector<ColumnSpec>& cols, const ColumnSpec& c) {
   for (std::size_t i = 0; i < cols.size(); ++i)
     if (cols[i].name == c.name) {
-      std::string& k = cols[i].kinds;
-      if (!c.kinds.empty() && !k.empty() && ("," + k + ",").find("," + c.kinds + ",") == std::string::npos)
-        k += "," + c.kinds;
+      ColumnSpec& have = cols[i];
+      if (!c.kinds.empty() && !have.kinds.empty() && ("," + have.kinds + ",").find("," + c.kinds + ",") == std::string::npos) {
+        if (have.description != c.description) {  // one description per kind: "trajectory: ...; ik: ..."
+          if (have.kinds.find(',') == std::string::npos) have.description = have.kinds + ": " + have.description;
+          have.description += "; " + c.kinds + ": " + c.description;
+        }
+        have.kinds += "," + c.kinds;
+      }
       return i;
     }
   cols.push_back(c);
