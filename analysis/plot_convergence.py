@@ -36,7 +36,7 @@ def main(argv=None):
     if missing:
         raise SystemExit(f"{args.file}: not an IK study (no column {', '.join(missing)})")
     runs = res.runs(columns=need, degrees=True)
-    ik = runs["iterations"] >= 0
+    ik = res.row_kinds() == "ik"  # from the columns' kinds attributes
     if args.methods:
         ik &= np.isin(runs["method"], [m.strip() for m in args.methods.split(",")])
     if args.runs:

@@ -1,4 +1,4 @@
-// Numerical IK of seed 001 (issue 3): the seed's Tables 3-7, the true Halley step's cubic rate,
+// Numerical IK of seed 001: the seed's Tables 3-7, the true Halley step's cubic rate,
 // statuses (singular, max_iter, cycle, diverged, stalled, unsupported), history, names.
 #include <gtest/gtest.h>
 

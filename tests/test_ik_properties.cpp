@@ -1,4 +1,4 @@
-// Property tests of the IK problems and solvers (issue 3): derivatives against central finite
+// Property tests of the IK problems and solvers: derivatives against central finite
 // differences, closed forms are roots, planar 3R solves checked by Orocos KDL's forward kinematics,
 // minimum-norm steps, singular starts, no allocation in a solve.
 #include <gtest/gtest.h>

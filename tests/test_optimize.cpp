@@ -1,4 +1,4 @@
-// Optimisation (issue 6): the NLopt pipeline on smooth functions with known minima, determinism over
+// Optimisation: the NLopt pipeline on smooth functions with known minima, determinism over
 // thread counts, the constraint, the study syntax and its located errors, the HDF5 round trip, and
 // the Must-show items on seed 000 (case 4 below the thesis' 48.39 Nm; case 1 sweep then polish at
 // least as good as the best cell of a 0.1 deg landscape).
@@ -359,7 +359,7 @@ TEST(OptimizeStore, WriteAndReadBack) {
   {
     store::StoreMeta meta;
     meta.study_name = "s";
-    auto w = store::ResultsWriter::create(path, meta, {{"run_id", CellType::i64, "", ""}}, 0);
+    auto w = store::ResultsWriter::create(path, meta, {run_id_column()}, 0);
     w->write_optimization(r.record);
     w->write_optimization(r.record);  // replacing is allowed
     w->close();

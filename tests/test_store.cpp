@@ -27,16 +27,6 @@ using namespace ks;
 using namespace ks::store;
 using namespace ks::store_test;
 
-struct TempDir {
-  fs::path dir;
-  TempDir() {
-    char tmpl[] = "/tmp/ks_store_test_XXXXXX";
-    dir = mkdtemp(tmpl);
-  }
-  ~TempDir() { fs::remove_all(dir); }
-  std::string file(const std::string& name) const { return (dir / name).string(); }
-};
-
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 /// Equal cells; doubles compared bit for bit (NaN == NaN, -0 != +0).
@@ -122,13 +112,6 @@ std::string check_snapshot(const ResultsReader& r, std::int64_t* n_done, int his
 
 std::unique_ptr<ResultsWriter> make_writer(const std::string& path, std::int64_t n, StoreOptions opt = {}) {
   return ResultsWriter::create(path, test_meta(), test_columns(), n, opt);
-}
-
-std::string slurp(const std::string& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -363,7 +346,7 @@ TEST(Store, NeverOverwritesUnlessAskedAndFailuresKeepTheOldFile) {
   EXPECT_THROW(ResultsWriter::create(path, test_meta(), cols, 3, StoreOptions{.overwrite = true}), StoreError);
   EXPECT_EQ(slurp(path), before);
   cols = test_columns();
-  cols.push_back({"done", CellType::f64, "", ""});
+  cols.push_back({"done", CellType::f64, "", "", Role::bookkeeping, ""});
   EXPECT_THROW(ResultsWriter::create(path, test_meta(), cols, 3, StoreOptions{.overwrite = true}), StoreError);
   EXPECT_EQ(slurp(path), before);
   // no temporary files left behind

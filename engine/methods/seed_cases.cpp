@@ -1,5 +1,7 @@
 #include "methods/seed_cases.hpp"
 
+#include "common/angles.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -38,7 +40,6 @@ constexpr std::array<SeedCase, 21> kCases{{
     {"5b", "non-redundant; alpha1A = 15", V, 0.0, 15.0, case5, 60.81, {121.11, 28.22, 8.26}},
     {"5c", "non-redundant; alpha1A = 30", V, 0.0, 30.0, case5, 60.05, {107.88, 28.23, 8.26}},
 }};
-constexpr double kDeg = std::numbers::pi / 180.0;
 }  // namespace
 
 TrajectoryOptions SeedCase::options() const {

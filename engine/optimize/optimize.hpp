@@ -1,5 +1,5 @@
 #pragma once
-// Optimisation pipelines over NLopt (issue 6): a global stage, then a local stage started from one or
+// Optimisation pipelines over NLopt: a global stage, then a local stage started from one or
 // more points (the global stage's best distinct points and/or given starts, e.g. a landscape's best
 // cells), every evaluation recorded. Study-free and HDF5-free: a Problem is variables with bounds
 // plus an objective callable; the result is a Summary.

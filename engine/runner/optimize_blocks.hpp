@@ -1,5 +1,5 @@
 #pragma once
-// Optimisation blocks ([[optimize]], issue 6): a study's OptimizeBlock -> an opt::Problem (one
+// Optimisation blocks ([[optimize]]): a study's OptimizeBlock -> an opt::Problem (one
 // evaluation = the block's runs with the variables' columns set to x; the weighted objective averaged
 // over them; failed runs get a deterministic penalty; the start's reach margin as the constraint) ->
 // opt::optimize -> a store::OptimizationRecord (/optimizations/<name>).

@@ -17,9 +17,6 @@ constexpr NameTable<IkProblem, 3> kProblems{{{IkProblem::scara, "scara"},
                                              {IkProblem::planar3r_position, "planar3r_position"}}};
 constexpr NameTable<ZMode, 3> kZModes{{{ZMode::unset, ""}, {ZMode::thesis, "thesis"}, {ZMode::physical, "physical"}}};
 constexpr std::array<BlockKind, 2> kKindList{BlockKind::trajectory, BlockKind::ik};
-constexpr std::array<std::string_view, 4> kTrajectoryStatuses{"ok", "unreachable_start", "singular", "diverged"};
-constexpr std::array<std::string_view, 8> kIkStatuses{"converged", "stalled",  "singular",    "max_iter",
-                                                      "cycle",     "diverged", "unsupported", "no_solution"};
 }  // namespace
 
 std::string_view to_string(BlockKind k) { return name_of(kKinds, k); }
@@ -78,8 +75,15 @@ const std::vector<MetricDef>& metrics(BlockKind kind) {
   return kind == BlockKind::trajectory ? trajectory_metrics() : ik_metrics();
 }
 std::span<const std::string_view> statuses(BlockKind kind) {
-  if (kind == BlockKind::trajectory) return kTrajectoryStatuses;
-  return kIkStatuses;
+  using ik::Status;
+  static const std::array<std::string_view, 4> trajectory{to_string(RunStatus::ok), to_string(RunStatus::unreachable_start),
+                                                          to_string(RunStatus::singular), to_string(RunStatus::diverged)};
+  static const std::array<std::string_view, 8> ik{
+      ik::to_string(Status::converged), ik::to_string(Status::stalled),  ik::to_string(Status::singular),
+      ik::to_string(Status::max_iter),  ik::to_string(Status::cycle),    ik::to_string(Status::diverged),
+      ik::to_string(Status::unsupported), ik::to_string(Status::no_solution)};
+  if (kind == BlockKind::trajectory) return trajectory;
+  return ik;
 }
 
 RunSpec default_run(BlockKind kind, const KindContext& c) {

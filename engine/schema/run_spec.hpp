@@ -9,15 +9,13 @@
 #include <string_view>
 #include <variant>
 
+#include "common/angles.hpp"
 #include "ik/solve.hpp"
 #include "methods/trajectory.hpp"
 #include "model/arm.hpp"
 #include "store/record.hpp"
 
 namespace ks {
-
-/// Degrees to radians: the one conversion of study files, presets and defaults.
-inline constexpr double kDeg = std::numbers::pi / 180.0;
 
 /// The kinds of run a study block holds.
 enum class BlockKind { trajectory, ik };

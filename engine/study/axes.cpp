@@ -50,6 +50,24 @@ std::optional<Cell> Parser::param_value(const ParamInfo& info, const toml::node&
   return info.from_file(*v);
 }
 
+bool Parser::count_and_interval_ok(const std::string& what, std::int64_t count, const toml::node& count_node,
+                                   double from, double to, const toml::node& at) {
+  if (count < 1) {
+    error(count_node, what + " count = " + std::to_string(count) + "; expected count >= 1");
+    return false;
+  }
+  if (from > to) {
+    error(at, what + " has from = " + fmt(from) + " > to = " + fmt(to) + "; expected from <= to");
+    return false;
+  }
+  if (std::uint64_t(count) > max_runs_) {
+    error(count_node, what + " count = " + std::to_string(count) + "; expected at most max_runs = " +
+                          std::to_string(max_runs_));
+    return false;
+  }
+  return true;
+}
+
 // ---------------------------------------------------------------------------------------------------
 std::optional<AxisDraft> Parser::parse_axis(const ParamInfo& info_ref, const toml::key& key_node, const toml::node& node,
                                           const toml::node* lhs_node) {
@@ -130,21 +148,9 @@ std::optional<AxisDraft> Parser::parse_axis(const ParamInfo& info_ref, const tom
         if (!rt->get(req))
           error(*rn, what + " random has no " + req + "; expected random = { from, to, count, seed }");
       if (!from || !to || !count || !seed) return std::nullopt;
-      if (*count < 1) {
-        error(*rt->get("count"), what + " count = " + std::to_string(*count) + "; expected count >= 1");
-        return std::nullopt;
-      }
+      if (!count_and_interval_ok(what, *count, *rt->get("count"), *from, *to, *rn)) return std::nullopt;
       if (*seed < 0) {
         error(*rt->get("seed"), what + " seed = " + std::to_string(*seed) + "; expected seed >= 0");
-        return std::nullopt;
-      }
-      if (*from > *to) {
-        error(*rn, what + " has from = " + fmt(*from) + " > to = " + fmt(*to) + "; expected from <= to");
-        return std::nullopt;
-      }
-      if (std::uint64_t(*count) > max_runs_) {
-        error(*rt->get("count"), what + " count = " + std::to_string(*count) + "; expected at most max_runs = " +
-                                     std::to_string(max_runs_));
         return std::nullopt;
       }
       const auto vals = uniform_draws(std::uint64_t(*seed), std::uint64_t(*count), *from, *to);
@@ -219,19 +225,7 @@ std::optional<AxisDraft> Parser::parse_axis(const ParamInfo& info_ref, const tom
         }
         auto count = get_integer(*t->get("count"), "count");
         if (!count) return std::nullopt;
-        if (*count < 1) {
-          error(*t->get("count"), what + " count = " + std::to_string(*count) + "; expected count >= 1");
-          return std::nullopt;
-        }
-        if (*from > *to) {
-          error(*n, what + " has from = " + fmt(*from) + " > to = " + fmt(*to) + "; expected from <= to");
-          return std::nullopt;
-        }
-        if (std::uint64_t(*count) > max_runs_) {
-          error(*t->get("count"), what + " count = " + std::to_string(*count) + "; expected at most max_runs = " +
-                                      std::to_string(max_runs_));
-          return std::nullopt;
-        }
+        if (!count_and_interval_ok(what, *count, *t->get("count"), *from, *to, *n)) return std::nullopt;
         vals = linspace_values(*from, *to, std::uint64_t(*count));
       }
       if (!gen_check(vals, *n)) return std::nullopt;

@@ -67,6 +67,9 @@ class Parser : public ParserCore {
   std::optional<Cell> param_value(const ParamInfo& info, const toml::node& n);
   /// Check a stored numeric value's domain (expects file units for messages). Empty when fine.
   std::string domain_problem(const ParamInfo& info, double file_value);
+  /// A count >= 1 and at most max_runs, and from <= to (random and linspace axes); false after reporting.
+  bool count_and_interval_ok(const std::string& what, std::int64_t count, const toml::node& count_node, double from,
+                             double to, const toml::node& at);
 
   std::string_view text_;
   StudyOptions options_;

@@ -17,8 +17,6 @@
 
 namespace ks::study_parse {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
 /// A place in the study text: 1-based line and column (columns count Unicode code points, as toml++
 /// does), and how many code points of the line a diagnostic underlines (0: to the end of the line).
 struct Pos {

@@ -1,4 +1,4 @@
-// IK side by side (issue 3): our solvers against Orocos KDL's ChainIkSolverPos_LMA and
+// IK side by side: our solvers against Orocos KDL's ChainIkSolverPos_LMA and
 // ChainIkSolverPos_NR (ChainFkSolverPos_recursive + ChainIkSolverVel_pinv) on the SAME planar-3R
 // problems. Problem set (seeded): 1000 targets = FK of uniformly random joint states of the seed's
 // arm (l = 1 m), position + orientation alpha; starts either "near" (the generating joint state plus

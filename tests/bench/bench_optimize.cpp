@@ -1,5 +1,5 @@
 // The seed's pipeline for case 1h -- a GA-like global search (GN_ESCH, population 50, 5000 evaluations)
-// then SQP (LD_SLSQP, finite differences) -- on 2 threads (issue 6; the seed under Octave: ~40 min).
+// then SQP (LD_SLSQP, finite differences) -- on 2 threads (the seed under Octave: ~40 min).
 // Also sweep then polish (1h: a 0.1 deg x 0.01 landscape's 8 best cells, BOBYQA from each, in parallel).
 #include <benchmark/benchmark.h>
 

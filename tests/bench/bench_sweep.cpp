@@ -1,5 +1,5 @@
-// Sweep throughput: runs per second at 1 and 2 threads, with histories none and full (issue 4
-// targets: 2 threads >= 1.9x one thread; full compressed histories cost <= 15 % of wall time).
+// Sweep throughput: runs per second at 1 and 2 threads, with histories none and full (targets:
+// 2 threads >= 1.9x one thread; full compressed histories cost <= 15 % of wall time).
 // Each iteration runs a 2 x 81 x 21 trajectory sweep (3402 runs of 2001 steps) into a fresh file.
 // histories: 0 none, 1 full (shuffle + deflate level 1), 2 full raw (no filter), 3 every=10 (level 1).
 #include <benchmark/benchmark.h>

@@ -1,4 +1,4 @@
-// Time of one 2001-step seed run (issue 2 target for local_weighted: <= 150 us on the 2-core machine),
+// Time of one 2001-step seed run (target for local_weighted: <= 150 us on the 2-core machine),
 // with the path sampled once as a sweep does (SampledPath), and, for comparison, sampled per run.
 #include <benchmark/benchmark.h>
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""End-to-end check of /optimizations (issue 6): run a small study with `kinesweep run` and read the
+"""End-to-end check of /optimizations: run a small study with `kinesweep run` and read the
 groups with h5py. Usage: check_optimize.py KINESWEEP WORKDIR"""
 import os
 import shutil
