@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cli/query_util.hpp"
+#include "schema/params.hpp"
 #include "store/store.hpp"
 
 namespace ks::cli {
@@ -60,6 +61,18 @@ std::string seconds(double s) {
 }
 
 /// The /optimizations section (nothing when the file has none). Metric units: the /runs columns'.
+/// False when the kind's table says parameter `c` has no effect on row `r` (its controlling column,
+/// e.g. method, holds a value outside the parameter's effect rule).
+bool has_effect_in_row(const RunsTable& t, const std::string& kind, const RunsColumn& c, std::int64_t r) {
+  BlockKind k{};
+  if (!parse(kind, k)) return true;
+  const auto table = params(k);
+  const ParamDef* p = find_param(table, c.name);
+  if (!p || p->effect.always()) return true;
+  const RunsColumn* ctl = t.find(p->effect.controller);
+  return !ctl || ctl->type != CellType::str || p->effect.applies(ctl->s[r]);
+}
+
 /// The /runs columns by role and run kind, with their units (from the columns' attributes).
 void print_columns(const RunsTable& t, std::ostream& os) {
   std::vector<std::string> kinds;
@@ -288,12 +301,11 @@ int run_info(const InfoArgs& args) {
       os << "  " << std::left << std::setw(static_cast<int>(wn)) << b.name << std::right << "  run " << std::setw(6)
          << r << "  " << key->name << " = " << cell_for_humans(*key, r) << (key->unit.empty() ? "" : " " + key->unit);
       if (tie) os << ", error = " << cell_for_humans(*tie, r) << " " << tie->unit;
-      if (!varying.empty()) {
-        os << "   (";
-        for (std::size_t j = 0; j < varying.size(); ++j)
-          os << (j ? ", " : "") << varying[j]->name << " = " << cell_for_humans(*varying[j], r);
-        os << ")";
-      }
+      std::string label;  // the varying parameters that have an effect on this row (the tables' rules)
+      for (const RunsColumn* c : varying)
+        if (has_effect_in_row(t, b.kind, *c, r))
+          label += (label.empty() ? "" : ", ") + c->name + " = " + cell_for_humans(*c, r);
+      if (!label.empty()) os << "   (" << label << ")";
       os << '\n';
     }
   }
