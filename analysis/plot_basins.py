@@ -14,6 +14,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import ksplot  # noqa: E402
 import ksread  # noqa: E402
 
 SOLUTION_COLOURS = ["#1f77b4", "#2ca02c", "#ff7f0e", "#17becf", "#bcbd22", "#8c564b"]
@@ -24,7 +25,7 @@ FAIL_COLOURS = {"stalled": "#8c510a", "singular": "#7b3294", "max_iter": "#d7191
 
 def parse_args(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ksread.add_output_args(p, default_size="1200x500")
+    ksplot.add_output_args(p, default_size="1200x500")
     p.add_argument("--block", help="IK landscape (block) name (default: the first IK landscape)")
     p.add_argument("--x", default="q0_1", help="initial-guess axis on x (default %(default)s)")
     p.add_argument("--y", default="q0_2", help="initial-guess axis on y (default %(default)s)")
@@ -69,7 +70,7 @@ def main(argv=None):
 
     status, sol, its = (arrange(ls.metrics[m]) for m in ("status_code", "solution", "iterations"))
     pa = ls.axis(panel_axis) if panel_axis else None
-    panel_labels = (pa.labels if pa.categorical else [f"{panel_axis} = {ksread.fmt_num(v)}" for v in pa.values]) \
+    panel_labels = (pa.labels if pa.categorical else [f"{panel_axis} = {ksplot.fmt_num(v)}" for v in pa.values]) \
         if pa else [""]
     xa, ya = ls.axis(args.x), ls.axis(args.y)
     statuses = ls.statuses
@@ -93,7 +94,7 @@ def main(argv=None):
     it_max = max(2.0, float(finite_its.max()) if finite_its.size else 2.0)
     shade_norm = mcolors.LogNorm(vmin=1, vmax=it_max)
 
-    plt, size = ksread.figure(args)
+    plt, size = ksplot.figure(args)
     fig, axes = plt.subplots(1, len(panel_labels), figsize=size, squeeze=False, sharey=True)
     fig.subplots_adjust(left=0.06, right=0.9, bottom=0.24, top=0.85, wspace=0.06)
     axes = axes[0]
@@ -124,9 +125,9 @@ def main(argv=None):
                     used[("fail", key)] = used.get(("fail", key), 0) + 1
         ax.imshow(rgb, origin="lower", extent=extent, aspect="auto", interpolation="nearest")
         ax.set_title(panel_labels[p], fontsize=10)
-        ax.set_xlabel(ksread.axis_label(xa.name, xa.unit))
+        ax.set_xlabel(ksplot.axis_label(xa.name, xa.unit))
         if p == 0:
-            ax.set_ylabel(ksread.axis_label(ya.name, ya.unit))
+            ax.set_ylabel(ksplot.axis_label(ya.name, ya.unit))
         conv = float(np.mean(st == 0)) if st.size else 0.0
         ax.text(0.02, 0.02, f"converged {conv:.0%}", transform=ax.transAxes, fontsize=8,
                 bbox=dict(facecolor="white", alpha=0.8, lw=0))
@@ -146,7 +147,7 @@ def main(argv=None):
                            + (f" ({', '.join(f'{k} = {v}' for k, v in fixed.items())})" if fixed else "")
                            + f"\n{os.path.basename(args.file)}")
     fig.suptitle(title, fontsize=11)
-    return ksread.finish(fig, args, f"basins_{ls.block}",
+    return ksplot.finish(fig, args, f"basins_{ls.block}",
         {"file": args.file, "block": ls.block, "panel_axis": panel_axis,
          "x": {"name": xa.name, "unit": xa.unit, "values": xa.values},
          "y": {"name": ya.name, "unit": ya.unit, "values": ya.values},

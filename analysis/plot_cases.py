@@ -13,6 +13,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import ksplot  # noqa: E402
 import ksread  # noqa: E402
 
 THESIS_INDEX = {"E": None, "tau1_inf": 0, "tau2_inf": 1, "tau3_inf": 2}
@@ -21,7 +22,7 @@ LABELS = {"E": "E (mean ‖τ‖)", "tau1_inf": "‖τ1‖∞", "tau2_inf": "‖
 
 def parse_args(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ksread.add_output_args(p)
+    ksplot.add_output_args(p)
     p.add_argument("--metric", default="E", choices=list(THESIS_INDEX), help="default %(default)s")
     p.add_argument("--cases", help="cases to show, comma-separated (default: every preset in the file)")
     p.add_argument("--log", action="store_true", help="logarithmic value axis")
@@ -47,7 +48,7 @@ def main(argv=None):
         k = THESIS_INDEX[args.metric]
         thesis.append(np.nan if row is None else (row[3] if k is None else row[4][k]))
     unit = runs.units[args.metric]
-    plt, size = ksread.figure(args)
+    plt, size = ksplot.figure(args)
     fig, ax = plt.subplots(figsize=size, constrained_layout=True)
     x = np.arange(len(cases))
     w = 0.4
@@ -68,7 +69,7 @@ def main(argv=None):
     ax.legend(fontsize=9, loc="upper left")
     ax.set_title(args.title or f"{LABELS[args.metric]} per case: thesis beside kinesweep (labels: deviation ≥ 1 %)\n"
                  f"{os.path.basename(args.file)}", fontsize=10)
-    return ksread.finish(fig, args, f"cases_{args.metric}",
+    return ksplot.finish(fig, args, f"cases_{args.metric}",
         {"file": args.file, "metric": args.metric, "unit": unit, "cases": cases,
          "run_ids": ids, "kinesweep": ours, "thesis": thesis})
 

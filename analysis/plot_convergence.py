@@ -14,6 +14,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import ksplot  # noqa: E402
 import ksread  # noqa: E402
 
 LAMBDA_METHODS = {"lm", "lm_adaptive"}
@@ -21,7 +22,7 @@ LAMBDA_METHODS = {"lm", "lm_adaptive"}
 
 def parse_args(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ksread.add_output_args(p)
+    ksplot.add_output_args(p)
     p.add_argument("--runs", help="run ids, comma-separated")
     p.add_argument("--start", help="initial guess q0_1,q0_2 in degrees: per (method, lambda) the nearest run")
     p.add_argument("--methods", help="only these methods, comma-separated")
@@ -60,7 +61,7 @@ def main(argv=None):
     if not ids:
         raise SystemExit(f"{args.file}: no IK run with an iteration history (run the study with histories)")
     rid = {int(r): i for i, r in enumerate(runs["run_id"])}
-    plt, size = ksread.figure(args)
+    plt, size = ksplot.figure(args)
     fig, ax = plt.subplots(figsize=size, constrained_layout=True)
     import matplotlib
     cmap = matplotlib.colormaps["plasma"]
@@ -98,7 +99,7 @@ def main(argv=None):
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     q = f" from q0 = ({args.start}) deg" if args.start else ""
     ax.set_title(args.title or f"Convergence ‖F_k‖ per method and λ{q}\n{os.path.basename(args.file)}", fontsize=10)
-    return ksread.finish(fig, args, "convergence", {"file": args.file, "runs": data})
+    return ksplot.finish(fig, args, "convergence", {"file": args.file, "runs": data})
 
 
 if __name__ == "__main__":

@@ -13,6 +13,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import ksplot  # noqa: E402
 import ksread  # noqa: E402
 
 NAMES = {"tau": "τ", "q": "q", "qd": "q̇", "qdd": "q̈"}
@@ -20,7 +21,7 @@ NAMES = {"tau": "τ", "q": "q", "qd": "q̇", "qdd": "q̈"}
 
 def parse_args(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ksread.add_output_args(p)
+    ksplot.add_output_args(p)
     p.add_argument("--runs", help="run ids, comma-separated")
     p.add_argument("--preset", help="Table 4 cases (the preset column), comma-separated, e.g. 1a,1c,1e")
     p.add_argument("--what", default="tau", help="quantities, comma-separated: tau, q, qd, qdd (default %(default)s)")
@@ -64,7 +65,7 @@ def main(argv=None):
         pre = runs["preset"][i] if (i is not None and "preset" in runs and runs["preset"][i]) else ""
         label[r] = f"run {r}" + (f" (case {pre})" if pre else f" ({runs['block'][i]})" if i is not None else "")
 
-    plt, size = ksread.figure(args)
+    plt, size = ksplot.figure(args)
     ncols = max(hist[ids[0]][w].shape[1] for w in whats)
     fig, axes = plt.subplots(len(whats), ncols, figsize=size, squeeze=False, sharex=True, constrained_layout=True)
     data = {}
@@ -89,7 +90,7 @@ def main(argv=None):
     title = args.title or (f"{', '.join(NAMES.get(w, w) for w in whats)} against time, "
                            f"{'; '.join(label[r] for r in ids)}\n{os.path.basename(args.file)}")
     fig.suptitle(title, fontsize=10)
-    return ksread.finish(fig, args, "histories", {"file": args.file, "runs": data})
+    return ksplot.finish(fig, args, "histories", {"file": args.file, "runs": data})
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import ksplot  # noqa: E402
 import ksread  # noqa: E402
 
 METRIC_LABELS = {"E": "E (mean ‖τ‖)", "E_M": "E_M (mean ‖τ‖ in M⁻¹ norm)", "tau_inf": "‖τ‖∞",
@@ -31,7 +32,7 @@ STATUS_COLOURS = {"unreachable_start": "#b0b0b0", "singular": "#7b3294", "diverg
 
 def parse_args(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ksread.add_output_args(p)
+    ksplot.add_output_args(p)
     p.add_argument("--block", help="landscape (block) name (default: the first in the file)")
     p.add_argument("--metric", help="E, E_M, tau_inf, tau1_inf..tau3_inf, min_manipulability, max_tracking_error "
                    "(trajectory; default E), iterations, error, convergence (IK; default convergence = mean of "
@@ -90,7 +91,7 @@ def pick_index(axis, value):
     i = int(np.argmin(np.abs(axis.values - v)))
     span = np.ptp(axis.values) if len(axis.values) > 1 else 1.0
     if abs(axis.values[i] - v) > 1e-6 * max(span, 1.0) + 1e-9:
-        vals = ", ".join(ksread.fmt_num(x) for x in axis.values[:12])
+        vals = ", ".join(ksplot.fmt_num(x) for x in axis.values[:12])
         raise SystemExit(f"--fix {axis.name}={value}: not on the grid; values: {vals}{' ...' if len(axis.values) > 12 else ''}")
     return i
 
@@ -192,7 +193,7 @@ def main(argv=None):
     unit = "" if metric == "convergence" else ls.units.get(metric, "")
     label = METRIC_LABELS.get(metric, metric) + (f" [{unit}]" if unit else "")
 
-    plt, size = ksread.figure(args)
+    plt, size = ksplot.figure(args)
     from matplotlib.colors import ListedColormap, LogNorm, Normalize
     from matplotlib import patheffects
     from matplotlib.patches import Patch
@@ -249,10 +250,10 @@ def main(argv=None):
         bx, by = xv[j], yv[i]
         best = {"value": z[i, j], "x": xa.values[j], "y": ya.values[i], "i": int(i), "j": int(j)}
         word = "min"
-        xs = xa.labels[j] if xa.categorical else f"{ksread.fmt_num(xa.values[j])}{'°' if xa.unit == 'deg' else ''}"
-        ys = ya.labels[i] if ya.categorical else f"{ksread.fmt_num(ya.values[i])}{'°' if ya.unit == 'deg' else ''}"
+        xs = xa.labels[j] if xa.categorical else f"{ksplot.fmt_num(xa.values[j])}{'°' if xa.unit == 'deg' else ''}"
+        ys = ya.labels[i] if ya.categorical else f"{ksplot.fmt_num(ya.values[i])}{'°' if ya.unit == 'deg' else ''}"
         ax.plot([bx], [by], marker="*", ms=16, color="#ff3030", mec="white", mew=1.2, zorder=5, ls="none",
-                label=f"{word} {ksread.fmt_num(z[i, j])}{(' ' + unit) if unit else ''} at {xa.name} = {xs}, {ya.name} = {ys}")
+                label=f"{word} {ksplot.fmt_num(z[i, j])}{(' ' + unit) if unit else ''} at {xa.name} = {xs}, {ya.name} = {ys}")
     # Thesis optimum.
     thesis = []
     if args.thesis and {xa.name, ya.name} == {"alpha1A", "k"}:
@@ -299,16 +300,16 @@ def main(argv=None):
         bu = ["°" if u == "deg" else "" for u in (opt["units"][opt["variables"].index(xa.name)],
                                                  opt["units"][opt["variables"].index(ya.name)])]
         ax.plot([b["x"]], [b["y"]], marker="o", ms=10, mfc="none", mec="#ff3030", mew=2.2, zorder=9, ls="none",
-                label=f"{opt['name']} best: {opt['objective']} = {ksread.fmt_num(b['objective'])} at "
-                      f"{xa.name} = {ksread.fmt_num(b['x'])}{bu[0]}, {ya.name} = {ksread.fmt_num(b['y'])}{bu[1]}")
-        ax.annotate(f"{opt['name']} best {ksread.fmt_num(b['objective'])}", (b["x"], b["y"]), xytext=(8, -14),
+                label=f"{opt['name']} best: {opt['objective']} = {ksplot.fmt_num(b['objective'])} at "
+                      f"{xa.name} = {ksplot.fmt_num(b['x'])}{bu[0]}, {ya.name} = {ksplot.fmt_num(b['y'])}{bu[1]}")
+        ax.annotate(f"{opt['name']} best {ksplot.fmt_num(b['objective'])}", (b["x"], b["y"]), xytext=(8, -14),
                     textcoords="offset points", color="#ff3030", fontsize=8, fontweight="bold", zorder=9,
                     path_effects=[patheffects.withStroke(linewidth=2.5, foreground="white")])
         ax.set_xlim(xlim)
         ax.set_ylim(ylim)
     for a, setlim, setticks, setlab in ((xa, ax.set_xlim, ax.set_xticks, ax.set_xlabel),
                                         (ya, ax.set_ylim, ax.set_yticks, ax.set_ylabel)):
-        setlab(ksread.axis_label(a.name, a.unit))
+        setlab(ksplot.axis_label(a.name, a.unit))
         if a.categorical:
             setticks(np.arange(len(a.labels)), a.labels)
     lines = ax.get_legend_handles_labels()
@@ -319,7 +320,7 @@ def main(argv=None):
     title = args.title or (f"{what} over {xa.name} × {ya.name} — block {ls.block}{(' (' + sub + ')') if sub else ''}"
                            f"\n{os.path.basename(args.file)}{' (log colour scale)' if args.log else ''}")
     ax.set_title(title, fontsize=10)
-    return ksread.finish(fig, args, f"landscape_{ls.block}_{metric}",
+    return ksplot.finish(fig, args, f"landscape_{ls.block}_{metric}",
         {"file": args.file, "block": ls.block, "metric": metric, "unit": unit,
          "reduce": d["reduce"], "fixed": d["fixed"],
          "x": {"name": xa.name, "unit": xa.unit, "values": xa.values, "labels": xa.labels},

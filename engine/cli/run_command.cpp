@@ -7,9 +7,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
-#include <optional>
 #include <thread>
 
 #include "runner/run_study.hpp"

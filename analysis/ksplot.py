@@ -1,0 +1,88 @@
+"""What the plot scripts share: output arguments, the figure, saving, printing the plotted data.
+Run with Debian's /usr/bin/python3 (numpy, matplotlib)."""
+import os
+
+import numpy as np
+
+
+def add_output_args(p, default_size="800x600"):
+    p.add_argument("file", help="results file (.h5) written by `kinesweep run`")
+    p.add_argument("-o", "--output", help="output picture (default: FILE's name + a suffix, .png); "
+                   "a .svg name writes SVG")
+    p.add_argument("--svg", action="store_true", help="write SVG instead of PNG")
+    p.add_argument("--size", default=default_size, help="picture size in pixels WxH (default %(default)s)")
+    p.add_argument("--dpi", type=float, default=100.0, help="dots per inch (default %(default)s)")
+    p.add_argument("--title", help="replace the title")
+    p.add_argument("--print-data", action="store_true",
+                   help="also print the plotted numbers as JSON on stdout (for tests and checking)")
+
+
+def figure(args):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    try:
+        w, h = (int(x) for x in args.size.lower().split("x"))
+    except ValueError:
+        raise SystemExit(f"--size {args.size!r}: expected WxH in pixels, e.g. 800x600")
+    return plt, (w / args.dpi, h / args.dpi)
+
+
+def output_path(args, suffix):
+    out = args.output
+    if not out:
+        base = os.path.splitext(args.file)[0]
+        out = f"{base}_{suffix}." + ("svg" if args.svg else "png")
+    elif args.svg and not out.lower().endswith(".svg"):
+        out = os.path.splitext(out)[0] + ".svg"
+    return out
+
+
+def save(fig, args, suffix):
+    out = output_path(args, suffix)
+    d = os.path.dirname(out)
+    if d:
+        os.makedirs(d, exist_ok=True)
+    fmt = "svg" if out.lower().endswith(".svg") else "png"
+    fig.savefig(out, dpi=args.dpi, format=fmt)
+    return out
+
+
+def finish(fig, args, suffix, data):
+    """Save the figure (see save); with --print-data print `data` plus the output path as JSON,
+    else print the path. Returns 0, the scripts' exit code."""
+    out = save(fig, args, suffix)
+    if args.print_data:
+        print_json({**data, "output": out})
+    else:
+        print(out)
+    return 0
+
+
+def print_json(obj):
+    import json
+
+    def clean(o):
+        if isinstance(o, dict):
+            return {str(k): clean(v) for k, v in o.items()}
+        if isinstance(o, (list, tuple)):
+            return [clean(v) for v in o]
+        if isinstance(o, np.ndarray):
+            return clean(o.tolist())
+        if isinstance(o, (np.floating, float)):
+            return None if not np.isfinite(o) else float(o)
+        if isinstance(o, np.integer):
+            return int(o)
+        return o
+
+    print(json.dumps(clean(obj)))
+
+
+def axis_label(name, unit):
+    pretty = {"alpha1A": "α1A", "q0_1": "θ1 initial guess (q0_1)", "q0_2": "θ2 initial guess (q0_2)",
+              "k": "k (gravity weight)", "lambda": "λ"}.get(name, name)
+    return f"{pretty} [{unit}]" if unit else pretty
+
+
+def fmt_num(v):
+    return f"{v:.4g}"
