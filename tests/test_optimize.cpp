@@ -9,12 +9,14 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <set>
 #include <sstream>
 
 #include "methods/seed_cases.hpp"
 #include "methods/trajectory.hpp"
 #include "optimize/optimize.hpp"
 #include "runner/optimize_blocks.hpp"
+#include "runner/run_study.hpp"
 #include "space/space.hpp"
 #include "store/store.hpp"
 #include "study/study.hpp"
@@ -347,6 +349,59 @@ TEST(OptimizeSeed, Case1SweepThenPolishBeatsTheBestCellOfA01DegreeLandscape) {
         EXPECT_EQ(r.record.status[i], "ok");
       }
   }
+}
+
+TEST(OptimizeSeed, PolishStartsReadFromTheResultsFileEqualThoseEvaluatedAfresh) {
+  // A landscape with ok, unreachable (|alpha1A| large) and failed cells: the starts ranked from the
+  // stored metrics and statuses must be the starts ranked from fresh runs (two independent routes).
+  const Study s = parse_study(R"([study]
+name = "polish_routes"
+histories = "none"
+[[block]]
+name = "landscape"
+kind = "trajectory"
+method = "local_unweighted"
+[block.axes]
+alpha1A = { from = -150, to = 150, step = 15 }
+k = [0, 0.5, 1]
+[[optimize]]
+name = "polish"
+method = "local_unweighted"
+variables = { alpha1A = [-150, 150], k = [0, 1] }
+polish_from = { block = "landscape", best = 63 }
+[optimize.local]
+algorithm = "LN_BOBYQA"
+max_evals = 10
+)",
+                              "routes.toml");
+  const std::string out = "/tmp/ks_polish_routes_" + std::to_string(::getpid()) + ".h5";
+  RunRequest req;
+  req.study_arg = "routes.toml";
+  req.output = out;
+  req.overwrite = true;
+  req.quiet = true;
+  req.options.histories.mode = HistoryPolicy::Mode::none;
+  std::ostringstream sink;
+  ASSERT_EQ(run_study(s, req, sink, sink), 0) << sink.str();
+  const store::ResultsReader cells(out);
+  OptimizeRunOptions from_file, fresh;
+  from_file.cells = &cells;
+  const auto a = best_cells(s, 0, from_file), b = best_cells(s, 0, fresh);
+  ASSERT_EQ(a.size(), 63u);
+  ASSERT_EQ(a.size(), b.size());
+  std::set<std::string> statuses;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].run, b[i].run) << i;
+    EXPECT_EQ(a[i].x, b[i].x) << i;
+    EXPECT_EQ(a[i].status, b[i].status) << i;
+    EXPECT_TRUE(a[i].value == b[i].value || (std::isnan(a[i].value) && std::isnan(b[i].value))) << i;
+    EXPECT_TRUE(std::isfinite(a[i].value)) << i << " " << a[i].status;
+    statuses.insert(a[i].status);
+  }
+  EXPECT_TRUE(statuses.count("ok"));
+  EXPECT_TRUE(statuses.count("unreachable_start"));  // the ranking covers failed cells too
+  std::filesystem::remove(out);
+  std::filesystem::remove(out + ".journal");
 }
 
 // ---- store -------------------------------------------------------------------------------------------

@@ -44,7 +44,8 @@ std::pair<std::string, double> inside(const ParamDef& p, const Family& f) {
   switch (p.domain.rule) {
     case Domain::Rule::positive: return {"0.125", 0.125};
     case Domain::Rule::nonnegative: return {"0.25", 0.25};
-    case Domain::Rule::at_least: return {"7", 7.0};
+    case Domain::Rule::at_least:
+    case Domain::Rule::within: return {"7", 7.0};
     case Domain::Rule::any: break;
   }
   return {"0.375", 0.375};
@@ -54,9 +55,27 @@ std::string outside(const ParamDef& p) {
   switch (p.domain.rule) {
     case Domain::Rule::positive: return "0";
     case Domain::Rule::nonnegative: return "-0.5";
-    case Domain::Rule::at_least: return std::to_string(static_cast<long long>(p.domain.bound) - 1);
+    case Domain::Rule::at_least:
+    case Domain::Rule::within: return std::to_string(static_cast<long long>(p.domain.bound) - 1);
     case Domain::Rule::any: break;
   }
+  return "";
+}
+
+/// The units the study files and results had before the tables existed (file unit / stored unit):
+/// an oracle written out by hand, so a wrongly declared table entry fails the walk.
+std::string expected_units(const Family& f, const std::string& name) {
+  if (f.kind == BlockKind::trajectory) {
+    if (name == "alpha1A" || name.starts_with("vertex_alpha_")) return "deg/rad";
+    if (name == "K_N") return "1/s";
+    if (name == "dt") return "s";
+    if (name == "torque_bound") return "Nm";
+    return "";
+  }
+  if (name == "q0_1" || name == "q0_2" || name == "target_alpha") return "deg/rad";
+  if (name == "q0_3") return f.scara ? "mm" : "deg/rad";
+  if (name.starts_with("target_")) return f.scara ? "mm" : "m";
+  if (name == "tol") return f.scara ? "mm" : "";
   return "";
 }
 
@@ -82,6 +101,8 @@ TEST(SchemaWalk, EveryParameterIsAcceptedWithItsUnitAndDomain) {
       const std::size_t c = b.column_index(p.name);
       ASSERT_NE(c, Block::npos);
       EXPECT_EQ(b.columns()[c].unit, p.unit);
+      const std::string units = expected_units(f, p.name);
+      EXPECT_EQ(p.file_unit == FileUnit::deg ? "deg/" + p.unit : p.unit, units);
       EXPECT_EQ(b.columns()[c].role, Role::parameter);
       EXPECT_EQ(b.columns()[c].kinds, std::string(to_string(f.kind)));
       const Cell stored = b.params(0)[c];
@@ -169,24 +190,42 @@ TEST(SchemaAccessors, NameTheTypedFields) {
   EXPECT_EQ(i.z_mode, ZMode::physical);
 }
 
-TEST(SchemaDefaults, OmittedKeysTakeTheTypedStructsDefaults) {
-  const Study s = parse_study("[[block]]\nname = \"t\"\nkind = \"trajectory\"\n[[block]]\nname = \"i\"\nkind = \"ik\"\n",
-                              "defaults.toml");
+TEST(SchemaDefaults, OmittedKeysTakeTheSeedsDefaults) {
+  // Seed 000's runs (Table 4 row 1a's settings) and seed 001's SCARA problem; the planar 3R IK problem
+  // of the basin studies. Literal values: what the study files have always meant by an omitted key.
+  const Study s = parse_study(
+      "[[block]]\nname = \"t\"\nkind = \"trajectory\"\n[[block]]\nname = \"i\"\nkind = \"ik\"\n"
+      "[[block]]\nname = \"p\"\nkind = \"ik\"\nproblem = \"planar3r_pose\"\n",
+      "defaults.toml");
   const auto t = std::get<TrajectoryRun>(s.blocks[0].run(0));
-  const TrajectoryOptions o;
-  EXPECT_EQ(t.options.k, o.k);
-  EXPECT_EQ(t.options.dt, o.dt);
-  EXPECT_EQ(t.options.torque_bound, o.torque_bound);
-  EXPECT_EQ(t.options.null_damping, o.null_damping);
-  EXPECT_EQ(t.options.method, o.method);
-  EXPECT_EQ(t.options.integrator, o.integrator);
-  EXPECT_EQ(t.inertia, TrajectoryRun{}.inertia);
+  EXPECT_EQ(t.preset, "");
+  EXPECT_EQ(t.options.method, TrajectoryMethod::local_weighted);
+  EXPECT_EQ(t.options.k, 0.0);
+  EXPECT_EQ(t.options.alpha1A, 0.0);
+  EXPECT_EQ(t.options.null_damping, 0.0);
+  EXPECT_EQ(t.options.vertex_alpha, std::vector<double>(4, 0.0));
+  EXPECT_EQ(t.options.integrator, Integrator::semi_implicit_euler);
+  EXPECT_EQ(t.options.dt, 1e-3);
+  EXPECT_EQ(t.options.torque_bound, 1e6);
+  EXPECT_EQ(t.inertia, InertiaForm::physical);
+  const double deg = std::numbers::pi / 180.0;
   const auto i = std::get<IkRun>(s.blocks[1].run(0));
-  const ik::Options io;
-  EXPECT_EQ(i.options.max_iter, io.max_iter);
-  EXPECT_EQ(i.options.tolerance, io.tolerance);
-  EXPECT_EQ(i.options.lambda, io.lambda);
-  EXPECT_EQ(i.options.method, io.method);
+  EXPECT_EQ(i.problem, IkProblem::scara);
+  EXPECT_EQ(i.options.method, ik::Method::newton);
+  EXPECT_EQ(i.options.lambda, 0.1);
+  EXPECT_EQ(i.options.tolerance, 1e-6);  // mm
+  EXPECT_EQ(i.options.max_iter, 1000);
+  EXPECT_EQ(i.q0, Eigen::Vector3d(60 * deg, 45 * deg, 50.0));
+  EXPECT_EQ(i.target, Eigen::Vector3d(50.0, -80.0, 10.0));  // mm
+  EXPECT_TRUE(std::isnan(i.target_alpha));
+  EXPECT_EQ(i.z_mode, ZMode::thesis);
+  const auto p = std::get<IkRun>(s.blocks[2].run(0));
+  EXPECT_EQ(p.q0, Eigen::Vector3d(0.0, 90 * deg, -90 * deg));
+  EXPECT_EQ(p.target.head<2>(), Eigen::Vector2d(1.5, 1.5));  // m
+  EXPECT_TRUE(std::isnan(p.target[2]));
+  EXPECT_EQ(p.target_alpha, 0.0);
+  EXPECT_EQ(p.z_mode, ZMode::unset);
+  EXPECT_EQ(p.options.max_iter, 1000);
 }
 
 TEST(OptionsIsValid, NamesTheFieldAndTheRule) {
@@ -208,7 +247,7 @@ TEST(OptionsIsValid, NamesTheFieldAndTheRule) {
   EXPECT_TRUE(o.IsValid(&why)) << why;
   o.max_iter = 0;
   EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_EQ(why, "max_iter = 0; expected max_iter >= 1");
+  EXPECT_EQ(why, "max_iter = 0; expected max_iter within [1, 1000000000]");
   o = {};
   o.cycle_window = 17;
   EXPECT_FALSE(o.IsValid(&why));

@@ -11,14 +11,16 @@
 namespace ks {
 
 struct Domain {
-  enum class Rule { any, positive, nonnegative, at_least };
+  enum class Rule { any, positive, nonnegative, at_least, within };
   Rule rule = Rule::any;
-  double bound = 0.0;  ///< at_least: the smallest value allowed
+  double bound = 0.0;  ///< at_least, within: the smallest value allowed
+  double upper = 0.0;  ///< within: the largest value allowed
 
   static constexpr Domain any() { return {}; }
   static constexpr Domain positive() { return {Rule::positive, 0.0}; }
   static constexpr Domain nonnegative() { return {Rule::nonnegative, 0.0}; }
   static constexpr Domain at_least(double v) { return {Rule::at_least, v}; }
+  static constexpr Domain within(double lo, double hi) { return {Rule::within, lo, hi}; }
 
   /// True when v satisfies the rule (NaN only satisfies `any`).
   constexpr bool holds(double v) const {
@@ -27,6 +29,7 @@ struct Domain {
       case Rule::positive: return v > 0.0;
       case Rule::nonnegative: return v >= 0.0;
       case Rule::at_least: return v >= bound;
+      case Rule::within: return v >= bound && v <= upper;
     }
     return false;
   }
@@ -38,6 +41,9 @@ struct Domain {
       case Rule::positive: return std::string(name) + " > 0";
       case Rule::nonnegative: return std::string(name) + " >= 0";
       case Rule::at_least: std::snprintf(b, sizeof b, "%.12g", bound); return std::string(name) + " >= " + b;
+      case Rule::within:
+        std::snprintf(b, sizeof b, "[%.12g, %.12g]", bound, upper);
+        return std::string(name) + " within " + b;
     }
     return "";
   }

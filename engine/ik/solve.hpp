@@ -84,7 +84,7 @@ struct Options {
 
   /// The rules on the fields (checked by IsValid; the study schema reports them at the key).
   static constexpr Domain tolerance_rule = Domain::positive();
-  static constexpr Domain max_iter_rule = Domain::at_least(1);
+  static constexpr Domain max_iter_rule = Domain::within(1, 1e9);  ///< an int, with room to spare
   static constexpr Domain lambda_rule = Domain::nonnegative();
   static constexpr Domain step_floor_rule = Domain::nonnegative();
   static constexpr Domain lambda_scale_rule = Domain::positive();
@@ -95,7 +95,7 @@ struct Options {
   static constexpr int max_cycle_window = 16;
 
   /// True when every field is finite and within its rule (cycle_window within [0, 16]); otherwise
-  /// false, with `why` (when given) naming the field and the rule, e.g. "max_iter = 0; expected max_iter >= 1".
+  /// false, with `why` (when given) naming the field and the rule, e.g. "tolerance = 0; expected tolerance > 0".
   bool IsValid(std::string* why = nullptr) const;
 };
 

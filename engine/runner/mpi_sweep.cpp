@@ -71,20 +71,19 @@ void remove_results_file(const std::string& path) {
 SweepResult merge(const Study& study, const StudySchema& schema, const RunRequest& run, int threads) {
   const std::string& out = run.output;
   const std::uint64_t total = study.run_count();
-  PreviousRuns all;
-  std::unique_ptr<store::ResultsWriter> writer;
   // Commits are the store's main cost (each journals every dirty page of /runs); the merge can be
   // redone from the shards, so it commits rarely (every 30 s) instead of every 64 runs.
   store::StoreOptions so;
   so.flush_every_runs = 0;
   so.flush_every_seconds = 30.0;
-  if (fs::exists(out)) {
-    all = read_previous(out, schema);
-    writer = std::move(store::ResultsWriter::open_for_resume(out, study.sha256, so).writer);
+  OpenedResults opened = open_results(study, schema, out, true, so);
+  std::unique_ptr<store::ResultsWriter> writer = std::move(opened.writer);
+  PreviousRuns all;
+  if (opened.previous) {
+    all = std::move(*opened.previous);
   } else {
     all.done.assign(total, 0);
     for (std::size_t c = 0; c < schema.columns.size(); ++c) all.columns.emplace_back(total, schema.blank.cells[c]);
-    writer = store::ResultsWriter::create(out, store_meta(study), schema.columns, static_cast<std::int64_t>(total), so);
   }
   all.done.resize(total, 0);
 
@@ -196,9 +195,7 @@ class MpiBackend final : public SweepBackend {
       std::string msg;
       try {
         code = prepare(study, r, msg);
-      } catch (const store::StoreError& e) {
-        code = 1, msg = e.what();
-      } catch (const fs::filesystem_error& e) {
+      } catch (const std::exception& e) {  // every rank must reach the Bcast
         code = 1, msg = e.what();
       }
       if (code) fail(msg);
@@ -218,7 +215,7 @@ class MpiBackend final : public SweepBackend {
         shard_ = std::move(store::ResultsWriter::open_for_resume(sp, study.sha256, so).writer);
       else
         shard_ = store::ResultsWriter::create(sp, store_meta(study), schema.columns, static_cast<std::int64_t>(total), so);
-    } catch (const store::StoreError& e) {
+    } catch (const std::exception& e) {  // every rank must reach the Allreduce
       fail(e.what());
       local = 1;
     }
@@ -271,6 +268,7 @@ class MpiBackend final : public SweepBackend {
       if (exists) files.insert(files.begin(), out);
       for (const auto& f : files) {
         store::ResultsReader rd(f);
+        store::require_resumable(f, rd.meta());
         if (rd.meta().study_sha256 != study.sha256 || rd.n_runs() != static_cast<std::int64_t>(done_.size())) {
           msg = f + " holds another study (study_sha256 " + rd.meta().study_sha256 + ", this study " + study.sha256 + ")";
           return 1;
@@ -331,7 +329,7 @@ SweepResult MpiBackend::sweep(const Study& study, const StudySchema& schema, con
     res.report = run_sweep(study, schema, *shard_, o, nullptr);
     if (res.report.interrupted) status = 130;
     shard_->close();
-  } catch (const store::StoreError& e) {
+  } catch (const std::exception& e) {  // the coordinator is joined and the ranks settle below
     err << "kinesweep run [rank " << rank_ << "]: " << e.what() << '\n' << std::flush;
     status = 1;
   }

@@ -64,9 +64,6 @@ class WorkPool {
 };
 
 /// Rank 0's coordinator thread: answers chunk requests until every other rank has retired (got an
-/// empty chunk or said it quits). Request:;
-
-/// Rank 0's coordinator thread: answers chunk requests until every other rank has retired (got an
 /// empty chunk or said it quits). Request: {quit, runs written so far, threads}.
 void coordinate(MPI_Comm comm, int size, std::size_t batch, WorkPool& pool,
                 std::vector<std::atomic<std::uint64_t>>& remote_done, const std::atomic<bool>* stop);

@@ -24,7 +24,8 @@ struct OptimizeRunOptions {
 /// (<= 0: reachable; the seed's IK has no real solution when > 0).
 double reach_margin(const PlanarArm3& arm, const Eigen::Vector2d& p, double alpha);
 
-/// The problem of optimisation block `index` of the study (thread-safe objective).
+/// The problem of optimisation block `index` of the study (thread-safe objective). Its objective
+/// refers to the study (robot, task, blocks): the study must outlive the problem.
 opt::Problem make_problem(const Study& study, std::size_t index);
 
 /// The `best` lowest-objective cells of the block `polish_from` names, as local starts (ties: run order).

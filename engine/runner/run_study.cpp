@@ -26,6 +26,20 @@ std::string refuse_existing(const std::string& out, bool exists, const std::stri
   return out + " " + what + "; use --resume to complete it or --overwrite to replace it";
 }
 
+OpenedResults open_results(const Study& study, const StudySchema& schema, const std::string& out, bool resume,
+                           const store::StoreOptions& so) {
+  OpenedResults r;
+  if (resume && fs::exists(out)) {
+    r.previous = read_previous(out, schema);
+    r.writer = std::move(store::ResultsWriter::open_for_resume(out, study.sha256, so).writer);
+    return r;
+  }
+  if (!fs::path(out).parent_path().empty()) fs::create_directories(fs::path(out).parent_path());
+  r.writer = store::ResultsWriter::create(out, store_meta(study), schema.columns,
+                                         static_cast<std::int64_t>(study.run_count()), so);
+  return r;
+}
+
 namespace {
 
 class LocalBackend final : public SweepBackend {
@@ -41,14 +55,9 @@ class LocalBackend final : public SweepBackend {
     }
     store::StoreOptions so;  // commits every second (see StoreOptions)
     so.overwrite = r.overwrite;
-    if (exists && r.resume) {
-      previous_ = read_previous(out, schema);
-      writer_ = std::move(store::ResultsWriter::open_for_resume(out, study.sha256, so).writer);
-    } else {
-      if (!fs::path(out).parent_path().empty()) fs::create_directories(fs::path(out).parent_path());
-      writer_ = store::ResultsWriter::create(out, store_meta(study), schema.columns,
-                                             static_cast<std::int64_t>(study.run_count()), so);
-    }
+    OpenedResults o = open_results(study, schema, out, r.resume, so);
+    writer_ = std::move(o.writer);
+    previous_ = std::move(o.previous);
     return 0;
   }
 
@@ -125,6 +134,9 @@ int run_study(const Study& study, const RunRequest& request, std::ostream& out, 
     err << "kinesweep run: " << e.what() << '\n';
     code = 1;
   } catch (const fs::filesystem_error& e) {
+    err << "kinesweep run: " << e.what() << '\n';
+    code = 1;
+  } catch (const std::exception& e) {  // anything else still ends every rank through finish()
     err << "kinesweep run: " << e.what() << '\n';
     code = 1;
   }

@@ -3,6 +3,7 @@
 // into the results file, or MPI ranks into shards merged by rank 0. run_study drives either through
 // the same steps: open, sweep, then (leader only) optimisations and report, then finish.
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -45,6 +46,16 @@ std::unique_ptr<SweepBackend> mpi_backend();
 /// process, judged from its environment (no MPI call).
 bool launched_under_mpi();
 #endif
+
+/// A results file opened for a sweep: its writer, and what it already held (resume).
+struct OpenedResults {
+  std::unique_ptr<store::ResultsWriter> writer;
+  std::optional<PreviousRuns> previous;  ///< set when an existing file was reopened
+};
+/// Reopen `out` when `resume` and it exists (its runs read first), else create it (and its folder).
+/// Throws store::StoreError (another study, another format version, unwritable, ...).
+OpenedResults open_results(const Study& study, const StudySchema& schema, const std::string& out, bool resume,
+                           const store::StoreOptions& options);
 
 /// "exists; use --resume ... or --overwrite ..." when `out` (or its `what`) exists and neither was
 /// asked for; "" otherwise.

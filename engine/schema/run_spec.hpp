@@ -59,7 +59,6 @@ struct IkRun {
 };
 
 using RunSpec = std::variant<TrajectoryRun, IkRun>;
-inline BlockKind kind_of(const RunSpec& r) { return r.index() == 0 ? BlockKind::trajectory : BlockKind::ik; }
 
 /// What an IK solve returns to the store (the Summary less its history).
 struct IkResult {
@@ -74,7 +73,6 @@ struct RunOutcome {
   std::variant<TrajectoryMetrics, IkResult> result;
   RunHistory history;
 
-  BlockKind kind() const { return result.index() == 0 ? BlockKind::trajectory : BlockKind::ik; }
   /// ok (trajectory) or converged (ik)
   bool good() const;
   /// The status name stored in /runs.

@@ -2,6 +2,7 @@
 // Helpers that build table entries from accessors to a typed run (internal to engine/schema).
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "schema/params.hpp"
 
@@ -58,7 +59,10 @@ ParamDef named(std::string name, std::vector<std::string> choices, std::string d
   p.description = std::move(description);
   p.effect = std::move(effect);
   p.get = [field](const RunSpec& r) { return Cell(std::string(to_string(field(std::get<Run>(r))))); };
-  p.set = [field](RunSpec& r, const Cell& c) { parse(std::get<std::string>(c), field(std::get<Run>(r))); };
+  p.set = [field, name = p.name](RunSpec& r, const Cell& c) {
+    if (!parse(std::get<std::string>(c), field(std::get<Run>(r))))
+      throw std::invalid_argument("unknown " + name + " '" + std::get<std::string>(c) + "'");
+  };
   return p;
 }
 

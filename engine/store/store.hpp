@@ -51,6 +51,10 @@ struct StoreMeta {
   std::int64_t format_version = kFormatVersion;
 };
 
+/// Throws StoreError unless a results file with these root attributes can be resumed by this
+/// kinesweep (format kinesweep-results, version kFormatVersion); the message names the version.
+void require_resumable(const std::string& path, const StoreMeta& meta);
+
 struct StoreOptions {
   bool overwrite = false;            ///< replace an existing file at the path
   /// Automatic flush after this many written runs (0: never). A commit journals every changed page,

@@ -59,6 +59,10 @@ std::string lower(std::string s) {
 
 }  // namespace
 
+void require_resumable(const std::string& path, const StoreMeta& meta) {
+  require_resumable_format(path, {meta.format, meta.engine_version, meta.format_version});
+}
+
 ResultsWriter::Resumed ResultsWriter::open_for_resume(const std::string& path, const std::string& expected_sha256,
                                                       const StoreOptions& options) {
   QuietHdf5 quiet;
