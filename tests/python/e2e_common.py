@@ -1,6 +1,7 @@
 """What the end-to-end tests share: the small studies they run and how they compare results files.
 Run with Debian's /usr/bin/python3 (h5py, numpy)."""
 import os
+import shutil
 import tempfile
 import unittest
 
@@ -77,6 +78,16 @@ def runs_table(path):
 
 def same_tables(a, b):
     return a.keys() == b.keys() and all(bitwise_equal(a[k], b[k]) for k in a)
+
+
+def make_v1(src, dst):
+    """A format_version 1 copy of a results file: no role / kinds attributes on /runs, version 1."""
+    shutil.copyfile(src, dst)
+    with h5py.File(dst, "r+") as f:
+        for k in f["runs"]:
+            for a in ("role", "kinds"):
+                del f["runs"][k].attrs[a]
+        f.attrs.modify("format_version", np.int64(1))
 
 
 class TempDirTest(unittest.TestCase):

@@ -17,7 +17,9 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import SWEEP as SWEEP_COMMON, TempDirTest, bitwise_equal, runs_table
+import hashlib
+
+from e2e_common import SWEEP as SWEEP_COMMON, TempDirTest, bitwise_equal, make_v1, runs_table
 
 KS = None
 MPIRUN = ["mpirun", "--oversubscribe", "--allow-run-as-root", "--bind-to", "none", "-np", "2"]
@@ -115,6 +117,17 @@ class Merged(Base):
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertIn("(0 computed now, 1002 already in the file)", r.stdout)
         self.assertSameFile(ref, out)
+        # a results file of format version 1 is refused before any rank computes, and left as it was
+        v1 = os.path.join(self.dir, "v1.h5")
+        make_v1(out, v1)
+        with h5py.File(v1, "r+") as f:
+            f["runs"]["done"][:10] = 0
+        before = hashlib.sha256(open(v1, "rb").read()).hexdigest()
+        r = mpirun("run", study, "-o", v1, "-q", "--resume")
+        self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+        self.assertIn("format v1", r.stderr)
+        self.assertEqual(hashlib.sha256(open(v1, "rb").read()).hexdigest(), before)
+        self.assertEqual(glob.glob(v1 + ".rank*"), [])
 
 
 class KillOneRank(Base):

@@ -18,7 +18,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import OPTIMIZE as OPTIMIZE_COMMON
+from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, make_v1
 
 KS = None
 ROOT = None
@@ -85,16 +85,6 @@ def h5table(path):
 def sha256(path):
     with open(path, "rb") as f:
         return hashlib.sha256(f.read()).hexdigest()
-
-
-def make_v1(src, dst):
-    """A format_version 1 copy of a results file: no role / kinds attributes on /runs, version 1."""
-    shutil.copyfile(src, dst)
-    with h5py.File(dst, "r+") as f:
-        for k in f["runs"]:
-            for a in ("role", "kinds"):
-                del f["runs"][k].attrs[a]
-        f.attrs.modify("format_version", np.int64(1))
 
 
 def import_ksread():
