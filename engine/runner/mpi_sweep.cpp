@@ -349,6 +349,8 @@ SweepResult MpiBackend::sweep(const Study& study, const StudySchema& schema, con
   res.report.skipped = total - todo_n;
   if (failed || interrupted) {
     res.code = failed ? 1 : 130;
+    res.report.blocks.clear();  // rank 0's own counts would read as the job's: the totals only
+    res.report.seed_rows.clear();
     return res;
   }
   if (rank_ != 0) return res;
