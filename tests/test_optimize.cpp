@@ -352,8 +352,9 @@ TEST(OptimizeSeed, Case1SweepThenPolishBeatsTheBestCellOfA01DegreeLandscape) {
 }
 
 TEST(OptimizeSeed, PolishStartsReadFromTheResultsFileEqualThoseEvaluatedAfresh) {
-  // A landscape with ok, unreachable (|alpha1A| large) and failed cells: the starts ranked from the
-  // stored metrics and statuses must be the starts ranked from fresh runs (two independent routes).
+  // A landscape with ok, unreachable (|alpha1A| large) and failed cells, some failing at their first
+  // sample (torque_bound 1 Nm: no samples, stop_time NaN): the starts ranked from the stored metrics
+  // and statuses must be the starts ranked from fresh runs (two independent routes), all finite.
   const Study s = parse_study(R"([study]
 name = "polish_routes"
 histories = "none"
@@ -364,11 +365,12 @@ method = "local_unweighted"
 [block.axes]
 alpha1A = { from = -150, to = 150, step = 15 }
 k = [0, 0.5, 1]
+torque_bound = [1.0, 1e6]
 [[optimize]]
 name = "polish"
 method = "local_unweighted"
 variables = { alpha1A = [-150, 150], k = [0, 1] }
-polish_from = { block = "landscape", best = 63 }
+polish_from = { block = "landscape", best = 126 }
 [optimize.local]
 algorithm = "LN_BOBYQA"
 max_evals = 10
@@ -387,7 +389,7 @@ max_evals = 10
   OptimizeRunOptions from_file, fresh;
   from_file.cells = &cells;
   const auto a = best_cells(s, 0, from_file), b = best_cells(s, 0, fresh);
-  ASSERT_EQ(a.size(), 63u);
+  ASSERT_EQ(a.size(), 126u);
   ASSERT_EQ(a.size(), b.size());
   std::set<std::string> statuses;
   for (std::size_t i = 0; i < a.size(); ++i) {
@@ -400,6 +402,7 @@ max_evals = 10
   }
   EXPECT_TRUE(statuses.count("ok"));
   EXPECT_TRUE(statuses.count("unreachable_start"));  // the ranking covers failed cells too
+  EXPECT_TRUE(statuses.count("diverged"));
   std::filesystem::remove(out);
   std::filesystem::remove(out + ".journal");
 }
