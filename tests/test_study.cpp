@@ -504,3 +504,13 @@ TEST(ShippedStudies, ReadmeExampleParses) {
   const Block& v = s.blocks[s.block_index("vertex_search")];
   EXPECT_EQ(v.shape(), (std::vector<std::uint64_t>{3, 64, 4}));
 }
+
+TEST(StudyErrors, ScaraAndPlanarIkBlocksAreSeparateStudies) {
+  // Their q0_3, target_* and tol columns have different units (mm; rad, m): one column cannot say both.
+  const std::string text = kIk + "[[block]]\nname = \"p\"\nkind = \"ik\"\nproblem = \"planar3r_pose\"\n";
+  expect_error_at(text, 4, 1, "would mix units");
+  const StudyError e = error_of(text);
+  ASSERT_EQ(e.diagnostics().front().notes.size(), 1u);
+  EXPECT_EQ(e.diagnostics().front().notes.front().line, 1);  // the first ik block
+}
+

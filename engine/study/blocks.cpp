@@ -382,10 +382,25 @@ void Parser::parse_blocks(const toml::table& root, Study& s) {
   std::map<std::string, Pos> names;
   std::uint64_t total = 0;
   bool reported_total = false;
+  std::optional<std::pair<bool, Pos>> ik_family;  // the first IK block's family (SCARA?) and place
   for (std::size_t i = 0; i < a->size(); ++i) {
     const auto& bt = *a->get(i)->as_table();
     auto block = parse_block(bt, i, s, names);
     if (!block) continue;
+    if (block->kind() == BlockKind::ik) {
+      // The problem families store q0_3, target_* and tol in different units (mm; rad, m): one
+      // /runs column cannot say both.
+      const bool scara = block->context().scara;
+      if (!ik_family) {
+        ik_family.emplace(scara, pos_of(bt.source()));
+      } else if (ik_family->first != scara) {
+        auto fam = [](bool sc) { return std::string(sc ? "the SCARA problem (mm)" : "planar 3R problems (m, rad)"); };
+        note(error(bt.source(), "ik block '" + block->name() + "' solves " + fam(scara) + " but an earlier ik block solves " +
+                                    fam(ik_family->first) + "; their q0_3, target_* and tol columns would mix units; "
+                                    "expected the SCARA and the planar 3R IK blocks in separate studies"),
+             ik_family->second, "the first ik block, with " + fam(ik_family->first));
+      }
+    }
     const bool over = block->overflowed() || total + block->run_count() < total ||
                       total + block->run_count() > max_runs_;
     if (over && !reported_total) {

@@ -17,8 +17,10 @@ from e2e_common import TempDirTest
 
 KS = REPO = None
 
-# One block per kind and IK family, every key omitted (the planar family is chosen by its problem).
-STUDY = """
+# One block per kind and IK family, every key omitted (the planar family is chosen by its problem;
+# SCARA and planar IK blocks go in separate studies: their columns' units differ).
+STUDIES = {
+    "walk": """
 [study]
 name = "walk"
 histories = "none"
@@ -30,13 +32,23 @@ kind = "trajectory"
 [[block]]
 name = "s"
 kind = "ik"
+""",
+    "walk_planar": """
+[study]
+name = "walk_planar"
+histories = "none"
+
+[[block]]
+name = "t"
+kind = "trajectory"
 
 [[block]]
 name = "p"
 kind = "ik"
 problem = "planar3r_position"
-"""
-BLOCK_FAMILY = {"t": ("trajectory", ""), "s": ("ik", "scara"), "p": ("ik", "planar3r")}
+"""}
+BLOCK_FAMILY = {("walk", "t"): ("trajectory", ""), ("walk", "s"): ("ik", "scara"),
+                ("walk_planar", "t"): ("trajectory", ""), ("walk_planar", "p"): ("ik", "planar3r")}
 
 
 def text(v):
@@ -51,48 +63,54 @@ class SchemaWalk(TempDirTest):
         cls.tables = {(k["kind"], k["family"]): k for k in cls.schema["kinds"]}
 
     def run_walk(self):
-        study = self.write("walk.toml", STUDY)
-        out = os.path.join(self.dir, "walk.h5")
-        r = subprocess.run([KS, "run", study, "-o", out, "-q"], capture_output=True, text=True)
-        self.assertEqual(r.returncode, 0, r.stderr)
-        return out
+        """name -> results file of each walk study."""
+        outs = {}
+        for name, text_ in STUDIES.items():
+            study = self.write(name + ".toml", text_)
+            outs[name] = os.path.join(self.dir, name + ".h5")
+            r = subprocess.run([KS, "run", study, "-o", outs[name], "-q"], capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+        return outs
 
     def test_every_column_is_self_described_and_omitted_keys_store_the_defaults(self):
-        out = self.run_walk()
-        with h5py.File(out, "r") as f:
-            runs = f["runs"]
-            blocks = [text(b) for b in runs["block"][()]]
-            for (kind, family), table in self.tables.items():
-                row = [i for i, b in enumerate(blocks) if BLOCK_FAMILY[b] == (kind, family)][0]
-                for p in table["params"]:
-                    with self.subTest(kind=kind, family=family, param=p["name"]):
-                        ds = runs[p["name"]]
-                        self.assertEqual(text(ds.attrs["role"]), "parameter")
-                        self.assertIn(kind, text(ds.attrs["kinds"]).split(","))
-                        if family != "planar3r":  # a column shared by both families keeps the first's unit
-                            self.assertEqual(text(ds.attrs["unit"]), p["unit"])
-                        self.assertIn(p["description"], text(ds.attrs["description"]))
-                        if p["name"] == "problem":
-                            continue  # the planar block names its problem
-                        stored, default = ds[row], p["default"]
-                        if p["type"] == "str":
-                            self.assertEqual(text(stored), default)
-                        elif default is None:
-                            self.assertTrue(math.isnan(stored))
-                        else:
-                            self.assertEqual(float(stored), float(default))
-                for m in table["metrics"]:
-                    with self.subTest(kind=kind, metric=m["name"]):
-                        ds = runs[m["name"]]
-                        self.assertEqual(text(ds.attrs["role"]), "metric")
-                        self.assertEqual(text(ds.attrs["unit"]), m["unit"])
-                        self.assertIn(kind, text(ds.attrs["kinds"]).split(","))
-            for name in self.schema["bookkeeping"]:
-                self.assertEqual(text(runs[name].attrs["role"]), "bookkeeping")
-                self.assertEqual(text(runs[name].attrs["kinds"]), "")
+        for name, out in self.run_walk().items():
+            with h5py.File(out, "r") as f:
+                self.check_file(name, f["runs"])
+
+    def check_file(self, name, runs):
+        blocks = [text(b) for b in runs["block"][()]]
+        for (kind, family), table in self.tables.items():
+            rows = [i for i, b in enumerate(blocks) if BLOCK_FAMILY[(name, b)] == (kind, family)]
+            if not rows:
+                continue
+            for p in table["params"]:
+                with self.subTest(study=name, kind=kind, family=family, param=p["name"]):
+                    ds = runs[p["name"]]
+                    self.assertEqual(text(ds.attrs["role"]), "parameter")
+                    self.assertIn(kind, text(ds.attrs["kinds"]).split(","))
+                    self.assertEqual(text(ds.attrs["unit"]), p["unit"])
+                    self.assertIn(p["description"], text(ds.attrs["description"]))
+                    if p["name"] == "problem":
+                        continue  # the planar block names its problem
+                    stored, default = ds[rows[0]], p["default"]
+                    if p["type"] == "str":
+                        self.assertEqual(text(stored), default)
+                    elif default is None:
+                        self.assertTrue(math.isnan(stored))
+                    else:
+                        self.assertEqual(float(stored), float(default))
+            for m in table["metrics"]:
+                with self.subTest(study=name, kind=kind, metric=m["name"]):
+                    ds = runs[m["name"]]
+                    self.assertEqual(text(ds.attrs["role"]), "metric")
+                    self.assertEqual(text(ds.attrs["unit"]), m["unit"])
+                    self.assertIn(kind, text(ds.attrs["kinds"]).split(","))
+        for col in self.schema["bookkeeping"]:
+            self.assertEqual(text(runs[col].attrs["role"]), "bookkeeping")
+            self.assertEqual(text(runs[col].attrs["kinds"]), "")
 
     def test_info_and_ksread_show_every_parameter_and_metric_with_its_role(self):
-        out = self.run_walk()
+        out = self.run_walk()["walk"]
         info = subprocess.run([KS, "info", out], capture_output=True, text=True)
         self.assertEqual(info.returncode, 0, info.stderr)
         lines = {}
@@ -107,6 +125,8 @@ class SchemaWalk(TempDirTest):
         with ksread.open_results(out) as r:
             roles = r.roles()
             for (kind, family), table in self.tables.items():
+                if family == "planar3r":
+                    continue  # its own study (the same parameter names)
                 for p in table["params"]:
                     self.assertIn(p["name"], lines[("parameters", kind)])
                     self.assertEqual(roles[p["name"]], "parameter")
