@@ -193,10 +193,10 @@ TEST(SchemaAccessors, NameTheTypedFields) {
 TEST(SchemaDefaults, OmittedKeysTakeTheSeedsDefaults) {
   // Seed 000's runs (Table 4 row 1a's settings) and seed 001's SCARA problem; the planar 3R IK problem
   // of the basin studies. Literal values: what the study files have always meant by an omitted key.
-  const Study s = parse_study(
-      "[[block]]\nname = \"t\"\nkind = \"trajectory\"\n[[block]]\nname = \"i\"\nkind = \"ik\"\n"
-      "[[block]]\nname = \"p\"\nkind = \"ik\"\nproblem = \"planar3r_pose\"\n",
-      "defaults.toml");
+  const Study s = parse_study("[[block]]\nname = \"t\"\nkind = \"trajectory\"\n[[block]]\nname = \"i\"\nkind = \"ik\"\n",
+                              "defaults.toml");
+  const Study planar =
+      parse_study("[[block]]\nname = \"p\"\nkind = \"ik\"\nproblem = \"planar3r_pose\"\n", "planar.toml");
   const auto t = std::get<TrajectoryRun>(s.blocks[0].run(0));
   EXPECT_EQ(t.preset, "");
   EXPECT_EQ(t.options.method, TrajectoryMethod::local_weighted);
@@ -219,7 +219,7 @@ TEST(SchemaDefaults, OmittedKeysTakeTheSeedsDefaults) {
   EXPECT_EQ(i.target, Eigen::Vector3d(50.0, -80.0, 10.0));  // mm
   EXPECT_TRUE(std::isnan(i.target_alpha));
   EXPECT_EQ(i.z_mode, ZMode::thesis);
-  const auto p = std::get<IkRun>(s.blocks[2].run(0));
+  const auto p = std::get<IkRun>(planar.blocks[0].run(0));
   EXPECT_EQ(p.q0, Eigen::Vector3d(0.0, 90 * deg, -90 * deg));
   EXPECT_EQ(p.target.head<2>(), Eigen::Vector2d(1.5, 1.5));  // m
   EXPECT_TRUE(std::isnan(p.target[2]));
