@@ -3,12 +3,14 @@
 // study text; its parts live in the files named for their jobs:
 //   study_tables.cpp     [study], [robot], [task]
 //   axes.cpp             parameter values and the [block.axes] forms (values, range, linspace, random, lhs)
-//   blocks.cpp           [[block]] tables: fixed parameters, lhs and zip groups, axes a run would ignore
+//   blocks.cpp           [[block]] tables: name, kind, keys, IK problem family, fixed parameters
+//   block_axes.cpp       a block's axes: lhs settings, [block.axes], lhs and zip groups, axes a run would ignore
 //   optimize_tables.cpp  [[optimize]] tables and their stages
 //   parse.cpp            Parser::run, parse_study, load_study
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -28,6 +30,40 @@ struct AxisDraft {
   Pos pos;                                   // the axis key
   bool lhs = false;
   std::pair<double, double> lhs_range{0, 0};  // LHS axes: [from, to) in file units
+};
+
+/// One [[block]] table (or the block part of an [[optimize]] table) while Parser::parse_block reads
+/// it: each step reads its part of the table into the draft and reports what is wrong there.
+struct BlockDraft {
+  BlockDraft(const toml::table& t, bool opt, std::string lbl)
+      : table(t), optimize(opt), pos(pos_of(t.source())), label(std::move(lbl)) {}
+
+  const toml::table& table;
+  bool optimize = false;
+  Pos pos;            // the table
+  std::string label;  // "[[block]] #N" or "[[optimize]] #N"
+  BlockSpec spec;
+  // The kind and its words for messages ("ik", "an ik"; the other kind's "trajectory", "a trajectory").
+  BlockKind kind{};
+  std::string kname, other_kname, a_kind, a_other;
+  std::size_t nverts = 0;                // the task's path vertices
+  std::vector<ParamInfo> infos;          // the kind's parameters (SCARA units until the IK family is known)
+  std::vector<ParamInfo> other;          // the other kind's parameters
+  std::vector<std::string> param_names;  // the kind's parameter names
+  const toml::table* axes_t = nullptr;   // [block.axes], when it is a table
+  std::set<std::string> axis_names;
+  std::map<std::string, Pos> axis_keys;  // where each axis is written
+  bool scara = true;                     // the IK problem family
+  const toml::node* lhs_node = nullptr;  // lhs = { count, seed }
+  std::optional<std::uint64_t> lhs_count, lhs_seed;
+  std::vector<AxisDraft> drafts;         // the axes read so far
+  std::vector<std::string> lhs_group;    // the LHS axes, once drawn
+  BlockContext ctx;
+
+  /// The kind's parameter named `n`, or nullptr.
+  const ParamInfo* info_of(std::string_view n) const;
+  /// True for a parameter of the other kind (and vertex_alpha in an IK block).
+  bool belongs_to_other(std::string_view n) const;
 };
 
 /// The metrics an [[optimize]] objective may name for runs of kind `k`.
@@ -53,6 +89,33 @@ class Parser : public ParserCore {
   /// holds the names seen so far (and where).
   std::optional<Block> parse_block(const toml::table& b, std::size_t index, const Study& s,
                                    std::map<std::string, Pos>& names, bool optimize = false);
+  // parse_block's steps, in order.
+  /// Reads name (else an optimisation's preset); reports an empty, duplicate or missing name.
+  void read_block_name(BlockDraft& d, std::map<std::string, Pos>& names);
+  /// Reads kind and sets up its parameters; reports an unknown or missing kind (false: read no further).
+  bool read_block_kind(BlockDraft& d);
+  /// Reads the table's keys; reports those neither block keys nor the kind's parameters.
+  void check_block_keys(const BlockDraft& d);
+  /// Reads where the axes are written; reports an axes that is not a table.
+  void find_axes_table(BlockDraft& d);
+  /// Reads an IK block's problems for its units; reports SCARA and planar 3R problems mixed.
+  void read_ik_family(BlockDraft& d);
+  /// Reads the fixed parameters (and vertex_alpha = [...]); reports bad values and parameters also axes.
+  void read_fixed_params(BlockDraft& d);
+
+  // block_axes.cpp: parse_block's steps for the axes, in order.
+  /// Reads lhs = { count, seed }; reports a bad or missing count or seed.
+  void read_block_lhs(BlockDraft& d);
+  /// Reads [block.axes]; reports axes that are not the kind's parameters (and their bad values).
+  void read_axes(BlockDraft& d);
+  /// Draws the LHS axes' values; reports lhs settings no axis uses.
+  void draw_lhs_group(BlockDraft& d);
+  /// Reads zip; reports bad groups, unknown, twice-zipped or LHS axes and unequal lengths.
+  void read_zip_groups(BlockDraft& d);
+  /// Reads the axes against their controlling parameters; reports axes a run would ignore.
+  void reject_ineffective_axes(const BlockDraft& d);
+  /// Reads the draft into a Block unless a step reported since errors_before; reports a spec Block refuses.
+  std::optional<Block> finish_block(BlockDraft& d, std::size_t errors_before);
 
   // optimize_tables.cpp: [[optimize]] tables, a block (parse_block with optimize = true) + the
   // optimisation keys.
