@@ -31,7 +31,7 @@ double num(const Cell& c) { return std::get<double>(c); }
 }  // namespace
 
 TEST(Space, ColumnsCoverEveryParameterOfTheKind) {
-  Block t({"t", BlockKind::trajectory, {}, {}, {}}, BlockContext{});
+  Block t({"t", BlockKind::trajectory, {}, {}, {}}, KindContext{});
   std::vector<std::string> names;
   for (const auto& c : t.columns()) names.push_back(c.name);
   EXPECT_EQ(names, (std::vector<std::string>{"preset", "method", "k", "alpha1A", "K_N", "vertex_alpha_2",
@@ -42,7 +42,7 @@ TEST(Space, ColumnsCoverEveryParameterOfTheKind) {
   EXPECT_EQ(t.columns()[t.column_index("method")].type, CellType::str);
   EXPECT_EQ(t.params(0).size(), t.columns().size());
 
-  Block ik({"i", BlockKind::ik, {}, {}, {}}, BlockContext{});
+  Block ik({"i", BlockKind::ik, {}, {}, {}}, KindContext{});
   names.clear();
   for (const auto& c : ik.columns()) names.push_back(c.name);
   EXPECT_EQ(names, (std::vector<std::string>{"problem", "method", "lambda", "q0_1", "q0_2", "q0_3", "target_x",
@@ -58,7 +58,7 @@ TEST(Space, ColumnsCoverEveryParameterOfTheKind) {
   EXPECT_EQ(num(p[8]), 10.0);
   EXPECT_TRUE(std::isnan(num(p[9])));
 
-  Block planar({"p", BlockKind::ik, {{"problem", std::string("planar3r_pose")}}, {}, {}}, BlockContext{});
+  Block planar({"p", BlockKind::ik, {{"problem", std::string("planar3r_pose")}}, {}, {}}, KindContext{});
   EXPECT_EQ(planar.columns()[planar.column_index("q0_3")].unit, "rad");
   EXPECT_EQ(planar.columns()[planar.column_index("target_x")].unit, "m");
 }
@@ -67,7 +67,7 @@ TEST(Space, ProductVisitsEveryCombinationOnce) {
   BlockSpec spec{"b", BlockKind::trajectory, {}, {}, {}};
   spec.axes = {str_axis("method", {"local_weighted", "local_unweighted", "vertex_alpha"}),
                num_axis("alpha1A", {0.1, 0.2, 0.3, 0.4}), num_axis("k", {0, 0.25, 0.5, 0.75, 1.0})};
-  Block b(spec, BlockContext{});
+  Block b(spec, KindContext{});
   EXPECT_EQ(b.run_count(), 60u);
   EXPECT_EQ(b.shape(), (std::vector<std::uint64_t>{3, 4, 5}));
   std::set<std::tuple<std::string, double, double>> seen;
@@ -117,7 +117,7 @@ TEST(Space, DecodingIsDirectForHugeBlocks) {
   for (int i = 0; i < 1000; ++i) v[i] = i;
   spec.axes = {num_axis("alpha1A", v), num_axis("k", v), num_axis("K_N", v), num_axis("dt", v)};
   for (auto& x : spec.axes[3].values) std::get<double>(x) += 1;  // dt > 0
-  Block b(spec, BlockContext{});
+  Block b(spec, KindContext{});
   EXPECT_EQ(b.run_count(), 1'000'000'000'000u);
   const std::uint64_t last = b.run_count() - 1;
   EXPECT_EQ(num(b.value(last, "alpha1A")), 999.0);
@@ -241,11 +241,11 @@ TEST(Space, GlobalRunIds) {
 
 TEST(Space, InconsistentSpecsAreRejected) {
   BlockSpec bad{"b", BlockKind::trajectory, {{"k", 0.5}}, {num_axis("k", {0, 1})}, {}};
-  EXPECT_THROW(Block(bad, BlockContext{}), std::invalid_argument);
+  EXPECT_THROW(Block(bad, KindContext{}), std::invalid_argument);
   BlockSpec zip{"b", BlockKind::trajectory, {}, {num_axis("k", {0, 1}), num_axis("alpha1A", {0})}, {{"k", "alpha1A"}}};
-  EXPECT_THROW(Block(zip, BlockContext{}), std::invalid_argument);
+  EXPECT_THROW(Block(zip, KindContext{}), std::invalid_argument);
   BlockSpec type{"b", BlockKind::trajectory, {{"method", 1.0}}, {}, {}};
-  EXPECT_THROW(Block(type, BlockContext{}), std::invalid_argument);
+  EXPECT_THROW(Block(type, KindContext{}), std::invalid_argument);
   BlockSpec unknown{"b", BlockKind::ik, {{"alpha1A", 1.0}}, {}, {}};
-  EXPECT_THROW(Block(unknown, BlockContext{}), std::invalid_argument);
+  EXPECT_THROW(Block(unknown, KindContext{}), std::invalid_argument);
 }

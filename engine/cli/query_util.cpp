@@ -81,7 +81,7 @@ void v1_column_roles(std::vector<ColumnSpec>& columns) {
     if (std::none_of(ms.begin(), ms.end(), [&](const MetricDef& m) { return names.count(m.name) > 0; }))
       continue;  // no block of this kind in the file
     const std::string kind(to_string(k));
-    for (const ParamInfo& p : block_params(k, vertices)) enter(p.name, Role::parameter, kind);
+    for (const ParamDef& p : block_params(k, vertices)) enter(p.name, Role::parameter, kind);
     for (const MetricDef& m : ms) enter(m.name, Role::metric, kind);
   }
   for (auto& c : columns) {

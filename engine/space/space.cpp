@@ -32,7 +32,7 @@ bool ik_problem_is_scara(std::string_view problem) {
   return parse(problem, p) && p == IkProblem::scara;
 }
 
-std::vector<ParamInfo> block_params(BlockKind kind, std::size_t path_vertices, bool scara) {
+std::vector<ParamDef> block_params(BlockKind kind, std::size_t path_vertices, bool scara) {
   KindContext c;
   c.path_vertices = path_vertices;
   c.scara = scara;
@@ -40,7 +40,7 @@ std::vector<ParamInfo> block_params(BlockKind kind, std::size_t path_vertices, b
 }
 
 // ---------------------------------------------------------------------------------------------------
-Block::Block(BlockSpec spec, const BlockContext& context)
+Block::Block(BlockSpec spec, const KindContext& context)
     : name_(std::move(spec.name)), kind_(spec.kind), context_(context) {
   // IK problem family (fixes the units of q0_3, the targets and tol, and the defaults).
   if (kind_ == BlockKind::ik) {

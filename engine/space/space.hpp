@@ -27,12 +27,8 @@ std::vector<std::string> inertia_names();
 /// (lengths in m, q0_3 an angle).
 bool ik_problem_is_scara(std::string_view problem);
 
-/// A block's parameters are the table entries of its kind (schema/params.hpp).
-using ParamInfo = ParamDef;
-/// What a block inherits from the study: its path and the study-wide defaults.
-using BlockContext = KindContext;
 /// The parameters of a kind for a path of `path_vertices` vertices (IK: of the SCARA family or not).
-std::vector<ParamInfo> block_params(BlockKind kind, std::size_t path_vertices = 5, bool scara = true);
+std::vector<ParamDef> block_params(BlockKind kind, std::size_t path_vertices = 5, bool scara = true);
 
 /// An axis: a parameter and its values, in stored units (angles in rad).
 struct Axis {
@@ -64,7 +60,7 @@ class Block {
   /// Throws std::invalid_argument on an inconsistent spec (unknown parameter, bad cell type, a
   /// parameter both fixed and swept, unequal lengths in a group, an axis in two groups, empty axis,
   /// IK problems of both families). `context.scara` is derived from the block's problems.
-  Block(BlockSpec spec, const BlockContext& context);
+  Block(BlockSpec spec, const KindContext& context);
 
   const std::string& name() const { return name_; }
   BlockKind kind() const { return kind_; }
@@ -72,7 +68,7 @@ class Block {
   const std::vector<ColumnSpec>& columns() const { return columns_; }
   /// The kind's parameter table for this block (units resolved for its context), columns() order.
   const std::vector<ParamDef>& table() const { return table_; }
-  const BlockContext& context() const { return context_; }
+  const KindContext& context() const { return context_; }
   /// Column of a parameter, or npos.
   std::size_t column_index(std::string_view param) const;
   const std::vector<Axis>& axes() const { return axes_; }
@@ -101,7 +97,7 @@ class Block {
  private:
   std::string name_;
   BlockKind kind_;
-  BlockContext context_;
+  KindContext context_;
   std::vector<ParamDef> table_;
   std::vector<ColumnSpec> columns_;
   RunSpec defaults_;          // the kind's defaults in this context

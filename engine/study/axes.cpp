@@ -7,7 +7,7 @@
 
 namespace ks::study_parse {
 
-std::string Parser::domain_problem(const ParamInfo& info, double v) {
+std::string Parser::domain_problem(const ParamDef& info, double v) {
   if (auto p = info.domain.problem(info.name, v); !p.empty()) return p;
   if (info.name == "dt" && path_duration_ / v + 1 > kMaxSamples)  // the path's samples bound dt from below
     return "dt = " + fmt(v) + " gives " + fmt(std::floor(path_duration_ / v) + 1) + " samples on the " +
@@ -16,7 +16,7 @@ std::string Parser::domain_problem(const ParamInfo& info, double v) {
   return "";
 }
 
-std::optional<Cell> Parser::param_value(const ParamInfo& info, const toml::node& n) {
+std::optional<Cell> Parser::param_value(const ParamDef& info, const toml::node& n) {
   if (info.type == CellType::str) {
     const auto* s = n.as_string();
     if (!s) {
@@ -69,9 +69,9 @@ bool Parser::count_and_interval_ok(const std::string& what, std::int64_t count, 
 }
 
 // ---------------------------------------------------------------------------------------------------
-std::optional<AxisDraft> Parser::parse_axis(const ParamInfo& info_ref, const toml::key& key_node, const toml::node& node,
+std::optional<AxisDraft> Parser::parse_axis(const ParamDef& info_ref, const toml::key& key_node, const toml::node& node,
                                           const toml::node* lhs_node) {
-  const ParamInfo* info = &info_ref;
+  const ParamDef* info = &info_ref;
   const toml::node* n = &node;
   const std::string key(key_node.str());
   AxisDraft d;

@@ -37,7 +37,7 @@ void Parser::read_axes(BlockDraft& d) {
   if (!d.axes_t) return;
   for (auto&& [k, n] : ordered(*d.axes_t)) {
     const std::string key(k->str());
-    const ParamInfo* info = d.info_of(key);
+    const ParamDef* info = d.info_of(key);
     if (!info) {
       if (key == "vertex_alpha" && d.kind == BlockKind::trajectory)
         error(*k, "vertex_alpha cannot be an axis as a whole; expected one axis per vertex: vertex_alpha_2 .. vertex_alpha_" +
@@ -68,7 +68,7 @@ void Parser::draw_lhs_group(BlockDraft& d) {
   if (!lhs_axes.empty() && d.lhs_count && d.lhs_seed) {
     const auto draws = lhs_draws(*d.lhs_seed, *d.lhs_count, ranges);
     for (std::size_t i = 0; i < lhs_axes.size(); ++i) {
-      const ParamInfo* info = d.info_of(lhs_axes[i]->axis.name);
+      const ParamDef* info = d.info_of(lhs_axes[i]->axis.name);
       for (double v : draws[i]) lhs_axes[i]->axis.values.push_back(info->from_file(v));
       d.lhs_group.push_back(lhs_axes[i]->axis.name);
     }
@@ -161,10 +161,10 @@ void Parser::reject_ineffective_axes(const BlockDraft& d) {
   };
   // The values a controlling parameter takes in the block's runs: its own, else those the leading
   // parameters (a preset) set, else its default.
-  auto controller_values = [&](const ParamInfo& ctl) {
+  auto controller_values = [&](const ParamDef& ctl) {
     std::vector<Cell> vs = explicit_values(ctl.name);
     if (vs.empty())
-      for (const ParamInfo& lead : d.infos)
+      for (const ParamDef& lead : d.infos)
         if (lead.leading)
           for (const Cell& v : explicit_values(lead.name)) {
             RunSpec r = defaults;
@@ -175,8 +175,8 @@ void Parser::reject_ineffective_axes(const BlockDraft& d) {
     return vs;
   };
   for (const auto& a : d.drafts) {
-    const ParamInfo* p = d.info_of(a.axis.name);
-    const ParamInfo* ctl = p && !p->effect.always() ? d.info_of(p->effect.controller) : nullptr;
+    const ParamDef* p = d.info_of(a.axis.name);
+    const ParamDef* ctl = p && !p->effect.always() ? d.info_of(p->effect.controller) : nullptr;
     if (!ctl) continue;
     for (const Cell& c : controller_values(*ctl)) {
       const std::string& v = std::get<std::string>(c);

@@ -12,8 +12,8 @@ namespace ks::study_parse {
 namespace {
 
 /// What the block inherits from the study, for its problem family.
-BlockContext block_context(const Study& s, bool scara) {
-  BlockContext ctx;
+KindContext block_context(const Study& s, bool scara) {
+  KindContext ctx;
   ctx.path_vertices = s.task.vertices.size();
   ctx.integrator = s.task.integrator;
   ctx.dt = s.task.dt;
@@ -24,7 +24,7 @@ BlockContext block_context(const Study& s, bool scara) {
 
 }  // namespace
 
-const ParamInfo* BlockDraft::info_of(std::string_view n) const {
+const ParamDef* BlockDraft::info_of(std::string_view n) const {
   for (const auto& i : infos)
     if (i.name == n) return &i;
   return nullptr;
@@ -201,7 +201,7 @@ void Parser::read_fixed_params(BlockDraft& d) {
       }
       continue;
     }
-    const ParamInfo* info = d.info_of(key);
+    const ParamDef* info = d.info_of(key);
     if (!info) continue;
     if (d.axis_names.count(key)) {
       note(error(*k, "'" + key + "' is both a fixed parameter and an axis; expected one or the other"),

@@ -152,7 +152,7 @@ void Parser::parse_optimizations(const toml::table& root, Study& s) {
         if (key == "vertex_alpha" && kind == BlockKind::trajectory)
           for (std::size_t v = 2; v <= nverts; ++v) params.push_back("vertex_alpha_" + std::to_string(v));
         else params.push_back(key);
-        const ParamInfo* info = nullptr;
+        const ParamDef* info = nullptr;
         for (const auto& in : infos)
           if (in.name == params.front()) info = &in;
         if (!info) {
@@ -181,7 +181,7 @@ void Parser::parse_optimizations(const toml::table& root, Study& s) {
           for (std::uint64_t r = 0; r < block->run_count(); ++r) {
             const RunSpec run = block->run(r);
             if (has_effect(*info, infos, run)) continue;
-            const ParamInfo* ctl = find_param(infos, info->effect.controller);
+            const ParamDef* ctl = find_param(infos, info->effect.controller);
             error(*k, "variable '" + key + "' has no effect when " + ctl->name + " = '" +
                           std::get<std::string>(ctl->get(run)) + "'; expected it " + info->effect.str());
             bad = true;

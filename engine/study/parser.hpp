@@ -47,8 +47,8 @@ struct BlockDraft {
   BlockKind kind{};
   std::string kname, other_kname, a_kind, a_other;
   std::size_t nverts = 0;                // the task's path vertices
-  std::vector<ParamInfo> infos;          // the kind's parameters (SCARA units until the IK family is known)
-  std::vector<ParamInfo> other;          // the other kind's parameters
+  std::vector<ParamDef> infos;          // the kind's parameters (SCARA units until the IK family is known)
+  std::vector<ParamDef> other;          // the other kind's parameters
   std::vector<std::string> param_names;  // the kind's parameter names
   const toml::table* axes_t = nullptr;   // [block.axes], when it is a table
   std::set<std::string> axis_names;
@@ -58,10 +58,10 @@ struct BlockDraft {
   std::optional<std::uint64_t> lhs_count, lhs_seed;
   std::vector<AxisDraft> drafts;         // the axes read so far
   std::vector<std::string> lhs_group;    // the LHS axes, once drawn
-  BlockContext ctx;
+  KindContext ctx;
 
   /// The kind's parameter named `n`, or nullptr.
-  const ParamInfo* info_of(std::string_view n) const;
+  const ParamDef* info_of(std::string_view n) const;
   /// True for a parameter of the other kind (and vertex_alpha in an IK block).
   bool belongs_to_other(std::string_view n) const;
 };
@@ -124,12 +124,12 @@ class Parser : public ParserCore {
 
   // axes.cpp
   /// One axis of [block.axes] (its values in stored units; LHS axes get their values later).
-  std::optional<AxisDraft> parse_axis(const ParamInfo& info, const toml::key& key, const toml::node& node,
+  std::optional<AxisDraft> parse_axis(const ParamDef& info, const toml::key& key, const toml::node& node,
                                       const toml::node* lhs_node);
   /// A parameter value from a node: type + choices + unit conversion + domain. nullopt on error.
-  std::optional<Cell> param_value(const ParamInfo& info, const toml::node& n);
+  std::optional<Cell> param_value(const ParamDef& info, const toml::node& n);
   /// Check a stored numeric value's domain (expects file units for messages). Empty when fine.
-  std::string domain_problem(const ParamInfo& info, double file_value);
+  std::string domain_problem(const ParamDef& info, double file_value);
   /// A count >= 1 and at most max_runs, and from <= to (random and linspace axes); false after reporting.
   bool count_and_interval_ok(const std::string& what, std::int64_t count, const toml::node& count_node, double from,
                              double to, const toml::node& at);

@@ -44,7 +44,7 @@ std::string suggest(std::string_view word, const std::vector<std::string>& candi
 }
 
 std::string suggest_either(std::string_view word, const std::vector<std::string>& mine,
-                           const std::vector<ParamInfo>& other, const std::string& other_kind) {
+                           const std::vector<ParamDef>& other, const std::string& other_kind) {
   if (auto s = suggest(word, mine); !s.empty()) return s;
   std::vector<std::string> names;
   for (const auto& i : other) names.push_back(i.name);

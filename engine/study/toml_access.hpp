@@ -34,7 +34,7 @@ std::string lower(std::string_view s);
 std::string suggest(std::string_view word, const std::vector<std::string>& candidates);
 /// A suggestion among `mine`, else among the other kind's parameters (saying so).
 std::string suggest_either(std::string_view word, const std::vector<std::string>& mine,
-                           const std::vector<ParamInfo>& other, const std::string& other_kind);
+                           const std::vector<ParamDef>& other, const std::string& other_kind);
 
 std::string join(const std::vector<std::string>& v, std::string_view sep = ", ");
 std::vector<std::string> to_strings(std::span<const std::string_view> v);
