@@ -162,7 +162,7 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
     const double nan = std::numeric_limits<double>::quiet_NaN();
     out.E = out.E_M = out.min_manipulability = out.torque_sq_integral = out.power_sq_integral = nan;
     out.max_tracking_error = out.final_alpha = nan;
-    out.tau_inf.setConstant(nan);
+    out.tau_inf.setConstant(3, nan);
     return out;
   }
   Vec3 q = *q0, qd = Vec3::Zero();
@@ -258,7 +258,7 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
   if (done > 0) {
     out.E = roots.sumE / static_cast<double>(done);
     out.E_M = roots.sumEM / static_cast<double>(done);
-    out.tau_inf = Vec3(inf0, inf1, inf2);
+    out.tau_inf = Vec3(inf0, inf1, inf2);  // VecN of size 3: no allocation
     out.min_manipulability = std::sqrt(min_w2);
     out.torque_sq_integral = dt * (f5 - 0.5 * (first5 + last5));
     out.power_sq_integral = dt * (f6 - 0.5 * (first6 + last6));

@@ -8,6 +8,7 @@
 
 #include "common/domain.hpp"
 #include "model/arm.hpp"
+#include "model/chain.hpp"
 #include "model/kinematics.hpp"
 #include "task/quintic_path.hpp"
 #include "task/sampled_path.hpp"
@@ -73,7 +74,7 @@ struct TrajectoryMetrics {
   std::size_t samples = 0;            ///< samples computed (2001 for the seed's square at dt = 1 ms)
   double E = 0.0;                     ///< mean over samples of sqrt(tau^T tau) [Nm]
   double E_M = 0.0;                   ///< mean over samples of sqrt(tau^T M^-1 tau) [Nm / sqrt(kg m^2)]
-  Vec3 tau_inf = Vec3::Zero();        ///< max over samples of |tau_i| [Nm]
+  VecN tau_inf = VecN::Zero(3);       ///< max over samples of |tau_i| [Nm] (one per joint)
   double min_manipulability = 0.0;    ///< min over samples of sqrt(det(J J^T)) [m^2]
   double torque_sq_integral = 0.0;    ///< trapezoidal integral of sum tau_i^2 [N^2 m^2 s]
   double power_sq_integral = 0.0;     ///< trapezoidal integral of sum (tau_i qd_i)^2 [W^2 s]
