@@ -205,7 +205,12 @@ int run_info(const InfoArgs& args) {
   const auto n_done = std::count(t.done.begin(), t.done.end(), std::uint8_t{1});
   os << "file        " << args.file << '\n';
   os << "study       " << m.study_name << (m.study_path.empty() ? "" : "  (source " + m.study_path + ")") << '\n';
-  os << "sha256      " << m.study_sha256 << "  (of the study file's text, stored in /study/text)\n";
+  if (m.robot_text.empty()) {
+    os << "sha256      " << m.study_sha256 << "  (of the study file's text, stored in /study/text)\n";
+  } else {
+    os << "robot       " << m.robot_path << "  (URDF, stored in /study/robot)\n";
+    os << "sha256      " << m.study_sha256 << "  (of the study file's text and the URDF's)\n";
+  }
   os << "engine      kinesweep " << m.engine_version << "; format " << m.format << " v" << m.format_version
      << "; created " << m.created << '\n';
   if (m.format_version < store::kFormatVersion)

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
+#include <set>
 
 #include "schema/params.hpp"
 
@@ -51,8 +52,22 @@ struct Listed {
 std::vector<Listed> listed() {
   KindContext planar;
   planar.scara = false;
-  return {{BlockKind::trajectory, "", {}}, {BlockKind::ik, "scara", {}}, {BlockKind::ik, "planar3r", planar}};
+  KindContext planar4;  // an n-link planar arm (here n = 4): q0_<i> and the per-joint metrics, one per joint
+  planar4.robot.chain = true;
+  planar4.robot.joints = 4;
+  planar4.scara = false;
+  KindContext spatial7 = planar4;  // a spatial URDF chain (here 7 revolute joints)
+  spatial7.robot.joints = 7;
+  spatial7.robot.planar = false;
+  spatial7.first_vertex = {0.5, 0.0, 0.5};
+  return {{BlockKind::trajectory, "", {}},
+          {BlockKind::ik, "scara", {}},
+          {BlockKind::ik, "planar3r", planar},
+          {BlockKind::trajectory, "chain_planar", planar4},
+          {BlockKind::ik, "chain_planar", planar4},
+          {BlockKind::ik, "chain_spatial", spatial7}};
 }
+bool is_chain(const Listed& l) { return l.context.robot.chain; }
 
 }  // namespace
 
@@ -67,7 +82,7 @@ void print_schema_markdown(std::ostream& os) {
           "|---|---|---|---|---|---|---|\n";
     std::vector<const Listed*> ctx;
     for (const Listed& l : all)
-      if (l.kind == kind) ctx.push_back(&l);
+      if (l.kind == kind && !is_chain(l)) ctx.push_back(&l);
     std::vector<std::vector<ParamDef>> tables;
     std::vector<RunSpec> defaults;
     for (const Listed* l : ctx) {
@@ -95,7 +110,33 @@ void print_schema_markdown(std::ostream& os) {
          << " | " << dflt << " | " << p.effect.str() << " | " << cell(p.description) << (p.leading ? " (applied first)" : "")
          << " |\n";
     }
-    os << "\nMetrics of `" << to_string(kind) << "` runs:\n\n| column | type | unit | in /landscapes | description |\n"
+    // the columns a chain robot adds (n-link planar arms, URDF robots), and those it has not
+    std::set<std::string> seed_names;
+    for (const auto& t : tables)
+      for (const ParamDef& p : t) seed_names.insert(p.name);
+    std::set<std::string> shown, chain_names;
+    os << "\nOn a chain robot (`[robot]` with n links or a URDF file; here a 4-link planar arm and a 7-joint spatial "
+          "arm) `"
+       << to_string(kind) << "` runs also have:\n\n| column | type | unit | default | has an effect | description |\n"
+       << "|---|---|---|---|---|---|\n";
+    for (const Listed& l : all) {
+      if (l.kind != kind || !is_chain(l)) continue;
+      const RunSpec d = default_run(kind, l.context);
+      for (const ParamDef& p : params(kind, l.context)) {
+        chain_names.insert(p.name);
+        if (seed_names.count(p.name) || !shown.insert(p.name).second) continue;
+        const std::string unit = p.file_unit_name() == p.unit ? (p.unit.empty() ? "-" : p.unit)
+                                                              : p.file_unit_name() + " / " + p.unit;
+        os << "| `" << p.name << "` | " << type_name(p.type) << " | " << unit << " | " << file_value(p, d) << " | "
+           << p.effect.str() << " | " << cell(p.description) << " |\n";
+      }
+    }
+    std::string absent;
+    for (const std::string& n : seed_names)
+      if (!chain_names.count(n)) absent += (absent.empty() ? "" : ", ") + ("`" + n + "`");
+    if (!absent.empty()) os << "\nNot on chain robots: " << absent << ".\n";
+    os << "\nMetrics of `" << to_string(kind) << "` runs (per-joint metrics: one per joint of the robot, "
+          "as many as it has):\n\n| column | type | unit | in /landscapes | description |\n"
           "|---|---|---|---|---|\n";
     for (const MetricDef& m : metrics(kind))
       os << "| `" << m.name << "` | " << type_name(m.type) << " | " << (m.unit.empty() ? "-" : m.unit) << " | "

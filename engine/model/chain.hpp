@@ -8,6 +8,7 @@
 // along it). The body moved by joint i (every link rigidly attached to it, merged) has its mass
 // properties in joint i's frame. Units: m, kg, kg m^2, rad (revolute) or m (prismatic).
 #include <Eigen/Core>
+#include <initializer_list>
 #include <limits>
 #include <string>
 #include <vector>
@@ -22,6 +23,14 @@ using VecN = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJoints, 1>;        
 using MatN = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJoints, kMaxJoints>;  ///< joint x joint
 using Mat6N = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, kMaxJoints>;  ///< twist rows x joints
 using Vec6 = Eigen::Matrix<double, 6, 1>;                                   ///< (linear; angular)
+
+/// A joint vector from its values, e.g. joint_vector({0.1, 0.2, 0.3}).
+inline VecN joint_vector(std::initializer_list<double> v) {
+  VecN q(static_cast<Eigen::Index>(v.size()));
+  Eigen::Index i = 0;
+  for (double x : v) q[i++] = x;
+  return q;
+}
 
 /// A rigid transform: a point x in the child frame is R x + p in the parent frame.
 struct Frame {

@@ -1,10 +1,14 @@
 #include "runner/execute.hpp"
 
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <vector>
 
+#include "ik/chain_ik.hpp"
 #include "ik/solve.hpp"
+#include "methods/chain_trajectory.hpp"
 #include "methods/trajectory.hpp"
 
 namespace ks {
@@ -26,12 +30,30 @@ HistoryArray array_of(std::string name, std::string unit, const M& m, Eigen::Ind
 struct RunWorkspace::Impl {
   const StudyTask* task = nullptr;
   std::vector<SampledPath> paths;  // the study's path sampled at the last few dt asked for
+  std::vector<ChainTask> chain_tasks;  // the same for chains
   TrajectoryHistory history;
+  ChainHistory chain_history;
   ik::Summary<3, 3> s33;
   ik::Summary<3, 2> s32;
+  ik::ChainIkWorkspace chain_ik;
+  ik::ChainIkResult chain_result;
+  const ChainTask& chain_task_of(const StudyTask& t, TaskSpace space, double dt) {
+    if (task != &t) {
+      paths.clear();
+      chain_tasks.clear();
+      task = &t;
+    }
+    for (const ChainTask& c : chain_tasks)
+      if (c.path.dt() == dt && c.space == space) return c;
+    if (chain_tasks.size() == 8) chain_tasks.erase(chain_tasks.begin());
+    std::vector<Eigen::Vector3d> v;
+    for (std::size_t i = 0; i < t.vertices.size(); ++i) v.push_back(t.vertex(i));
+    return chain_tasks.emplace_back(space, Path3(std::move(v), t.durations), dt);
+  }
   const SampledPath& path_of(const StudyTask& t, double dt) {
     if (task != &t) {
       paths.clear();
+      chain_tasks.clear();
       task = &t;
     }
     for (const SampledPath& p : paths)  // a dt axis alternates between a few values: keep them all
@@ -45,7 +67,73 @@ RunWorkspace::~RunWorkspace() = default;
 
 namespace {
 
+/// The task space of a chain's path: planar or spatial, with or without the orientation.
+TaskSpace task_space(const Chain& chain, const StudyTask& task) {
+  if (chain.planar()) return task.orientation.empty() ? TaskSpace::planar_position : TaskSpace::planar_pose;
+  return task.hold_orientation ? TaskSpace::spatial_pose : TaskSpace::spatial_position;
+}
+
+/// The initial guess of a chain's start: the run's q0, or (NaN entries) the automatic guess: for
+/// planar chains planar_start_guess, for spatial ones mid-range of each limited joint, else 0.3 rad.
+VecN start_guess(const Chain& chain, const VecN& q0) {
+  if (q0.size() == chain.dof() && q0.allFinite()) return q0;
+  VecN g = chain.planar() ? planar_start_guess(chain.dof()) : VecN::Constant(chain.dof(), 0.3);
+  for (int j = 0; j < chain.dof(); ++j) {
+    const ChainJoint& c = chain.joints[j];
+    if (!chain.planar() && c.limited() && std::isfinite(c.lower) && std::isfinite(c.upper))
+      g[j] = c.type == JointType::prismatic ? 0.5 * (c.lower + c.upper) : std::clamp(0.3, c.lower, c.upper);
+    if (j < q0.size() && std::isfinite(q0[j])) g[j] = q0[j];
+  }
+  return g;
+}
+
+RunOutcome run_chain_trajectory(const Scenario& sc, const TrajectoryRun& run, int stride, RunWorkspace::Impl& ws) {
+  const Chain& chain = *sc.chain;
+  const TaskSpace space = task_space(chain, *sc.task);
+  const ChainTask& task = ws.chain_task_of(*sc.task, space, run.options.dt);
+  TrajectoryOptions o = run.options;
+  if (space == TaskSpace::planar_pose) {  // the path's orientation: alpha1A and the later vertices
+    o.alpha1A = sc.task->orientation.front();
+    o.vertex_alpha.assign(sc.task->orientation.begin() + 1, sc.task->orientation.end());
+  }
+  ChainHistory* h = nullptr;
+  if (stride > 0) {
+    ws.chain_history.stride = stride;
+    h = &ws.chain_history;
+  }
+  RunOutcome out;
+  out.result = simulate(chain, task, start_guess(chain, run.q0), o, h);
+  if (h && h->size > 0) {
+    const Eigen::Index n = h->size;
+    auto& a = out.history.arrays;
+    std::string q_unit, v_unit, a_unit, f_unit;
+    for (const ChainJoint& j : chain.joints) {
+      const bool p = j.type == JointType::prismatic;
+      const char* sep = q_unit.empty() ? "" : ", ";
+      q_unit += sep + std::string(p ? "m" : "rad");
+      v_unit += sep + std::string(p ? "m/s" : "rad/s");
+      a_unit += sep + std::string(p ? "m/s^2" : "rad/s^2");
+      f_unit += sep + std::string(p ? "N" : "Nm");
+    }
+    bool uniform = true;
+    for (const ChainJoint& j : chain.joints) uniform = uniform && j.type == chain.joints.front().type;
+    if (uniform) {  // one unit for every component
+      const bool p = chain.joints.front().type == JointType::prismatic;
+      q_unit = p ? "m" : "rad", v_unit = p ? "m/s" : "rad/s", a_unit = p ? "m/s^2" : "rad/s^2", f_unit = p ? "N" : "Nm";
+    }
+    a.push_back({"t", "s", static_cast<std::size_t>(n), 1, std::vector<double>(h->t.data(), h->t.data() + n)});
+    a.push_back(array_of("q", q_unit, h->q, n));
+    a.push_back(array_of("qd", v_unit, h->qd, n));
+    a.push_back(array_of("qdd", a_unit, h->qdd, n));
+    a.push_back(array_of("tau", f_unit, h->tau, n));
+    a.push_back(array_of("x", "m", h->x, n));
+    a.push_back({"alpha", "rad", static_cast<std::size_t>(n), 1, std::vector<double>(h->alpha.data(), h->alpha.data() + n)});
+  }
+  return out;
+}
+
 RunOutcome run_trajectory(const Scenario& sc, const TrajectoryRun& run, int stride, RunWorkspace::Impl& ws) {
+  if (sc.chain) return run_chain_trajectory(sc, run, stride, ws);
   PlanarArm3 arm = *sc.robot;
   arm.inertia_form = run.inertia;
   const SampledPath& path = ws.path_of(*sc.task, run.options.dt);
@@ -71,9 +159,9 @@ RunOutcome run_trajectory(const Scenario& sc, const TrajectoryRun& run, int stri
 }
 
 template <class P, int M>
-RunOutcome solve_ik(const P& problem, const Vec3& q0, const ik::Options& o, int stride, ik::Summary<3, M>& s,
+RunOutcome solve_ik(const P& problem, const VecN& q0, const ik::Options& o, int stride, ik::Summary<3, M>& s,
                     const char* q3_unit) {
-  ik::solve(problem, q0, o, s);
+  ik::solve(problem, Vec3(q0.head<3>()), o, s);
   RunOutcome out;
   out.result = IkResult{s.status, s.iterations, s.rejected, s.solution, s.error, s.min_rcond, s.q};
   if (stride > 0 && s.history.size() > 0) {
@@ -97,10 +185,58 @@ RunOutcome solve_ik(const P& problem, const Vec3& q0, const ik::Options& o, int 
   return out;
 }
 
+/// Rotation R = Rz(yaw) Ry(pitch) Rx(roll) [rad].
+Eigen::Matrix3d rotation_rpy(const Eigen::Vector3d& rpy) {
+  return (Eigen::AngleAxisd(rpy[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(rpy[1], Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(rpy[0], Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+RunOutcome run_chain_ik(const Scenario& sc, const IkRun& run, const ik::Options& o, int stride,
+                        RunWorkspace::Impl& ws) {
+  const Chain& chain = *sc.ik_chain;
+  ik::ChainIkTask task;
+  const bool pose = run.problem == IkProblem::pose;
+  task.kind = chain.planar() ? (pose ? ik::ChainIkTask::Kind::planar_pose : ik::ChainIkTask::Kind::planar_position)
+                             : (pose ? ik::ChainIkTask::Kind::spatial_pose : ik::ChainIkTask::Kind::spatial_position);
+  task.position = chain.planar() ? Eigen::Vector3d(run.target[0], run.target[1], 0.0) : Eigen::Vector3d(run.target);
+  task.alpha = run.target_alpha;
+  task.rotation = rotation_rpy(run.target_rpy);
+  ik::ChainIkResult& r = ws.chain_result;
+  ik::solve_chain(chain, task, run.q0, o, r, ws.chain_ik);
+  RunOutcome out;
+  out.result = IkResult{r.status, r.iterations, r.rejected, -1, r.error, r.min_rcond, r.q};
+  if (stride > 0 && r.history.size() > 0) {
+    const std::size_t n = r.history.size(), nq = static_cast<std::size_t>(chain.dof());
+    const std::size_t m = static_cast<std::size_t>(ik::residual_count(task.kind));
+    std::vector<std::size_t> rows;
+    for (std::size_t k = 0; k < n; k += stride) rows.push_back(k);
+    if (rows.back() != n - 1) rows.push_back(n - 1);
+    std::string q_unit;
+    for (const ChainJoint& j : chain.joints) q_unit += (q_unit.empty() ? "" : ", ") + std::string(j.type == JointType::prismatic ? "m" : "rad");
+    const char* f_unit = pose ? "m, rad" : "m";
+    HistoryArray k{"k", "", rows.size(), 1, {}}, q{"q", q_unit, rows.size(), nq, {}}, F{"F", f_unit, rows.size(), m, {}},
+        e{"norm_F", f_unit, rows.size(), 1, {}}, st{"step", q_unit, rows.size(), 1, {}}, l{"lambda", "", rows.size(), 1, {}};
+    for (std::size_t row : rows) {
+      k.data.push_back(static_cast<double>(row));
+      for (std::size_t j = 0; j < nq; ++j) q.data.push_back(r.history.q[row][j]);
+      for (std::size_t j = 0; j < m; ++j) F.data.push_back(r.history.F[row][j]);
+      e.data.push_back(r.history.error[row]);
+      st.data.push_back(r.history.step[row]);
+      l.data.push_back(r.history.lambda[row]);
+    }
+    out.history.arrays = {std::move(k), std::move(q), std::move(F), std::move(e), std::move(st), std::move(l)};
+  }
+  return out;
+}
+
 RunOutcome run_ik(const Scenario& sc, const IkRun& run, int stride, RunWorkspace::Impl& ws) {
   ik::Options o = run.options;
   o.keep_history = stride > 0;
   switch (run.problem) {
+    case IkProblem::position:
+    case IkProblem::pose:
+      return run_chain_ik(sc, run, o, stride, ws);
     case IkProblem::scara: {
       ik::ScaraPosition s;
       s.target = run.target;

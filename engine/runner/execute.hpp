@@ -11,9 +11,13 @@ namespace ks {
 
 /// The constants a run executes against: the study's robot and task (not copied).
 struct Scenario {
-  const PlanarArm3* robot = nullptr;
+  const PlanarArm3* robot = nullptr;  ///< the seed's closed-form 3R (trajectory runs when chain is null)
   const StudyTask* task = nullptr;
-  static Scenario of(const Study& s) { return {&s.robot, &s.task}; }
+  const Chain* chain = nullptr;       ///< the study's chain robot; null: the closed-form 3R
+  const Chain* ik_chain = nullptr;    ///< the chain of the position / pose IK problems (chain, or the 3R as one)
+  static Scenario of(const Study& s) {
+    return {&s.robot, &s.task, s.chain.get(), s.arm_chain ? s.arm_chain.get() : s.chain.get()};
+  }
 };
 
 /// Per-thread buffers reused from run to run (no allocation per time step or iteration).

@@ -16,7 +16,7 @@ double number(const Cell& c) {
 
 LandscapeGrid::LandscapeGrid(const Block& block) : block_(block) {
   // The good-status grid (ok / converged), the metrics marked gridded, the status code.
-  const auto& ms = metrics(block.kind());
+  const auto& ms = block.metrics();
   names_.emplace_back(statuses(block.kind()).front());
   sources_.push_back(Source::is_ok);
   metric_index_.push_back(ms.size());
@@ -75,7 +75,7 @@ store::LandscapeSpec LandscapeGrid::spec() const {
     if (!labels.empty()) a.unit = "labels:" + labels;
     s.axes.push_back(std::move(a));
   }
-  const auto& ms = metrics(block_.kind());
+  const auto& ms = block_.metrics();
   for (std::size_t m = 0; m < names_.size(); ++m) {
     store::LandscapeMetric lm;
     lm.name = names_[m];

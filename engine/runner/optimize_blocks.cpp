@@ -143,7 +143,7 @@ std::shared_ptr<Evaluator> make_evaluator(const Study& study, std::size_t index,
     e->vars.push_back(p);
     if (p->file_unit == FileUnit::deg && e->kind == BlockKind::trajectory) e->reach_varies = true;
   }
-  const auto& ms = metrics(e->kind);
+  const auto& ms = block.metrics();
   auto metric = [&](std::string_view n) -> const MetricDef* {
     for (const MetricDef& m : ms)
       if (m.name == n) return &m;
@@ -357,7 +357,7 @@ OptimizeResult run_optimization(const Study& study, std::size_t index, const Opt
   if (!s.best_x.empty()) {
     RunOutcome o;
     e->run_value(0, s.best_x, 1, &o);
-    for (const MetricDef& m : metrics(e->kind)) r.best_metrics.emplace_back(m.name, cell_num(m.get(o)));
+    for (const MetricDef& m : e->block->metrics()) r.best_metrics.emplace_back(m.name, cell_num(m.get(o)));
     r.history = std::move(o.history);
   }
   // A seed row: the thesis' optimum and figures, and this objective at the thesis' printed point.

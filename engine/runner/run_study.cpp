@@ -18,6 +18,8 @@ store::StoreMeta store_meta(const Study& study) {
   meta.study_path = study.file;
   meta.study_text = study.text;
   meta.study_sha256 = study.sha256;
+  meta.robot_path = study.robot_file;
+  meta.robot_text = study.robot_text;
   return meta;
 }
 

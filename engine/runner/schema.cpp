@@ -43,7 +43,7 @@ StudySchema make_schema(const Study& study) {
   }
   for (const Block& b : study.blocks) {
     std::vector<std::size_t> mc;
-    for (const MetricDef& m : metrics(b.kind())) mc.push_back(add(c, m.column(b.kind())));
+    for (const MetricDef& m : b.metrics()) mc.push_back(add(c, m.column(b.kind())));
     s.metric_column.push_back(std::move(mc));
   }
   s.status = add(c, status_column());
@@ -59,7 +59,7 @@ Record StudySchema::row(std::uint64_t id, std::size_t bi, const Block& b, const 
   r.cells[block] = b.name();
   const auto& table = b.table();
   for (std::size_t i = 0; i < table.size(); ++i) r.cells[param_column[bi][i]] = table[i].get(run);
-  const auto& ms = metrics(b.kind());
+  const auto& ms = b.metrics();
   for (std::size_t j = 0; j < ms.size(); ++j) r.cells[metric_column[bi][j]] = ms[j].get(o);
   r.cells[status] = std::string(o.status());
   r.cells[wall_time] = wall;

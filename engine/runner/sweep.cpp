@@ -56,7 +56,7 @@ class Accumulator {
       report_.blocks.push_back(std::move(r));
     }
     auto metric = [&](std::size_t b, std::string_view name) {
-      const auto& ms = metrics(study.blocks[b].kind());
+      const auto& ms = study.blocks[b].metrics();
       for (std::size_t j = 0; j < ms.size(); ++j)
         if (ms[j].name == name) return schema.metric_column[b][j];
       return std::size_t(0);

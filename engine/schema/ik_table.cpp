@@ -10,8 +10,19 @@ using Run = IkRun;
 IkRun IkRun::planar_defaults() {
   IkRun r;
   r.problem = IkProblem::planar3r_pose;
-  r.q0 = {0.0, 90.0 * kDeg, -90.0 * kDeg};
+  r.q0 = joint_vector({0.0, 90.0 * kDeg, -90.0 * kDeg});
   r.target = {1.5, 1.5, std::numeric_limits<double>::quiet_NaN()};
+  r.target_alpha = 0.0;
+  r.z_mode = ZMode::unset;
+  return r;
+}
+
+IkRun IkRun::chain_defaults(const std::vector<bool>& prismatic, int joints, const Eigen::Vector3d& target) {
+  IkRun r;
+  r.problem = IkProblem::position;
+  r.q0 = VecN::Zero(joints);
+  for (int j = 0; j < joints; ++j) r.q0[j] = j < int(prismatic.size()) && prismatic[j] ? 0.0 : 30.0 * kDeg;
+  r.target = target;
   r.target_alpha = 0.0;
   r.z_mode = ZMode::unset;
   return r;
@@ -19,16 +30,18 @@ IkRun IkRun::planar_defaults() {
 
 std::vector<ParamDef> ik_params(const KindContext& ctx) {
   using ik::Method;
+  const RobotShape& robot = ctx.robot;
   const std::string len = ctx.scara ? "mm" : "m";
-  const FileUnit q3_file = ctx.scara ? FileUnit::none : FileUnit::deg;
   std::vector<std::string> iterative;  // every method but analytic: the start matters
   for (Method m : {Method::newton, Method::lm, Method::lm_adaptive, Method::halley_thesis, Method::halley})
     iterative.emplace_back(ik::to_string(m));
   const EffectRule from_start{"method", iterative};
   std::vector<ParamDef> t;
-  t.push_back(named<Run>("problem", names_of<IkProblem>(IkProblem::scara, IkProblem::planar3r_pose,
-                                                         IkProblem::planar3r_position),
-                         "IK problem", [](auto& r) -> auto& { return r.problem; }));
+  const std::vector<std::string> problems =
+      robot.chain ? names_of<IkProblem>(IkProblem::scara, IkProblem::position, IkProblem::pose)
+                  : names_of<IkProblem>(IkProblem::scara, IkProblem::planar3r_pose, IkProblem::planar3r_position,
+                                        IkProblem::position, IkProblem::pose);
+  t.push_back(named<Run>("problem", problems, "IK problem", [](auto& r) -> auto& { return r.problem; }));
   t.push_back(named<Run>("method",
                          names_of<Method>(Method::newton, Method::lm, Method::lm_adaptive, Method::halley_thesis,
                                           Method::halley, Method::analytic),
@@ -36,21 +49,36 @@ std::vector<ParamDef> ik_params(const KindContext& ctx) {
   t.push_back(real<Run>("lambda", FileUnit::none, "", ik::Options::lambda_rule,
                         "Levenberg-Marquardt damping (lm, lm_adaptive)", [](auto& r) -> auto& { return r.options.lambda; },
                         EffectRule{"method", {"lm", "lm_adaptive"}}));
-  t.push_back(real<Run>("q0_1", FileUnit::deg, "rad", Domain::any(), "initial guess, joint 1",
-                        [](auto& r) -> auto& { return r.q0[0]; }, from_start));
-  t.push_back(real<Run>("q0_2", FileUnit::deg, "rad", Domain::any(), "initial guess, joint 2",
-                        [](auto& r) -> auto& { return r.q0[1]; }, from_start));
-  t.push_back(real<Run>("q0_3", q3_file, ctx.scara ? "mm" : "rad", Domain::any(),
-                        "initial guess, joint 3 (SCARA: prismatic d)", [](auto& r) -> auto& { return r.q0[2]; },
-                        from_start));
+  const int n = ctx.scara ? 3 : robot.joints;
+  for (int j = 0; j < n; ++j) {
+    const std::string i = std::to_string(j + 1);
+    const bool mm = ctx.scara && j == 2, metres = !ctx.scara && robot.is_prismatic(j);
+    std::string what = "initial guess, joint " + i;
+    if (j == 2 && !robot.chain) what += " (SCARA: prismatic d)";
+    t.push_back(real<Run>("q0_" + i, mm || metres ? FileUnit::none : FileUnit::deg, mm ? "mm" : metres ? "m" : "rad",
+                          Domain::any(), what, [j](auto& r) -> auto& { return r.q0[j]; }, from_start));
+  }
+  std::vector<std::string> with_z{"scara"}, with_alpha{"planar3r_pose"};
+  if (robot.planar) with_alpha.push_back("pose");
+  else with_z.insert(with_z.end(), {"position", "pose"});
   t.push_back(real<Run>("target_x", FileUnit::none, len, Domain::any(), "target x",
                         [](auto& r) -> auto& { return r.target[0]; }));
   t.push_back(real<Run>("target_y", FileUnit::none, len, Domain::any(), "target y",
                         [](auto& r) -> auto& { return r.target[1]; }));
-  t.push_back(real<Run>("target_z", FileUnit::none, len, Domain::any(), "target z (SCARA)",
-                        [](auto& r) -> auto& { return r.target[2]; }, EffectRule{"problem", {"scara"}}));
-  t.push_back(real<Run>("target_alpha", FileUnit::deg, "rad", Domain::any(), "target orientation (planar3r_pose)",
-                        [](auto& r) -> auto& { return r.target_alpha; }, EffectRule{"problem", {"planar3r_pose"}}));
+  t.push_back(real<Run>("target_z", FileUnit::none, len, Domain::any(),
+                        robot.planar ? "target z (SCARA)" : "target z (SCARA, spatial chains)",
+                        [](auto& r) -> auto& { return r.target[2]; }, EffectRule{"problem", with_z}));
+  t.push_back(real<Run>("target_alpha", FileUnit::deg, "rad", Domain::any(),
+                        robot.planar ? "target orientation (planar3r_pose, pose)" : "target orientation (planar3r_pose)",
+                        [](auto& r) -> auto& { return r.target_alpha; }, EffectRule{"problem", with_alpha}));
+  if (!robot.planar) {
+    const char* axis[3] = {"roll (about x)", "pitch (about y)", "yaw (about z)"};
+    const char* name[3] = {"target_roll", "target_pitch", "target_yaw"};
+    for (int a = 0; a < 3; ++a)
+      t.push_back(real<Run>(name[a], FileUnit::deg, "rad", Domain::any(),
+                            std::string("target orientation, ") + axis[a] + "; R = Rz(yaw) Ry(pitch) Rx(roll) (pose)",
+                            [a](auto& r) -> auto& { return r.target_rpy[a]; }, EffectRule{"problem", {"pose"}}));
+  }
   t.push_back(real<Run>("tol", FileUnit::none, ctx.scara ? "mm" : "", ik::Options::tolerance_rule,
                         "stop when the residual norm falls below this",
                         [](auto& r) -> auto& { return r.options.tolerance; }));
@@ -62,9 +90,9 @@ std::vector<ParamDef> ik_params(const KindContext& ctx) {
   return t;
 }
 
-const std::vector<MetricDef>& ik_metrics() {
+std::vector<MetricDef> ik_metrics(const KindContext& ctx) {
   using R = IkResult;
-  static const std::vector<MetricDef> m{
+  std::vector<MetricDef> m{
       metric<R>("iterations", CellType::i64, "", "updates made (the seed's count)", true,
                 [](const R& r) { return std::int64_t(r.iterations); }),
       metric<R>("error", CellType::f64, "problem units", "||F|| at the final iterate (mm for scara, m/rad for planar3r)",
@@ -75,11 +103,16 @@ const std::vector<MetricDef>& ik_metrics() {
                 [](const R& r) { return std::int64_t(r.rejected); }),
       metric<R>("min_rcond", CellType::f64, "", "smallest reciprocal condition number met", false,
                 [](const R& r) { return r.min_rcond; }),
-      metric<R>("q_final_1", CellType::f64, "rad", "final iterate, joint 1", false, [](const R& r) { return r.q[0]; }),
-      metric<R>("q_final_2", CellType::f64, "rad", "final iterate, joint 2", false, [](const R& r) { return r.q[1]; }),
-      metric<R>("q_final_3", CellType::f64, "rad or mm", "final iterate, joint 3 (scara: d in mm)", false,
-                [](const R& r) { return r.q[2]; }),
   };
+  const int n = ctx.scara ? 3 : ctx.robot.joints;
+  for (int j = 0; j < n; ++j) {
+    const std::string i = std::to_string(j + 1);
+    std::string unit = ctx.robot.is_prismatic(j) ? "m" : "rad", what = "final iterate, joint " + i;
+    if (j == 2 && !ctx.robot.chain) unit = "rad or mm", what += " (scara: d in mm)";
+    m.push_back(metric<R>("q_final_" + i, CellType::f64, unit, what, false, [j](const R& r) {
+      return j < r.q.size() ? r.q[j] : std::numeric_limits<double>::quiet_NaN();
+    }));
+  }
   return m;
 }
 

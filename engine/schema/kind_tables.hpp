@@ -4,7 +4,7 @@
 
 namespace ks {
 std::vector<ParamDef> trajectory_params(const KindContext& context);
-const std::vector<MetricDef>& trajectory_metrics();
+std::vector<MetricDef> trajectory_metrics(const KindContext& context);
 std::vector<ParamDef> ik_params(const KindContext& context);
-const std::vector<MetricDef>& ik_metrics();
+std::vector<MetricDef> ik_metrics(const KindContext& context);
 }  // namespace ks

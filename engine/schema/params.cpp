@@ -12,9 +12,11 @@ namespace {
 constexpr NameTable<BlockKind, 2> kKinds{{{BlockKind::trajectory, "trajectory"}, {BlockKind::ik, "ik"}}};
 constexpr NameTable<InertiaForm, 2> kInertia{{{InertiaForm::physical, "physical"},
                                               {InertiaForm::thesis_m11, "thesis_m11"}}};
-constexpr NameTable<IkProblem, 3> kProblems{{{IkProblem::scara, "scara"},
+constexpr NameTable<IkProblem, 5> kProblems{{{IkProblem::scara, "scara"},
                                              {IkProblem::planar3r_pose, "planar3r_pose"},
-                                             {IkProblem::planar3r_position, "planar3r_position"}}};
+                                             {IkProblem::planar3r_position, "planar3r_position"},
+                                             {IkProblem::position, "position"},
+                                             {IkProblem::pose, "pose"}}};
 constexpr NameTable<ZMode, 3> kZModes{{{ZMode::unset, ""}, {ZMode::thesis, "thesis"}, {ZMode::physical, "physical"}}};
 constexpr std::array<BlockKind, 2> kKindList{BlockKind::trajectory, BlockKind::ik};
 }  // namespace
@@ -71,8 +73,8 @@ const ParamDef* find_param(const std::vector<ParamDef>& table, std::string_view 
     if (p.name == name) return &p;
   return nullptr;
 }
-const std::vector<MetricDef>& metrics(BlockKind kind) {
-  return kind == BlockKind::trajectory ? trajectory_metrics() : ik_metrics();
+std::vector<MetricDef> metrics(BlockKind kind, const KindContext& context) {
+  return kind == BlockKind::trajectory ? trajectory_metrics(context) : ik_metrics(context);
 }
 std::span<const std::string_view> statuses(BlockKind kind) {
   using ik::Status;
@@ -87,8 +89,14 @@ std::span<const std::string_view> statuses(BlockKind kind) {
 }
 
 RunSpec default_run(BlockKind kind, const KindContext& c) {
-  if (kind == BlockKind::ik) return c.scara ? IkRun{} : IkRun::planar_defaults();
+  if (kind == BlockKind::ik) {
+    if (c.scara) return IkRun{};
+    if (c.robot.chain) return IkRun::chain_defaults(c.robot.prismatic, c.robot.joints, c.first_vertex);
+    return IkRun::planar_defaults();
+  }
   TrajectoryRun r;
+  // chains: NaN asks for the automatic initial guess of the start (see simulate_chain)
+  r.q0.setConstant(c.robot.joints, std::numeric_limits<double>::quiet_NaN());
   r.options.integrator = c.integrator;
   r.options.dt = c.dt;
   r.options.vertex_alpha.assign(c.path_vertices >= 1 ? c.path_vertices - 1 : 0, 0.0);

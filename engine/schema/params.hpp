@@ -21,6 +21,18 @@ namespace ks {
 /// How a study file writes a value: as stored, or in degrees (stored in radians).
 enum class FileUnit { none, deg };
 
+/// What the tables need to know of the study's robot: its joints and whether it is a chain.
+struct RobotShape {
+  int joints = 3;                  ///< n: the q0_i and per-joint metric columns
+  std::vector<bool> prismatic;     ///< per joint (empty: all revolute): q0_i in m instead of deg
+  bool chain = false;              ///< a generic chain (n-link planar, URDF); false: the seed's closed-form 3R
+  bool planar = true;              ///< the tip moves in the xy plane (orientation: one angle alpha)
+  bool pose_task = false;          ///< the path prescribes the tip's orientation too ([task] orientation)
+  bool is_prismatic(int j) const { return j < static_cast<int>(prismatic.size()) && prismatic[j]; }
+  /// vertex_alpha (the seed's non-redundant baseline) is defined: a planar 3-joint arm, position path.
+  bool vertex_alpha() const { return planar && joints == 3 && !pose_task; }
+};
+
 /// What a block's tables depend on: its path and the study-wide defaults of [task] and [robot].
 struct KindContext {
   std::size_t path_vertices = 5;                       ///< vertices of the path (the square: 5)
@@ -28,6 +40,8 @@ struct KindContext {
   double dt = TrajectoryOptions{}.dt;                  ///< [task] dt [s]
   InertiaForm inertia = TrajectoryRun{}.inertia;       ///< [robot] inertia
   bool scara = true;                                   ///< ik: the block's problem family (units, defaults)
+  RobotShape robot;                                    ///< [robot]
+  Eigen::Vector3d first_vertex{1.5, 1.5, 0.0};         ///< the path's first vertex [m] (chain IK's default target)
 };
 
 /// When a parameter has an effect: always (no controller), or only while another text parameter
@@ -82,8 +96,8 @@ std::span<const BlockKind> block_kinds();
 std::vector<ParamDef> params(BlockKind kind, const KindContext& context = {});
 /// The parameter named `name` in `table`, or nullptr.
 const ParamDef* find_param(const std::vector<ParamDef>& table, std::string_view name);
-/// The metrics of a kind, in /runs column order.
-const std::vector<MetricDef>& metrics(BlockKind kind);
+/// The metrics of a kind, in /runs column order (per-joint metrics: one per joint of context.robot).
+std::vector<MetricDef> metrics(BlockKind kind, const KindContext& context = {});
 /// The status names of a kind, in enum order (the first is the good one: ok / converged).
 std::span<const std::string_view> statuses(BlockKind kind);
 /// A run of the kind with every default (the typed structs' own, with the context's study defaults).

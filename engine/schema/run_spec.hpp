@@ -13,6 +13,7 @@
 #include "ik/solve.hpp"
 #include "methods/trajectory.hpp"
 #include "model/arm.hpp"
+#include "model/chain.hpp"
 #include "store/record.hpp"
 
 namespace ks {
@@ -28,11 +29,16 @@ bool parse(std::string_view name, InertiaForm& out);
 struct TrajectoryRun {
   std::string preset;                            ///< seed 000 Table 4 row ("" when none)
   TrajectoryOptions options;                     ///< method, k, alpha1A, K_N, vertex_alpha, integrator, dt, ...
-  InertiaForm inertia = InertiaForm::physical;   ///< closed form of M(q)
+  InertiaForm inertia = InertiaForm::physical;   ///< closed form of M(q) (the seed's 3R only)
+  /// Chains: the initial guess of the start configuration, placed on the first vertex by an IK
+  /// solve [rad or m per joint]. Unused by the seed's closed-form 3R (its start is analytic).
+  VecN q0 = VecN::Zero(3);
 };
 
 /// The IK problems of seed 001 (SCARA, lengths in mm) and the planar 3R arm (m, rad).
-enum class IkProblem { scara, planar3r_pose, planar3r_position };
+/// `position` and `pose` are the study robot's chain (any arm; the seed's 3R as a chain by default):
+/// tip position (x, y, or x, y, z), or position and orientation (alpha, or roll-pitch-yaw).
+enum class IkProblem { scara, planar3r_pose, planar3r_position, position, pose };
 std::string_view to_string(IkProblem p);
 bool parse(std::string_view name, IkProblem& out);
 /// The SCARA's z residual; `unset` for the planar problems (stored as "").
@@ -45,17 +51,23 @@ bool parse(std::string_view name, ZMode& out);
 struct IkRun {
   IkProblem problem = IkProblem::scara;
   ik::Options options;                    ///< method, lambda, tol, max_iter, ...
-  /// initial guess: theta1, theta2 [rad], then d [mm] (scara) or theta3 [rad]
-  Eigen::Vector3d q0{60.0 * kDeg, 45.0 * kDeg, 50.0};
+  /// initial guess: theta1, theta2 [rad], then d [mm] (scara) or theta3 [rad]; chains: one per joint
+  VecN q0 = joint_vector({60.0 * kDeg, 45.0 * kDeg, 50.0});
   /// target x, y, z [mm] (scara) or x, y [m] (planar; z unused: NaN)
   Eigen::Vector3d target{50.0, -80.0, 10.0};
-  double target_alpha = std::numeric_limits<double>::quiet_NaN();  ///< planar3r_pose: orientation [rad]
+  double target_alpha = std::numeric_limits<double>::quiet_NaN();  ///< planar pose: orientation [rad]
+  /// spatial pose: the tip orientation as roll, pitch, yaw about the base x, y, z axes (R = Rz Ry Rx) [rad]
+  Eigen::Vector3d target_rpy = Eigen::Vector3d::Zero();
   ZMode z_mode = ZMode::thesis;
 
   /// The defaults of the planar 3R problems (the seed arm reaching (1.5, 1.5) m, alpha 0, from
   /// (0, 90, -90) deg).
   static IkRun planar_defaults();
+  /// The defaults of the chain problems for a robot of `joints` joints: position of the tip at
+  /// `target` (the path's first vertex) from q0 = 30 deg at every revolute joint, 0 m at every prismatic one.
+  static IkRun chain_defaults(const std::vector<bool>& prismatic, int joints, const Eigen::Vector3d& target);
   bool scara() const { return problem == IkProblem::scara; }
+  bool chain() const { return problem == IkProblem::position || problem == IkProblem::pose; }
 };
 
 using RunSpec = std::variant<TrajectoryRun, IkRun>;
@@ -65,7 +77,7 @@ struct IkResult {
   ik::Status status = ik::Status::max_iter;
   int iterations = 0, rejected = 0, solution = -1;
   double error = 0.0, min_rcond = 1.0;
-  Eigen::Vector3d q = Eigen::Vector3d::Zero();
+  VecN q = VecN::Zero(3);  ///< final iterate (one per joint)
 };
 
 /// The outcome of one run: its metrics with an enum status, and its history (empty when off).

@@ -45,11 +45,13 @@ std::vector<ParamDef> trajectory_params(const KindContext& ctx) {
                          "redundancy resolution method", [](auto& r) -> auto& { return r.options.method; }));
   t.push_back(real<Run>("k", FileUnit::none, "", Domain::any(), "gravity weight in the resolution",
                         [](auto& r) -> auto& { return r.options.k; }, kLocalOnly));
-  t.push_back(real<Run>("alpha1A", FileUnit::deg, "rad", Domain::any(), "end-effector orientation at the start",
-                        [](auto& r) -> auto& { return r.options.alpha1A; }));
+  const RobotShape& robot = ctx.robot;
+  if (robot.planar && !robot.pose_task)
+    t.push_back(real<Run>("alpha1A", FileUnit::deg, "rad", Domain::any(), "end-effector orientation at the start",
+                          [](auto& r) -> auto& { return r.options.alpha1A; }));
   t.push_back(real<Run>("K_N", FileUnit::none, "1/s", TrajectoryOptions::null_damping_rule, "null-space damping",
                         [](auto& r) -> auto& { return r.options.null_damping; }, kLocalOnly));
-  for (std::size_t v = 2; v <= ctx.path_vertices; ++v) {
+  for (std::size_t v = 2; robot.vertex_alpha() && v <= ctx.path_vertices; ++v) {
     const std::size_t i = v - 2;
     t.push_back(real<Run>("vertex_alpha_" + std::to_string(v), FileUnit::deg, "rad", Domain::any(),
                           "orientation at vertex " + std::to_string(v) + " (vertex_alpha method)",
@@ -62,26 +64,29 @@ std::vector<ParamDef> trajectory_params(const KindContext& ctx) {
   t.push_back(real<Run>("torque_bound", FileUnit::none, "Nm", TrajectoryOptions::torque_bound_rule,
                         "|tau_i| above this stops the run (diverged)",
                         [](auto& r) -> auto& { return r.options.torque_bound; }));
-  t.push_back(named<Run>("inertia", names_of<InertiaForm>(InertiaForm::physical, InertiaForm::thesis_m11),
-                         "closed form of M(q)", [](auto& r) -> auto& { return r.inertia; }));
+  if (!robot.chain)
+    t.push_back(named<Run>("inertia", names_of<InertiaForm>(InertiaForm::physical, InertiaForm::thesis_m11),
+                           "closed form of M(q)", [](auto& r) -> auto& { return r.inertia; }));
+  for (int j = 0; robot.chain && j < robot.joints; ++j) {
+    const bool prismatic = robot.is_prismatic(j);
+    t.push_back(real<Run>("q0_" + std::to_string(j + 1), prismatic ? FileUnit::none : FileUnit::deg,
+                          prismatic ? "m" : "rad", Domain::any(),
+                          "initial guess of the start configuration, joint " + std::to_string(j + 1) +
+                              " (placed on the first vertex by an IK solve)",
+                          [j](auto& r) -> auto& { return r.q0[j]; }));
+  }
   return t;
 }
 
-const std::vector<MetricDef>& trajectory_metrics() {
+std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
   using M = TrajectoryMetrics;
-  static const std::vector<MetricDef> m{
+  std::vector<MetricDef> m{
       metric<M>("E", CellType::f64, "Nm", "mean over samples of sqrt(tau^T tau) (seed Eq. 60)", true,
                 [](const M& r) { return r.E; }),
       metric<M>("E_M", CellType::f64, "Nm/sqrt(kg m^2)", "mean over samples of sqrt(tau^T M^-1 tau)", true,
                 [](const M& r) { return r.E_M; }),
       metric<M>("tau_inf", CellType::f64, "Nm", "max over samples and joints of |tau_i|", true,
                 [](const M& r) { return r.tau_inf.maxCoeff(); }),
-      metric<M>("tau1_inf", CellType::f64, "Nm", "max over samples of |tau_1|", true,
-                [](const M& r) { return r.tau_inf[0]; }),
-      metric<M>("tau2_inf", CellType::f64, "Nm", "max over samples of |tau_2|", true,
-                [](const M& r) { return r.tau_inf[1]; }),
-      metric<M>("tau3_inf", CellType::f64, "Nm", "max over samples of |tau_3|", true,
-                [](const M& r) { return r.tau_inf[2]; }),
       metric<M>("min_manipulability", CellType::f64, "m^2", "min over samples of sqrt(det(J J^T))", true,
                 [](const M& r) { return r.min_manipulability; }),
       metric<M>("torque_sq_integral", CellType::f64, "N^2 m^2 s",
@@ -98,6 +103,16 @@ const std::vector<MetricDef>& trajectory_metrics() {
       metric<M>("stop_time", CellType::f64, "s", "time of the last sample computed", false,
                 [](const M& r) { return r.samples == 0 ? std::numeric_limits<double>::quiet_NaN() : r.stop_time; }),
   };
+  // per joint, after tau_inf: tau1_inf .. tau<n>_inf (N for a prismatic joint)
+  std::vector<MetricDef> joints;
+  for (int j = 0; j < ctx.robot.joints; ++j) {
+    const std::string i = std::to_string(j + 1);
+    joints.push_back(metric<M>("tau" + i + "_inf", CellType::f64, ctx.robot.is_prismatic(j) ? "N" : "Nm",
+                               "max over samples of |tau_" + i + "|", true, [j](const M& r) {
+                                 return j < r.tau_inf.size() ? r.tau_inf[j] : std::numeric_limits<double>::quiet_NaN();
+                               }));
+  }
+  m.insert(m.begin() + 3, joints.begin(), joints.end());
   return m;
 }
 

@@ -51,12 +51,13 @@ Block::Block(BlockSpec spec, const KindContext& context)
       if (a.name == "problem")
         for (const auto& v : a.values)
           if (std::holds_alternative<std::string>(v)) problems.push_back(std::get<std::string>(v));
-    context_.scara = problems.empty() || ik_problem_is_scara(problems.front());
+    if (!problems.empty()) context_.scara = ik_problem_is_scara(problems.front());
     for (const auto& p : problems)
       if (ik_problem_is_scara(p) != context_.scara)
         throw std::invalid_argument("block '" + name_ + "': problems mix scara and planar3r units");
   }
   table_ = ks::params(kind_, context_);
+  metrics_ = ks::metrics(kind_, context_);
   for (const ParamDef& p : table_) columns_.push_back(p.column(kind_));
   auto col_of = [&](const std::string& n) -> std::size_t {
     for (std::size_t i = 0; i < table_.size(); ++i)

@@ -69,6 +69,8 @@ class Block {
   /// The kind's parameter table for this block (units resolved for its context), columns() order.
   const std::vector<ParamDef>& table() const { return table_; }
   const KindContext& context() const { return context_; }
+  /// The kind's metrics for this block's robot (per-joint columns), /runs order.
+  const std::vector<MetricDef>& metrics() const { return metrics_; }
   /// Column of a parameter, or npos.
   std::size_t column_index(std::string_view param) const;
   const std::vector<Axis>& axes() const { return axes_; }
@@ -99,6 +101,7 @@ class Block {
   BlockKind kind_;
   KindContext context_;
   std::vector<ParamDef> table_;
+  std::vector<MetricDef> metrics_;
   std::vector<ColumnSpec> columns_;
   RunSpec defaults_;          // the kind's defaults in this context
   RunSpec base_;              // defaults_ with the fixed values applied (leading ones first)

@@ -46,6 +46,16 @@ struct ResultsReader::Impl {
       meta.study_text = p ? p : "";
       H5Dvlen_reclaim(t, s, H5P_DEFAULT, &p);
     }
+    if (H5Lexists(study, "robot", H5P_DEFAULT) > 0) {
+      Hid d(check(H5Dopen2(study, "robot", H5P_DEFAULT), path, "open /study/robot"));
+      Hid t(utf8_vlen_type());
+      Hid s(H5Dget_space(d));
+      char* p = nullptr;
+      check(H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, &p), path, "read /study/robot");
+      meta.robot_text = p ? p : "";
+      H5Dvlen_reclaim(t, s, H5P_DEFAULT, &p);
+      meta.robot_path = read_str_attr(d, "path");
+    }
     columns = read_run_columns(f, path, n_runs, meta.format_version >= 2);
     if (meta.format_version == 1 && v1_roles) v1_roles(columns);
     if (n_runs < 0) {

@@ -110,6 +110,15 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
     const char* p = meta.study_text.c_str();
     check(H5Dwrite(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, &p), path, "write /study/text");
   }
+  if (!meta.robot_text.empty()) {  // the URDF the runs used, so the file is complete without it
+    Hid type(utf8_vlen_type());
+    Hid space(H5Screate(H5S_SCALAR));
+    Hid d(check(H5Dcreate2(study, "robot", type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path,
+                "create /study/robot"));
+    const char* p = meta.robot_text.c_str();
+    check(H5Dwrite(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, &p), path, "write /study/robot");
+    write_str_attr(d, "path", meta.robot_path);
+  }
 
   Hid runs(check(H5Gcreate2(file, "runs", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /runs"));
   std::vector<std::string> names;

@@ -19,6 +19,8 @@ KindContext block_context(const Study& s, bool scara) {
   ctx.dt = s.task.dt;
   ctx.inertia = s.robot.inertia_form;
   ctx.scara = scara;
+  ctx.robot = s.robot_shape();
+  if (!s.task.vertices.empty()) ctx.first_vertex = s.task.vertices.front();
   return ctx;
 }
 
@@ -42,6 +44,8 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
   const std::size_t errors_before = diags_.size();
   BlockDraft d(b, optimize, (optimize ? "[[optimize]] #" : "[[block]] #") + std::to_string(index + 1));
   d.nverts = s.task.vertices.size();
+  d.scara = !s.chain;  // an IK block without a problem: the SCARA, or the study's chain's position problem
+  d.ctx = block_context(s, d.scara);
 
   read_block_name(d, names);
   if (!read_block_kind(d)) return std::nullopt;
@@ -55,6 +59,7 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
   read_zip_groups(d);
   if (!d.lhs_group.empty()) d.spec.groups.push_back(d.lhs_group);  // after the zip groups
   d.ctx = block_context(s, d.scara);
+  check_robot_supports(d, s);
   reject_ineffective_axes(d);
   return finish_block(d, errors_before);
 }
@@ -105,8 +110,8 @@ bool Parser::read_block_kind(BlockDraft& d) {
   d.other_kname = std::string(to_string(other_kind));
   d.a_kind = (kind == BlockKind::ik ? "an " : "a ") + d.kname;
   d.a_other = (kind == BlockKind::ik ? "a " : "an ") + d.other_kname;
-  d.infos = block_params(kind, d.nverts);  // SCARA units until the block's problem family is known
-  d.other = block_params(other_kind, d.nverts);
+  d.infos = params(kind, d.ctx);  // the default family's units until the block's problem family is known
+  d.other = params(other_kind, d.ctx);
   for (const auto& i : d.infos) d.param_names.push_back(i.name);
   return true;
 }
@@ -163,15 +168,16 @@ void Parser::read_ik_family(BlockDraft& d) {
     d.scara = ik_problem_is_scara(probs.front().first);
     for (const auto& [p, node] : probs)
       if (ik_problem_is_scara(p) != d.scara) {
-        note(error(*node, "problem '" + p + "' mixes the SCARA (mm) with the planar 3R (m, deg) problems in one "
-                          "block; expected separate blocks for scara and planar3r_* problems"),
+        note(error(*node, "problem '" + p + "' mixes the SCARA (mm) with the arm's (m, deg) problems in one "
+                          "block; expected separate blocks for scara and the other problems"),
              pos_of(probs.front().second->source()),
              "the block's first problem, '" + probs.front().first + "', is " +
-                 (d.scara ? "the SCARA problem (mm)" : "a planar 3R problem (m, deg)"));
+                 (d.scara ? "the SCARA problem (mm)" : "an arm problem (m, deg)"));
         break;
       }
   }
-  if (!d.scara) d.infos = block_params(d.kind, d.nverts, false);
+  d.ctx.scara = d.scara;
+  d.infos = params(d.kind, d.ctx);
 }
 
 void Parser::read_fixed_params(BlockDraft& d) {
@@ -260,6 +266,43 @@ void Parser::parse_blocks(const toml::table& root, Study& s) {
     if (!block->overflowed()) total += block->run_count();
     s.blocks.push_back(std::move(*block));
   }
+}
+
+void Parser::check_robot_supports(const BlockDraft& d, const Study& s) {
+  if (d.kind != BlockKind::trajectory || !s.chain) return;
+  const RobotShape& r = d.ctx.robot;
+  const int m = (r.planar ? 2 : 3) + (s.task.orientation.empty() ? 0 : 1) + (s.task.hold_orientation ? 3 : 0);
+  if (m >= r.joints) {
+    error(d.pos, d.label + " resolves redundancy, but the task has " + std::to_string(m) + " equations and the robot " +
+                     std::to_string(r.joints) + " joints (redundancy " + std::to_string(r.joints - m) +
+                     "); expected a robot with more joints than task equations, or a position task");
+    return;
+  }
+  if (r.vertex_alpha()) return;
+  // vertex_alpha: named by method (fixed or axis) or by a preset of cases 3-5
+  auto uses = [&](const std::string& name, const Cell& v) {
+    const std::string* t = std::get_if<std::string>(&v);
+    if (!t) return false;
+    if (name == "method") return *t == "vertex_alpha";
+    if (name == "preset")
+      if (const SeedCase* c = find_seed_case(*t)) return c->method == TrajectoryMethod::vertex_alpha;
+    return false;
+  };
+  const char* why = !r.planar ? "a spatial robot" : r.pose_task ? "an orientation path" : "a planar arm of more than 3 joints";
+  const std::string reason = std::string("vertex_alpha prescribes the tip angle at the vertices: the seed's "
+                                         "non-redundant baseline, defined for a planar 3-joint arm on a position path, "
+                                         "not for ") + why;
+  for (const auto& [name, v] : d.spec.fixed)
+    if (uses(name, v)) {
+      error(d.table.get(name)->source(), reason + "; expected local_weighted or local_unweighted");
+      return;
+    }
+  for (const AxisDraft& a : d.drafts)
+    for (const auto& v : a.axis.values)
+      if (uses(a.axis.name, v)) {
+        error(a.pos, reason + " (the " + a.axis.name + " axis includes it); expected local methods only");
+        return;
+      }
 }
 
 }  // namespace ks::study_parse

@@ -41,6 +41,9 @@ Study study_parse::Parser::run() {
   parse_study_table(root, s);
   parse_robot(root, s);
   parse_task(root, s);
+  check_task_fits_robot(root.get("task") ? root.get("task")->as_table() : nullptr, s);
+  s.arm_chain = s.robot_chain();
+  if (!s.robot_text.empty()) s.sha256 = sha256_hex(std::string(text) + std::string(1, '\0') + s.robot_text);  // the robot is part of the study
   if (root.get("block") || !root.get("optimize")) parse_blocks(root, s);
   parse_optimizations(root, s);
   if (!diags_.empty()) {

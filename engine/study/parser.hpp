@@ -1,7 +1,8 @@
 #pragma once
 // Internal to engine/study (not included from outside it): the study parser. One Parser reads one
 // study text; its parts live in the files named for their jobs:
-//   study_tables.cpp     [study], [robot], [task]
+//   study_tables.cpp     [study], [task]
+//   robot_table.cpp      [robot]: the seed 3R, an n-link planar arm or a URDF robot
 //   axes.cpp             parameter values and the [block.axes] forms (values, range, linspace, random, lhs)
 //   blocks.cpp           [[block]] tables: name, kind, keys, IK problem family, fixed parameters
 //   block_axes.cpp       a block's axes: lhs settings, [block.axes], lhs and zip groups, axes a run would ignore
@@ -80,8 +81,19 @@ class Parser : public ParserCore {
  private:
   // study_tables.cpp
   void parse_study_table(const toml::table& root, Study& s);
-  void parse_robot(const toml::table& root, Study& s);
   void parse_task(const toml::table& root, Study& s);
+  /// The task's orientation key (after the vertices): per-vertex angles (planar) or "hold" (spatial).
+  void parse_task_orientation(const toml::table& t, Study& s);
+  /// The path's vertices against the robot's reach (chains); the task's equations against its joints.
+  void check_task_fits_robot(const toml::table* task, Study& s);
+
+  // robot_table.cpp
+  void parse_robot(const toml::table& root, Study& s);
+  void parse_planar_robot(const toml::table& t, Study& s);
+  void parse_urdf_robot(const toml::table& t, Study& s);
+  /// A list of 2 .. kMaxJoints numbers (or exactly `count` when count > 0); nullopt after reporting.
+  std::optional<std::vector<double>> get_joint_numbers(const toml::table& t, std::string_view key, std::size_t count,
+                                                       std::string_view what, std::string_view unit);
 
   // blocks.cpp
   void parse_blocks(const toml::table& root, Study& s);
@@ -112,6 +124,8 @@ class Parser : public ParserCore {
   void draw_lhs_group(BlockDraft& d);
   /// Reads zip; reports bad groups, unknown, twice-zipped or LHS axes and unequal lengths.
   void read_zip_groups(BlockDraft& d);
+  /// Checks the block's runs against the robot: redundancy left by the task, vertex_alpha's domain.
+  void check_robot_supports(const BlockDraft& d, const Study& s);
   /// Reads the axes against their controlling parameters; reports axes a run would ignore.
   void reject_ineffective_axes(const BlockDraft& d);
   /// Reads the draft into a Block unless a step reported since errors_before; reports a spec Block refuses.

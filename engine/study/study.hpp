@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -13,6 +14,7 @@
 
 #include "methods/trajectory.hpp"
 #include "model/arm.hpp"
+#include "model/chain.hpp"
 #include "optimize/optimize.hpp"
 #include "space/space.hpp"
 #include "task/quintic_path.hpp"
@@ -67,11 +69,20 @@ struct HistoryPolicy {
 };
 
 struct StudyTask {
-  std::vector<Eigen::Vector2d> vertices;  ///< [m]
+  std::vector<Eigen::Vector2d> vertices;  ///< x, y [m]
+  std::vector<double> z;                  ///< vertex heights [m] (spatial robots; empty: planar, z = 0)
   std::vector<double> durations;          ///< [s], vertices.size() - 1 values
   double dt = 1e-3;                       ///< [s]
   Integrator integrator = Integrator::semi_implicit_euler;
+  /// The tip orientation along the path: planar robots, one angle per vertex [rad] (a quintic between
+  /// them); empty with hold_orientation false: a position task.
+  std::vector<double> orientation;
+  bool hold_orientation = false;          ///< spatial robots: the start's tip orientation held along the path
   Path2 path() const { return Path2(vertices, durations); }
+  Eigen::Vector3d vertex(std::size_t i) const {
+    return {vertices[i].x(), vertices[i].y(), i < z.size() ? z[i] : 0.0};
+  }
+  bool pose() const { return !orientation.empty() || hold_orientation; }
 };
 
 /// An optimisation block ([[optimize]] in a study file; syntax in studies/README.md).
@@ -109,8 +120,16 @@ struct Study {
   std::string description;
   std::string output;       ///< default "results/<name>.h5"
   HistoryPolicy histories;
-  PlanarArm3 robot;         ///< with the study's inertia form (the blocks' default)
+  PlanarArm3 robot;         ///< the seed's closed-form 3R, with the study's inertia form (the blocks' default)
   double robot_b = 0.1;     ///< link thickness [m] the inertias came from
+  /// The robot as a chain (an n-link planar arm or a URDF robot); null when it is the seed's
+  /// closed-form 3R (`robot`). Shared, immutable: runs read it concurrently.
+  std::shared_ptr<const Chain> chain;
+  /// The robot as a chain for the position / pose IK problems: `chain`, or the seed's 3R as a chain
+  /// (physical inertia) when that is null. Set by the parser.
+  std::shared_ptr<const Chain> arm_chain;
+  std::string robot_file;   ///< the URDF file as the study names it ("" when none)
+  std::string robot_text;   ///< its text, verbatim (kept with the results)
   StudyTask task;
   std::string text;         ///< the study file's text, verbatim
   std::string sha256;       ///< lower-case hex SHA-256 of text
@@ -118,6 +137,10 @@ struct Study {
   std::vector<OptimizeBlock> optimizations;  ///< [[optimize]] tables, file order (run after the blocks)
 
   std::uint64_t run_count() const { return total_runs(blocks); }
+  /// What the parameter tables need to know of the robot and task.
+  RobotShape robot_shape() const;
+  /// A new chain of the study's robot: a copy of `chain`, or the seed's 3R (`robot`, physical inertia).
+  std::shared_ptr<const Chain> robot_chain() const;
   RunRef locate(std::uint64_t global) const { return locate_run(blocks, global); }
   std::uint64_t first_run(std::size_t block) const { return ks::first_run(blocks, block); }
   /// Index of the block named `name`, or Block::npos.

@@ -1,4 +1,5 @@
-// The study-wide tables: [study] (name, output, histories, max_runs), [robot] (the arm), [task] (the path).
+// The study-wide tables: [study] (name, output, histories, max_runs) and [task] (the path); [robot] is
+// in robot_table.cpp.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -58,42 +59,6 @@ void Parser::parse_study_table(const toml::table& root, Study& s) {
   }
 }
 
-void Parser::parse_robot(const toml::table& root, Study& s) {
-  std::array<double, 3> l{1, 1, 1}, m{5, 2, 1};
-  double b = 0.1, g = 9.81;
-  InertiaForm form = InertiaForm::physical;
-  if (const toml::node* n = root.get("robot")) {
-    if (const auto* t = n->as_table()) {
-      check_keys(*t, {"l", "m", "b", "g", "inertia"}, "[robot]");
-      if (auto v = get_numbers(*t, "l", 3, "robot l")) {
-        for (std::size_t i = 0; i < 3; ++i) l[i] = (*v)[i];
-        if (*std::min_element(v->begin(), v->end()) <= 0)
-          error(*t->get("l"), "a link length is <= 0; expected lengths > 0 [m]");
-      }
-      if (auto v = get_numbers(*t, "m", 3, "robot m")) {
-        for (std::size_t i = 0; i < 3; ++i) m[i] = (*v)[i];
-        if (*std::min_element(v->begin(), v->end()) <= 0)
-          error(*t->get("m"), "a link mass is <= 0; expected masses > 0 [kg]");
-      }
-      if (auto v = get_number(*t, "b", "robot b")) {
-        if (*v < 0) error(*t->get("b"), "b = " + fmt(*v) + "; expected b >= 0 [m]");
-        else b = *v;
-      }
-      if (auto v = get_number(*t, "g", "robot g")) g = *v;
-      if (auto v = get_string(*t, "inertia", "inertia")) {
-        if (!parse(*v, form))
-          error(*t->get("inertia"), "unknown inertia '" + *v + "'; expected one of " +
-                                        join(inertia_names()) + suggest(*v, inertia_names()));
-      }
-    } else {
-      error(*n, "'robot' is " + type_name(*n) + "; expected a [robot] table");
-    }
-  }
-  s.robot = PlanarArm3::bars(l, m, b, g);
-  s.robot.inertia_form = form;
-  s.robot_b = b;
-}
-
 void Parser::parse_task(const toml::table& root, Study& s) {
   const Path2 sq = seed_square();
   s.task.vertices = sq.vertices();
@@ -105,30 +70,36 @@ void Parser::parse_task(const toml::table& root, Study& s) {
     error(*n, "'task' is " + type_name(*n) + "; expected a [task] table");
     return;
   }
-  check_keys(*t, {"vertices", "durations", "dt", "integrator"}, "[task]");
+  check_keys(*t, {"vertices", "durations", "dt", "integrator", "orientation"}, "[task]");
+  const bool spatial = s.chain && !s.chain->planar();
+  const std::size_t dims = spatial ? 3 : 2;
+  const std::string point = spatial ? "[x, y, z]" : "[x, y]";
   bool vertices_ok = true;
   if (const toml::node* vn = t->get("vertices")) {
     const auto* a = vn->as_array();
     if (!a || a->size() < 2) {
       error(*vn, "vertices is " + (a ? "an array of " + std::to_string(a->size()) : type_name(*vn)) +
-                     "; expected an array of at least 2 [x, y] points [m]");
+                     "; expected an array of at least 2 " + point + " points [m]");
       vertices_ok = false;
     } else {
       std::vector<Eigen::Vector2d> v;
+      std::vector<double> z;
       for (const auto& e : *a) {
         const auto* p = e.as_array();
-        if (!p || p->size() != 2) {
-          error(e, "a vertex is " + (p ? "an array of " + std::to_string(p->size()) : type_name(e)) +
-                       "; expected [x, y] [m]");
+        if (!p || p->size() != dims) {
+          error(e, "a vertex is " + (p ? "an array of " + std::to_string(p->size()) : type_name(e)) + "; expected " +
+                       point + " [m]" + (spatial ? " (the robot is spatial)" : ""));
           vertices_ok = false;
           continue;
         }
         auto x = get_number(*p->get(0), "vertex x");
         auto y = get_number(*p->get(1), "vertex y");
-        if (x && y) v.emplace_back(*x, *y);
+        std::optional<double> zz = spatial ? get_number(*p->get(2), "vertex z") : std::optional<double>(0.0);
+        if (x && y && zz) v.emplace_back(*x, *y), z.push_back(*zz);
         else vertices_ok = false;
       }
       s.task.vertices = v;
+      if (spatial) s.task.z = z;
       if (!t->get("durations") && vertices_ok && v.size() != 5) {
         error(*vn, "vertices given without durations; expected durations = [...] (" + std::to_string(v.size() - 1) +
                        " segment durations [s])");
@@ -165,10 +136,62 @@ void Parser::parse_task(const toml::table& root, Study& s) {
     if (auto p = domain_problem(*find_param(block_params(BlockKind::trajectory), "dt"), *v); !p.empty()) error(*t->get("dt"), p + " [s]");
     else s.task.dt = *v;
   }
+  if (vertices_ok) parse_task_orientation(*t, s);
   if (auto v = get_string(*t, "integrator", "integrator")) {
     if (!parse(*v, s.task.integrator))
       error(*t->get("integrator"), "unknown integrator '" + *v + "'; expected one of " +
                                        join(integrator_names()) + suggest(*v, integrator_names()));
+  }
+}
+
+void Parser::parse_task_orientation(const toml::table& t, Study& s) {
+  const toml::node* n = t.get("orientation");
+  if (!n) return;
+  if (!s.chain) {
+    error(*n, "an orientation path on the seed's closed-form 3R leaves no redundancy; expected a robot with more "
+              "joints (l = [...] with 4 or more links, or a URDF robot) for a pose task");
+    return;
+  }
+  if (!s.chain->planar()) {
+    if (auto v = n->as_string(); v && v->get() == "hold") s.task.hold_orientation = true;
+    else error(*n, "orientation of a spatial robot's path is " + type_name(*n) +
+                       "; expected \"hold\" (the start's tip orientation held along the path)");
+    return;
+  }
+  const auto* a = n->as_array();
+  if (!a || a->size() != s.task.vertices.size()) {
+    error(*n, "orientation is " + (a ? "an array of " + std::to_string(a->size()) : type_name(*n)) + "; expected " +
+                  std::to_string(s.task.vertices.size()) + " tip angles [deg], one per vertex");
+    return;
+  }
+  std::vector<double> o;
+  for (const auto& e : *a)
+    if (auto x = get_number(e, "orientation")) o.push_back(*x * kDeg);
+  if (o.size() == a->size()) s.task.orientation = o;
+}
+
+void Parser::check_task_fits_robot(const toml::table* task, Study& s) {
+  if (!s.chain) return;
+  // reach: the distance from the first joint's origin to the tip can not exceed the sum of the
+  // frame offsets (and of the prismatic travels)
+  const Chain& c = *s.chain;
+  double reach = c.tip.p.norm();
+  for (int j = 0; j < c.dof(); ++j) {
+    if (j > 0) reach += c.joints[j].origin.p.norm();
+    if (c.joints[j].type == JointType::prismatic)
+      reach += std::max(std::abs(c.joints[j].lower), std::abs(c.joints[j].upper));
+  }
+  const Eigen::Vector3d base = c.joints.front().origin.p;
+  const toml::node* vn = task ? task->get("vertices") : nullptr;
+  for (std::size_t i = 0; i < s.task.vertices.size(); ++i) {
+    const double d = (s.task.vertex(i) - base).norm();
+    if (d > reach * (1 + 1e-12)) {
+      const toml::node* at = vn && vn->as_array() ? vn->as_array()->get(i) : vn;
+      if (at) error(*at, "vertex " + std::to_string(i + 1) + " is " + fmt(d) + " m from the first joint; expected a vertex within the "
+                              "robot's reach (" + fmt(reach) + " m)");
+      else error(Pos{1, 1}, "vertex " + std::to_string(i + 1) + " of the default path is " + fmt(d) +
+                                " m from the first joint; expected [task] vertices within the robot's reach (" + fmt(reach) + " m)");
+    }
   }
 }
 

@@ -1,0 +1,212 @@
+// [robot] in study files: the seed's 3R, n-link planar arms, URDF robots; the task against the robot;
+// every bad input located at FILE:LINE:COL with what was expected.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "model/chain_dynamics.hpp"
+#include "model/kinematics.hpp"
+#include "schema/params.hpp"
+#include "study/study.hpp"
+
+using namespace ks;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A scratch folder holding a study file's neighbours (URDF files), removed at the end of the test.
+class Folder {
+ public:
+  Folder() : dir_(fs::temp_directory_path() / ("ks_robot_" + std::to_string(::getpid()) + "_" + std::to_string(next_++))) {
+    fs::create_directories(dir_);
+  }
+  ~Folder() { fs::remove_all(dir_); }
+  void write(const std::string& name, const std::string& text) const { std::ofstream(dir_ / name) << text; }
+  std::string study() const { return (dir_ / "s.toml").string(); }
+
+ private:
+  static inline int next_ = 0;
+  fs::path dir_;
+};
+
+std::string studies_dir() { return std::string(KS_SOURCE_DIR) + "/studies/"; }
+
+const std::string kTraj = "[[block]]\nname = \"b\"\nkind = \"trajectory\"\n";
+const std::string kIk = "[[block]]\nname = \"b\"\nkind = \"ik\"\nproblem = \"position\"\n";
+
+/// The parse error of `text` (as file `file`): its first diagnostic.
+StudyDiagnostic first_error(const std::string& text, const std::string& file = "bad.toml") {
+  try {
+    parse_study(text, file);
+  } catch (const StudyError& e) {
+    if (!e.diagnostics().empty()) return e.diagnostics().front();
+  }
+  ADD_FAILURE() << "no StudyError for:\n" << text;
+  return {};
+}
+
+void expect_error(const std::string& text, int line, int col, const std::string& part,
+                  const std::string& file = "bad.toml") {
+  const StudyDiagnostic d = first_error(text, file);
+  EXPECT_EQ(d.line, line) << d.str();
+  EXPECT_EQ(d.column, col) << d.str();
+  EXPECT_NE(d.message.find(part), std::string::npos) << d.str();
+  EXPECT_NE(d.message.find("expected"), std::string::npos) << d.str();
+}
+
+/// A two-link URDF with `joint2` of type `type2`, and a tool link after a fixed joint.
+std::string two_link_urdf(const std::string& type2 = "revolute", double mass2 = 1.0) {
+  return R"(<?xml version="1.0"?>
+<robot name="two">
+  <link name="base"/>
+  <link name="l1"><inertial><mass value="1"/><origin xyz="0.5 0 0"/>
+    <inertia ixx="0.001" iyy="0.08" izz="0.08" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="l2"><inertial><mass value=")" + std::to_string(mass2) + R"("/><origin xyz="0.5 0 0"/>
+    <inertia ixx="0.001" iyy="0.08" izz="0.08" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="tool"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="100" velocity="5"/></joint>
+  <joint name="j2" type=")" + type2 + R"("><parent link="l1"/><child link="l2"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="100" velocity="5"/></joint>
+  <joint name="jt" type="fixed"><parent link="l2"/><child link="tool"/><origin xyz="1 0 0"/></joint>
+</robot>
+)";
+}
+
+}  // namespace
+
+TEST(StudyRobot, DefaultIsTheSeedClosedForm) {
+  const Study s = parse_study(kTraj, "s.toml");
+  EXPECT_EQ(s.chain, nullptr);
+  ASSERT_NE(s.arm_chain, nullptr);  // the position / pose IK problems' chain: the seed arm
+  EXPECT_EQ(s.arm_chain->dof(), 3);
+  const RobotShape r = s.robot_shape();
+  EXPECT_FALSE(r.chain);
+  EXPECT_EQ(r.joints, 3);
+  EXPECT_TRUE(r.vertex_alpha());
+}
+
+TEST(StudyRobot, PlanarArmOfFourLinksIsAChainWithPerJointColumns) {
+  const Study s = parse_study("[robot]\nl = [0.8, 0.8, 0.7, 0.5]\nm = [3.2, 3.2, 2.8, 2.0]\nb = 0.08\n" + kTraj, "s.toml");
+  ASSERT_NE(s.chain, nullptr);
+  EXPECT_EQ(s.chain->dof(), 4);
+  EXPECT_TRUE(s.chain->planar());
+  // the chain's tip at q = 0 is the sum of the lengths along x (an oracle independent of the parser)
+  ChainData d;
+  forward_kinematics(*s.chain, d, VecN::Zero(4));
+  EXPECT_NEAR(d.tip.p.x(), 2.8, 1e-12);
+  const Block& b = s.blocks.front();
+  for (const char* c : {"q0_1", "q0_4", "alpha1A", "k"}) EXPECT_NE(b.column_index(c), Block::npos) << c;
+  for (const char* c : {"inertia", "vertex_alpha_2", "q0_5"}) EXPECT_EQ(b.column_index(c), Block::npos) << c;
+  std::vector<std::string> metric_names;
+  for (const MetricDef& m : b.metrics()) metric_names.push_back(m.name);
+  EXPECT_NE(std::find(metric_names.begin(), metric_names.end(), "tau4_inf"), metric_names.end());
+}
+
+TEST(StudyRobot, ThreeLinksWithRecursiveDynamicsEqualTheSeedArm) {
+  const Study s = parse_study("[robot]\ndynamics = \"recursive\"\n" + kTraj, "s.toml");
+  ASSERT_NE(s.chain, nullptr);
+  ChainData d;
+  MatN M;
+  const VecN q = joint_vector({0.3, -0.7, 1.1});
+  crba(*s.chain, d, q, M);
+  const Mat3 Mc = mass_matrix(PlanarArm3::seed(), joint_trig(Eigen::Vector3d(q.head<3>())));
+  EXPECT_LT((M - MatN(Mc)).norm(), 1e-12 * Mc.norm());
+}
+
+TEST(StudyRobot, PlanarArmErrorsAreLocated) {
+  expect_error("[robot]\nl = [1, 1, 1, 1]\n" + kTraj, 2, 5, "m is not given");
+  expect_error("[robot]\nl = [1, 1, 1, 1]\nm = [1, 1, 1]\n" + kTraj, 3, 5, "expected an array of 4 numbers");
+  expect_error("[robot]\nl = [1]\nm = [1]\n" + kTraj, 2, 5, "expected an array of 2 to 8");
+  expect_error("[robot]\nl = [1, 1, 1, 1, 1, 1, 1, 1, 1]\n" + kTraj, 2, 5, "expected an array of 2 to 8");
+  expect_error("[robot]\nl = [1, 1, 1, 1]\nm = [1, 1, 1, 1]\nlimits = [[0, 1], [0, 1], [0, 1], [2, 1]]\n" + kTraj, 4,
+               36, "expected lower < upper");
+  expect_error("[robot]\nl = [1, 1, 1, 1]\nm = [1, 1, 1, 1]\ninertia = \"thesis_m11\"\n" + kTraj, 4, 11,
+               "closed form of the seed's 3R");
+  expect_error("[robot]\nl = [1, 1, 1, 1]\nm = [1, 1, 1, 1]\ndynamics = \"closed_form\"\n" + kTraj, 4, 12,
+               "seed's 3-link arm");
+  expect_error("[robot]\nbase = \"b\"\n" + kTraj, 2, 8, "URDF robots");
+}
+
+TEST(StudyRobot, VertexOutOfReachIsLocated) {
+  // a 4-link arm of total length 1.2 m cannot reach the seed's square (2.1 m away)
+  expect_error("[robot]\nl = [0.3, 0.3, 0.3, 0.3]\nm = [1, 1, 1, 1]\n[task]\nvertices = [[0.5, 0.5], [1.5, 1.5]]\n"
+               "durations = [1]\n" + kTraj,
+               5, 25, "robot's reach");
+}
+
+TEST(StudyRobot, RedundancyAndVertexAlphaAreCheckedAgainstTheRobot) {
+  // two links on a planar position path: no redundancy left
+  expect_error("[robot]\nl = [1.5, 1.5]\nm = [1, 1]\n" + kTraj, 4, 1, "redundancy 0");
+  // vertex_alpha is the seed's 3-joint baseline
+  expect_error("[robot]\nl = [0.8, 0.8, 0.7, 0.5]\nm = [1, 1, 1, 1]\n" + kTraj + "method = \"vertex_alpha\"\n", 7, 10,
+               "not for a planar arm of more than 3 joints");
+  expect_error("[robot]\nl = [0.8, 0.8, 0.7, 0.5]\nm = [1, 1, 1, 1]\n" + kTraj + "[block.axes]\npreset = [\"1a\", \"3\"]\n",
+               8, 1, "the preset axis includes it");
+}
+
+TEST(StudyRobot, UrdfRobotLoadsRelativeToTheStudy) {
+  Folder f;
+  f.write("two.urdf", two_link_urdf());
+  const Study s = parse_study("[robot]\nurdf = \"two.urdf\"\nbase = \"base\"\ntip = \"tool\"\n" + kIk, f.study());
+  ASSERT_NE(s.chain, nullptr);
+  EXPECT_EQ(s.chain->dof(), 2);
+  EXPECT_TRUE(s.chain->planar());
+  EXPECT_NEAR(s.chain->gravity.y(), -9.81, 1e-15);  // planar: the seed's -y unless gravity is given
+  EXPECT_EQ(s.robot_text, two_link_urdf());
+  EXPECT_EQ(s.robot_file, "two.urdf");
+  // the URDF is part of the study's identity (resume refuses another robot)
+  f.write("two.urdf", two_link_urdf("revolute", 2.0));
+  const Study s2 = parse_study("[robot]\nurdf = \"two.urdf\"\nbase = \"base\"\ntip = \"tool\"\n" + kIk, f.study());
+  EXPECT_NE(s.sha256, s2.sha256);
+}
+
+TEST(StudyRobot, UrdfErrorsAreLocatedInTheStudy) {
+  Folder f;
+  f.write("two.urdf", two_link_urdf());
+  f.write("floating.urdf", two_link_urdf("floating"));
+  f.write("planar.urdf", two_link_urdf("planar"));
+  f.write("massless.urdf", two_link_urdf("revolute", 0.0));
+  f.write("broken.urdf", "<robot name=\"x\"><link name=\"a\"></robot>");
+  const std::string file = f.study();
+  auto robot = [](const std::string& urdf, const std::string& base, const std::string& tip) {
+    return "[robot]\nurdf = \"" + urdf + "\"\nbase = \"" + base + "\"\ntip = \"" + tip + "\"\n" + kIk;
+  };
+  expect_error(robot("missing.urdf", "base", "tool"), 2, 8, "cannot read the URDF file", file);
+  expect_error(robot("broken.urdf", "base", "tool"), 2, 8, "broken.urdf", file);
+  expect_error(robot("two.urdf", "bsae", "tool"), 3, 8, "base", file);
+  expect_error(robot("two.urdf", "base", "tol"), 4, 7, "tool", file);   // did you mean 'tool'
+  expect_error(robot("two.urdf", "tool", "base"), 2, 8, "base", file);  // the tip is not below the base
+  expect_error(robot("floating.urdf", "base", "tool"), 2, 8, "floating", file);
+  expect_error(robot("planar.urdf", "base", "tool"), 2, 8, "planar", file);
+  expect_error("[robot]\nurdf = \"two.urdf\"\ntip = \"tool\"\n" + kIk, 2, 8, "without base", file);
+  expect_error("[robot]\nurdf = \"two.urdf\"\nbase = \"base\"\ntip = \"tool\"\nl = [1, 1, 1]\n" + kIk, 5, 5,
+               "describes a planar arm", file);
+}
+
+TEST(StudyRobot, MasslessTipIsASingularChain) {
+  Folder f;
+  f.write("massless.urdf", two_link_urdf("revolute", 0.0));
+  const StudyDiagnostic d =
+      first_error("[robot]\nurdf = \"massless.urdf\"\nbase = \"base\"\ntip = \"tool\"\n" + kTraj, f.study());
+  EXPECT_EQ(d.line, 2) << d.str();
+  EXPECT_NE(d.message.find("expected"), std::string::npos) << d.str();
+}
+
+TEST(StudyRobot, SpatialTaskNeedsThreeCoordinatesAndHoldsOrientation) {
+  const std::string robot = "[robot]\nurdf = \"" + studies_dir() + "robots/arm7.urdf\"\nbase = \"base_link\"\ntip = \"tool0\"\n";
+  const Study s = parse_study(robot + "[task]\nvertices = [[0.5, -0.1, 0.5], [0.5, 0.1, 0.5]]\ndurations = [1]\n"
+                                      "orientation = \"hold\"\n" + kTraj, "s.toml");
+  ASSERT_NE(s.chain, nullptr);
+  EXPECT_EQ(s.chain->dof(), 7);
+  EXPECT_FALSE(s.chain->planar());
+  EXPECT_NEAR(s.chain->gravity.z(), -9.81, 1e-15);  // spatial: -z unless gravity is given
+  EXPECT_TRUE(s.task.hold_orientation);
+  EXPECT_DOUBLE_EQ(s.task.vertex(1).z(), 0.5);
+  expect_error(robot + "[task]\nvertices = [[0.5, -0.1], [0.5, 0.1]]\ndurations = [1]\n" + kTraj, 6, 13,
+               "expected [x, y, z]");
+  expect_error(robot + "[task]\nvertices = [[0.5, -0.1, 0.5], [0.5, 0.1, 0.5]]\ndurations = [1]\norientation = [0, 0]\n" +
+                   kTraj,
+               8, 15, "expected \"hold\"");
+}
