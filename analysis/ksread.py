@@ -450,6 +450,31 @@ class Results:
         return Optimization(name, self.f["optimizations"][name], degrees=degrees)
 
 
+def cluster_solutions(q, revolute, tolerance=1e-3):
+    """Name distinct IK solutions where no closed form is known (the engine's cluster_solutions):
+    greedy and in input order. q[0] opens cluster 0; each later row joins the first cluster (lowest
+    label) whose FIRST member is within `tolerance` in the max-norm, revolute components compared
+    mod 2 pi (wrapped to (-pi, pi]); else it opens the next cluster. Rows with a non-finite entry get -1.
+    q: (runs x joints) array [rad or m]; revolute: per joint, True for an angle. Returns int labels."""
+    q = np.asarray(q, dtype=float)
+    rev = np.asarray(revolute, dtype=bool)
+    labels = np.full(len(q), -1, dtype=int)
+    firsts = []
+    for i, row in enumerate(q):
+        if not np.all(np.isfinite(row)):
+            continue
+        for label, f in enumerate(firsts):
+            d = row - f
+            d[rev] = np.remainder(d[rev] + np.pi, 2 * np.pi) - np.pi
+            if np.max(np.abs(d)) <= tolerance:
+                labels[i] = label
+                break
+        else:
+            labels[i] = len(firsts)
+            firsts.append(row)
+    return labels
+
+
 def open_results(path):
     return Results(path)
 

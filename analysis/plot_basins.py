@@ -39,6 +39,25 @@ def wrap_deg(a):
     return (np.asarray(a) + 180.0) % 360.0 - 180.0
 
 
+# max-norm distance [rad or m] under which two converged final iterates are the same solution
+CLUSTER_TOLERANCE = 1e-3
+
+
+def joint_text(runs, qcols, units, mask):
+    """The median final iterate of the runs in `mask`, joint by joint with its unit."""
+    parts = []
+    for c, u in zip(qcols, units):
+        v = np.median(runs[c][mask])
+        j = c.rsplit("_", 1)[1]
+        if u == "rad":
+            parts.append(f"θ{j} = {wrap_deg(v * ksread.RAD2DEG):.1f}°")
+        elif u == "mm":  # the SCARA's prismatic joint
+            parts.append(f"d = {v:.1f} mm")
+        else:
+            parts.append(f"q{j} = {v:.3g} {u}")
+    return ", ".join(parts)
+
+
 def main(argv=None):
     args = parse_args(argv)
     res = ksread.open_results(args.file)
@@ -75,19 +94,37 @@ def main(argv=None):
     xa, ya = ls.axis(args.x), ls.axis(args.y)
     statuses = ls.statuses
 
-    # Label the solutions by the joint angles they stand for (median final iterate of their runs).
-    runs = res.runs(columns=["block", "solution", "q_final_1", "q_final_2", "q_final_3", "status"])
-    sel = runs["block"] == ls.block
+    # The final iterates: as many joints as the robot has (q_final_1 .. q_final_n), with their units.
+    qcols = sorted((c for c in res.columns() if c.startswith("q_final_")), key=lambda c: int(c.rsplit("_", 1)[1]))
+    runs = res.runs(columns=["run_id", "block", "solution", "status", "problem"] + qcols, done_only=False)
+    sel = (runs["block"] == ls.block) & runs["done"]
+    scara = bool(np.any(runs["problem"][sel] == "scara"))
+    # "rad or mm": the third joint is the SCARA's d in mm, else an angle
+    qunits = [("mm" if scara else "rad") if runs.units[c].startswith("rad or") else runs.units[c] for c in qcols]
+    clustered = False
+    if not np.any((runs["solution"] >= 0) & sel):
+        # No closed form (a chain robot): name the distinct solutions by clustering the converged final
+        # iterates (ksread.cluster_solutions, tolerance CLUSTER_TOLERANCE), in run order, and grid them:
+        # a grid block's runs are its cells in row-major order of the landscape's axes.
+        rows = np.flatnonzero(runs["block"] == ls.block)
+        conv = runs["done"][rows] & (runs["status"][rows] == "converged")
+        q = np.column_stack([runs[c][rows] for c in qcols])
+        q[~conv] = np.nan
+        labels = ksread.cluster_solutions(q, [u == "rad" for u in qunits], CLUSTER_TOLERANCE).astype(float)
+        labels[labels < 0] = np.nan
+        shape = ls.metrics["solution"].shape
+        if labels.size == int(np.prod(shape)):
+            runs["solution"] = runs["solution"].astype(float)
+            runs["solution"][rows] = labels
+            sol = arrange(labels.reshape(shape))
+            clustered = True
     sol_ids = sorted(int(s) for s in np.unique(sol[np.isfinite(sol)]))
     sol_label = {}
     for s in sol_ids:
         m = sel & (runs["solution"] == s) & (runs["status"] == "converged")
-        if m.any():
-            q1, q2 = wrap_deg(np.median(runs["q_final_1"][m]) * ksread.RAD2DEG), \
-                wrap_deg(np.median(runs["q_final_2"][m]) * ksread.RAD2DEG)
-            sol_label[s] = f"solution {s}: θ1 = {q1:.1f}°, θ2 = {q2:.1f}°, d = {np.median(runs['q_final_3'][m]):.1f} mm"
-        else:
-            sol_label[s] = f"solution {s}"
+        sol_label[s] = f"solution {s}" + (": " + joint_text(runs, qcols, qunits, m) if m.any() else "")
+    if len(sol_ids) > len(SOLUTION_COLOURS):  # a continuum (redundant problem): too many to tell apart
+        sol_label = {s: sol_label[s] for s in sol_ids[:len(SOLUTION_COLOURS)]}
 
     import matplotlib.colors as mcolors
     finite_its = its[np.isfinite(its) & (status == 0)]
@@ -151,7 +188,7 @@ def main(argv=None):
         {"file": args.file, "block": ls.block, "panel_axis": panel_axis,
          "x": {"name": xa.name, "unit": xa.unit, "values": xa.values},
          "y": {"name": ya.name, "unit": ya.unit, "values": ya.values},
-         "panels": data_panels, "solutions": sol_label})
+         "panels": data_panels, "solutions": sol_label, "clustered": clustered})
 
 
 if __name__ == "__main__":

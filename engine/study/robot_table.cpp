@@ -205,17 +205,22 @@ void Parser::parse_urdf_robot(const toml::table& t, Study& s) {
   text << in.rdbuf();
   try {
     // gravity: as given; else the seed's -y when the chain moves in the base xy plane, else -z
-    Chain c = load_urdf_string(text.str(), path.string(), *base, *tip, gravity.value_or(Eigen::Vector3d(0, -9.81, 0)));
+    Chain c = parse_urdf(text.str(), *base, *tip, gravity.value_or(Eigen::Vector3d(0, -9.81, 0)), path.string());
     if (!gravity && !c.planar()) c.gravity = Eigen::Vector3d(0, 0, -9.81);
     c.prepare();
     s.chain = std::make_shared<const Chain>(std::move(c));
     s.robot_file = *file;
     s.robot_text = text.str();
   } catch (const UrdfError& e) {
-    const toml::node& where = e.about == UrdfError::About::base ? *t.get("base")
-                              : e.about == UrdfError::About::tip ? *t.get("tip")
-                                                                : at;
-    error(where, std::string(e.what()));
+    // an unknown link at its key, anything else at urdf; the URDF's file and line lead the message
+    std::string what = e.message, hint;
+    if (const auto dym = what.find("; did you mean"); dym != std::string::npos) hint = what.substr(dym), what.resize(dym);
+    const toml::node* where = &at;
+    std::string expected = "a URDF chain of revolute, continuous or prismatic joints with mass";
+    if (what.starts_with("unknown base link")) where = t.get("base"), expected = "a link of the URDF";
+    else if (what.starts_with("unknown tip link")) where = t.get("tip"), expected = "a link of the URDF";
+    error(*where, "URDF " + e.file + (e.line > 0 ? ":" + std::to_string(e.line) : std::string()) + ": " + what +
+                      "; expected " + expected + hint);
   }
 }
 

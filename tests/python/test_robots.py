@@ -1,0 +1,131 @@
+"""End-to-end tests of chain robots: Table 4 through the seed arm's URDF (generic RNEA/CRBA path)
+against the closed form, bad robots rejected with a location and nothing written, the shipped
+robot studies run and read back with h5py (per-joint columns, histories of width n).
+
+usage: /usr/bin/python3 test_robots.py KINESWEEP_BINARY STUDIES_DIR
+"""
+import os
+import subprocess
+import sys
+import unittest
+
+import h5py
+import numpy as np
+
+from e2e_common import TempDirTest
+
+KS = None
+STUDIES = None
+
+TABLE4 = """
+[study]
+name = "t4"
+histories = "every=50"
+{robot}
+[[block]]
+name = "table4"
+kind = "trajectory"
+[block.axes]
+preset = ["1a", "1b", "1c", "1d", "1e", "1f", "1g", "1h", "2a", "2b", "2c", "2d", "2e", "2f", "2g", "2h",
+          "3", "4", "5a", "5b", "5c"]
+"""
+
+
+def run(*args, **kw):
+    return subprocess.run([KS, *args], capture_output=True, text=True, **kw)
+
+
+def read_runs(path):
+    with h5py.File(path, "r") as f:
+        return {k: f["runs"][k][()] for k in f["runs"] if k not in ("wall_time",)}
+
+
+class Table4ThroughUrdf(TempDirTest):
+    def test_generic_path_agrees_with_the_closed_form(self):
+        closed = self.write("closed.toml", TABLE4.format(robot=""))
+        urdf = os.path.join(STUDIES, "robots", "seed3r.urdf")
+        generic = self.write("generic.toml", TABLE4.format(
+            robot=f'[robot]\nurdf = "{urdf}"\nbase = "base_link"\ntip = "tool"\n'))
+        a, b = os.path.join(self.dir, "a.h5"), os.path.join(self.dir, "b.h5")
+        for study, out in ((closed, a), (generic, b)):
+            r = run("run", study, "-o", out, "--quiet")
+            self.assertEqual(r.returncode, 0, r.stderr)
+        ra, rb = read_runs(a), read_runs(b)
+        self.assertEqual(list(ra["status"]), list(rb["status"]))
+        compared = 0
+        for name, col in ra.items():
+            if name not in rb or col.dtype.kind != "f":
+                continue
+            x, y = col, rb[name]
+            both = np.isfinite(x) & np.isfinite(y)
+            self.assertTrue(np.array_equal(np.isfinite(x), np.isfinite(y)), name)
+            scale = np.maximum(np.abs(x[both]), 1e-300)
+            rel = np.abs(x[both] - y[both]) / scale
+            self.assertLess(rel.max(initial=0.0), 1e-9, f"{name}: max relative difference {rel.max():.3g}")
+            compared += 1
+        self.assertGreaterEqual(compared, 10)
+        # the chain's columns: q0_1..3 (the start guess) and the same metric columns as the closed form
+        for c in ("E", "E_M", "tau1_inf", "tau2_inf", "tau3_inf", "max_tracking_error"):
+            self.assertIn(c, rb)
+        with h5py.File(b, "r") as f:
+            self.assertEqual(f["study/robot"].attrs["path"].decode() if isinstance(f["study/robot"].attrs["path"], bytes)
+                             else f["study/robot"].attrs["path"], urdf)
+
+
+class BadRobots(TempDirTest):
+    def test_each_bad_robot_is_rejected_with_location_and_no_file(self):
+        self.write("broken.urdf", "<robot name='x'><link name='a'>")
+        cases = {
+            "missing_urdf": ('[robot]\nurdf = "nope.urdf"\nbase = "a"\ntip = "b"\n', 2),
+            "broken_urdf": ('[robot]\nurdf = "broken.urdf"\nbase = "a"\ntip = "b"\n', 2),
+            "unknown_tip": (f'[robot]\nurdf = "{STUDIES}/robots/arm7.urdf"\nbase = "base_link"\ntip = "tool"\n', 4),
+            "out_of_reach": ('[robot]\nl = [0.3, 0.3, 0.3, 0.3]\nm = [1, 1, 1, 1]\n', None),
+            "too_few_joints": ('[robot]\nl = [2, 2]\nm = [1, 1]\n', 4),
+        }
+        for name, (robot, line) in cases.items():
+            with self.subTest(name):
+                study = self.write(name + ".toml", robot + '[[block]]\nname = "b"\nkind = "trajectory"\n')
+                out = os.path.join(self.dir, name + ".h5")
+                r = run("run", study, "-o", out)
+                self.assertEqual(r.returncode, 2, r.stderr)
+                if line is not None:
+                    self.assertIn(f"{study}:{line}:", r.stderr)
+                self.assertIn("expected", r.stderr)
+                self.assertFalse(os.path.exists(out))
+
+
+class ChainStudies(TempDirTest):
+    def test_arm7_square_runs_with_seven_joint_histories(self):
+        study = os.path.join(STUDIES, "arm7_square.toml")
+        out = os.path.join(self.dir, "arm7.h5")
+        r = run("run", study, "-o", out, "--quiet")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with h5py.File(out, "r") as f:
+            runs = f["runs"]
+            self.assertIn("q0_7", runs)
+            self.assertIn("tau7_inf", runs)
+            status = [s.decode() if isinstance(s, bytes) else s for s in runs["status"][()]]
+            self.assertIn("ok", status)
+            good = [i for i, s in enumerate(status) if s == "ok"]
+            # the tip follows the 3-D path: open-loop drift small against the 0.2 m square
+            self.assertLess(np.max(runs["max_tracking_error"][()][good]), 0.01)
+            hist = f["histories"]
+            name = sorted(hist)[0]
+            self.assertEqual(hist[name]["q"].shape[1], 7)
+            self.assertEqual(hist[name]["x"].shape[1], 3)
+
+    def test_arm7_ik_basins_run(self):
+        study = os.path.join(STUDIES, "arm7_ik_basins.toml")
+        out = os.path.join(self.dir, "basins.h5")
+        r = run("run", study, "-o", out, "--quiet")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with h5py.File(out, "r") as f:
+            runs = f["runs"]
+            status = [s.decode() if isinstance(s, bytes) else s for s in runs["status"][()]]
+            self.assertGreater(status.count("converged"), len(status) // 4)
+            self.assertIn("q_final_7", runs)
+
+
+if __name__ == "__main__":
+    KS, STUDIES = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+    unittest.main(argv=sys.argv[:1])
