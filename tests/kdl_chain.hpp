@@ -1,7 +1,9 @@
 #pragma once
 // Orocos KDL model of any ks::Chain: the independent oracle of the chain tests (never used by the engine).
 #include <kdl/chain.hpp>
+#include <kdl/jacobian.hpp>
 #include <kdl/jntarray.hpp>
+#include <kdl/jntspaceinertiamatrix.hpp>
 
 #include "model/chain.hpp"
 
@@ -13,6 +15,26 @@ inline KDL::JntArray kdl_array(const VecN& v) {
   KDL::JntArray a(v.size());
   for (int i = 0; i < v.size(); ++i) a(i) = v[i];
   return a;
+}
+
+// KDL's results copied element by element: its Eigen storage comes from a library built for a
+// different vector width (16-byte alignment), so it must not meet our vectorised expressions.
+inline VecN from_kdl(const KDL::JntArray& a) {
+  VecN v(a.rows());
+  for (unsigned i = 0; i < a.rows(); ++i) v[i] = a(i);
+  return v;
+}
+inline MatN from_kdl(const KDL::JntSpaceInertiaMatrix& m) {
+  MatN M(m.rows(), m.columns());
+  for (unsigned i = 0; i < m.rows(); ++i)
+    for (unsigned j = 0; j < m.columns(); ++j) M(i, j) = m(i, j);
+  return M;
+}
+inline Mat6N from_kdl(const KDL::Jacobian& j) {
+  Mat6N J(6, j.columns());
+  for (unsigned r = 0; r < 6; ++r)
+    for (unsigned c = 0; c < j.columns(); ++c) J(r, c) = j(r, c);
+  return J;
 }
 
 inline KDL::Frame kdl_frame(const Frame& f) {

@@ -9,6 +9,12 @@ using detail::M3;
 using detail::V3;
 
 void forward_kinematics(const Chain& chain, ChainData& data, const VecN& q) {
+  if (chain.planar_fast_path) {
+    detail::PlanarPose P;
+    detail::planar_pose(chain, q, P);
+    detail::store_planar_pose(chain, P, data);
+    return;
+  }
   const int n = chain.dof();
   Frame prev;
   for (int i = 0; i < n; ++i) {

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "model/chain.hpp"
+#include "model/chain_kinematics.hpp"
 #include "model/sincos.hpp"
 
 namespace ks::detail {
@@ -52,6 +53,67 @@ inline void joint_twist(JointType type, const V3& a, const V3& o, V3& w, V3& v) 
     w.setZero();
     v = a;
   }
+}
+
+/// Joint frames of a planar chain (Chain::planar()): each frame is an angle about z, stored as its
+/// cosine and sine, and an origin in the base xy plane [m]. The revolute joints turn by sigma q
+/// about z, sigma = axis.z() = +-1; the prismatic ones slide along their in-plane axis.
+struct PlanarPose {
+  double c[kMaxJoints], s[kMaxJoints];  ///< cos, sin of joint i's frame angle
+  double x[kMaxJoints], y[kMaxJoints];  ///< joint i's frame origin [m]
+  double tc, ts, tx, ty;                ///< the tip frame, likewise
+};
+
+/// Planar forward kinematics: \param[in] q (dim chain.dof()). \param[out] P the frames.
+inline void planar_pose(const Chain& chain, const VecN& q, PlanarPose& P) {
+  const int n = chain.dof();
+  double sq[kMaxJoints], cq[kMaxJoints];
+  for (int i = 0; i < n; ++i)  // independent calls first: they overlap in the pipeline
+    if (chain.joints[i].type == JointType::revolute) fast_sincos(q[i], sq[i], cq[i]);
+  double c = 1.0, s = 0.0, x = 0.0, y = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const ChainJoint& j = chain.joints[i];
+    const double px = j.origin.p.x(), py = j.origin.p.y();
+    x += c * px - s * py;
+    y += s * px + c * py;
+    const double oc = j.origin.R(0, 0), os = j.origin.R(1, 0);
+    const double c0 = c * oc - s * os, s0 = s * oc + c * os;
+    if (j.type == JointType::revolute) {
+      const double qs = j.axis.z() * sq[i], qc = cq[i];
+      c = c0 * qc - s0 * qs;
+      s = s0 * qc + c0 * qs;
+    } else {
+      c = c0;
+      s = s0;
+      x += (c * j.axis.x() - s * j.axis.y()) * q[i];
+      y += (s * j.axis.x() + c * j.axis.y()) * q[i];
+    }
+    P.c[i] = c, P.s[i] = s, P.x[i] = x, P.y[i] = y;
+  }
+  const Frame& t = chain.tip;
+  P.tx = x + c * t.p.x() - s * t.p.y();
+  P.ty = y + s * t.p.x() + c * t.p.y();
+  P.tc = c * t.R(0, 0) - s * t.R(1, 0);
+  P.ts = s * t.R(0, 0) + c * t.R(1, 0);
+}
+
+/// A frame at angle (c, s) about z and origin (x, y, 0).
+inline void planar_frame(double c, double s, double x, double y, Frame& f) {
+  f.R << c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0;
+  f.p = V3(x, y, 0.0);
+}
+
+/// Writes the frames of P and the joint axes into data (what forward_kinematics computes).
+inline void store_planar_pose(const Chain& chain, const PlanarPose& P, ChainData& data) {
+  for (int i = 0; i < chain.dof(); ++i) {
+    const ChainJoint& j = chain.joints[i];
+    planar_frame(P.c[i], P.s[i], P.x[i], P.y[i], data.joint[i]);
+    if (j.type == JointType::revolute)
+      data.axis[i] = V3(0.0, 0.0, j.axis.z());
+    else
+      data.axis[i] = V3(P.c[i] * j.axis.x() - P.s[i] * j.axis.y(), P.s[i] * j.axis.x() + P.c[i] * j.axis.y(), 0.0);
+  }
+  planar_frame(P.tc, P.ts, P.tx, P.ty, data.tip);
 }
 
 }  // namespace ks::detail
