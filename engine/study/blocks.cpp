@@ -20,7 +20,7 @@ KindContext block_context(const Study& s, bool scara) {
   ctx.inertia = s.robot.inertia_form;
   ctx.scara = scara;
   ctx.robot = s.robot_shape();
-  if (!s.task.vertices.empty()) ctx.first_vertex = s.task.vertices.front();
+  if (!s.task.vertices.empty()) ctx.first_vertex = s.task.vertex(0);
   return ctx;
 }
 
