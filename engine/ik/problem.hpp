@@ -7,7 +7,9 @@
 //
 //   static constexpr int unknowns;                          // N: joint variables q
 //   static constexpr int residuals;                         // M: task equations F(q)
-//   static constexpr std::array<bool, N> revolute;          // angles: matched and compared mod 2 pi
+//   std::array<bool, N> revolute;                           // angles: matched and compared mod 2 pi
+//                                                           // (static constexpr, or a data member
+//                                                           // when it depends on the robot)
 //   void evaluate(const Vec<N>& q, Vec<M>& F, Mat<M, N>& J) const;   // F(q) and J = dF/dq
 //
 // Optional members (a method that needs a missing one returns Status::unsupported):
@@ -17,6 +19,11 @@
 //   SolutionSet<N> known_solutions() const;
 //       // the exact solutions, when they are isolated and known in closed form (analytic; and the
 //       // Summary's solution index); mark a continuum with SolutionSet::continuum = true.
+//   void project(Vec<N>& q) const;
+//       // clamp q onto the joint limits [lower, upper] in place (Options::joint_limits = clamp)
+//   bool admit(Vec<N>& q) const;
+//       // true when q lies within the joint limits, after moving each revolute joint by a multiple
+//       // of 2 pi into them where one exists (Options::joint_limits = reject)
 //
 // Units are the problem's own (the SCARA problem works in mm and rad, the planar arm in m and rad);
 // the solver tolerances are in the same units.
@@ -88,7 +95,7 @@ concept Problem = requires(const P& p, const Vec<P::unknowns>& q, Vec<P::residua
                            Mat<P::residuals, P::unknowns>& J) {
   { P::unknowns } -> std::convertible_to<int>;
   { P::residuals } -> std::convertible_to<int>;
-  { P::revolute } -> std::convertible_to<std::array<bool, P::unknowns>>;
+  { p.revolute } -> std::convertible_to<std::array<bool, P::unknowns>>;
   p.evaluate(q, F, J);
 };
 
@@ -102,6 +109,14 @@ concept HasSecondDerivatives = Problem<P> && requires(const P& p, const Vec<P::u
 template <class P>
 concept HasKnownSolutions = Problem<P> && requires(const P& p) {
   { p.known_solutions() } -> std::convertible_to<SolutionSet<P::unknowns>>;
+};
+
+/// The problem has joint limits: it can clamp an iterate onto them (JointLimits::clamp) and test a
+/// solution against them (JointLimits::reject).
+template <class P>
+concept HasJointLimits = Problem<P> && requires(const P& p, Vec<P::unknowns>& q) {
+  p.project(q);
+  { p.admit(q) } -> std::convertible_to<bool>;
 };
 
 }  // namespace ks::ik

@@ -27,11 +27,19 @@ bool Options::IsValid(std::string* why) const {
                      {"match_tolerance", match_tolerance, match_tolerance_rule}},
                     why))
     return false;
-  if (cycle_window >= 0 && cycle_window <= max_cycle_window) return true;
-  if (why)
-    *why = "cycle_window = " + std::to_string(cycle_window) + "; expected cycle_window within [0, " +
-           std::to_string(max_cycle_window) + "]";
-  return false;
+  if (!(cycle_window >= 0 && cycle_window <= max_cycle_window)) {
+    if (why)
+      *why = "cycle_window = " + std::to_string(cycle_window) + "; expected cycle_window within [0, " +
+             std::to_string(max_cycle_window) + "]";
+    return false;
+  }
+  if (joint_limits != JointLimits::none && joint_limits != JointLimits::clamp && joint_limits != JointLimits::reject) {
+    if (why)
+      *why = "joint_limits = " + std::to_string(static_cast<int>(joint_limits)) +
+             "; expected joint_limits one of none, clamp, reject";
+    return false;
+  }
+  return true;
 }
 
 }  // namespace ks::ik

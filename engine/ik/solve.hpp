@@ -47,13 +47,24 @@ enum class Status {
   unsupported,  ///< the method does not apply to the problem (halley_thesis with M != N, analytic
                 ///< without a closed form, Halley without second derivatives)
   no_solution,  ///< analytic: the closed form says the target is out of reach
+  out_of_limits,  ///< ||F|| < tolerance at a q outside the joint limits (JointLimits::reject)
+};
+
+/// What a solve does with the problem's joint limits (problems without limits ignore this).
+enum class JointLimits {
+  none,    ///< iterate and report freely
+  clamp,   ///< clamp every iterate onto [lower, upper] after the step (lm_adaptive: every trial point)
+  reject,  ///< iterate freely; a converged q outside the limits (revolute joints: no 2 pi shift of
+           ///< it inside) ends as Status::out_of_limits
 };
 
 std::string_view to_string(Method m);
 std::string_view to_string(Status s);
+std::string_view to_string(JointLimits l);
 /// Parse a name; false when unknown.
 bool parse(std::string_view name, Method& out);
 bool parse(std::string_view name, Status& out);
+bool parse(std::string_view name, JointLimits& out);
 
 /// Options of one solve. Defaults are the seed's where it has one.
 struct Options {
@@ -81,6 +92,7 @@ struct Options {
   /// far apart except near a singularity.
   double match_tolerance = 1e-3;
   bool keep_history = true;       ///< record the history (off: no allocation at all in a solve)
+  JointLimits joint_limits = JointLimits::none;  ///< use of the problem's joint limits, if it has any
 
   /// The rules on the fields (checked by IsValid; the study schema reports them at the key).
   static constexpr Domain tolerance_rule = Domain::positive();
@@ -94,7 +106,8 @@ struct Options {
   static constexpr Domain match_tolerance_rule = Domain::positive();
   static constexpr int max_cycle_window = 16;
 
-  /// True when every field is finite and within its rule (cycle_window within [0, 16]); otherwise
+  /// True when every field is finite and within its rule (cycle_window within [0, 16], joint_limits
+  /// one of the named values); otherwise
   /// false, with `why` (when given) naming the field and the rule, e.g. "tolerance = 0; expected tolerance > 0".
   bool IsValid(std::string* why = nullptr) const;
 };

@@ -150,12 +150,22 @@ void solve(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P:
   const double lambda0 = o.method == Method::lm ? o.lambda : mu;
   if (keep) s.history.push(q, F, e, 0.0, lambda0);
 
+  // Joint limits: only problems that declare them (HasJointLimits) see Options::joint_limits.
+  bool clamping = false, rejecting = false;
+  if constexpr (HasJointLimits<P>) {
+    clamping = o.joint_limits == JointLimits::clamp;
+    rejecting = o.joint_limits == JointLimits::reject;
+  }
+
   auto finish = [&](Status st) {
+    if constexpr (HasJointLimits<P>) {
+      if (st == Status::converged && rejecting && !pb.admit(q)) st = Status::out_of_limits;
+    }
     s.status = st;
     s.q = q;
     s.F = F;
     s.error = e;
-    if constexpr (HasKnownSolutions<P>) s.solution = match_solution<N>(pb.known_solutions(), q, P::revolute, o.match_tolerance);
+    if constexpr (HasKnownSolutions<P>) s.solution = match_solution<N>(pb.known_solutions(), q, pb.revolute, o.match_tolerance);
   };
   auto rcond_ok = [&](double rc) {
     s.min_rcond = std::min(s.min_rcond, rc);
@@ -171,7 +181,7 @@ void solve(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P:
       int best = 0;
       double best_d = std::numeric_limits<double>::infinity();
       for (int i = 0; i < set.count; ++i) {
-        const double d = joint_difference<N>(set.q[i], q0, P::revolute).norm();
+        const double d = joint_difference<N>(set.q[i], q0, pb.revolute).norm();
         if (d < best_d) best = i, best_d = d;
       }
       q = set.q[best];
@@ -194,6 +204,7 @@ void solve(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P:
   watch.best_error = e;
 
   VecN delta = VecN::Zero();
+  VecN qt = q;             // clamping: the (clamped) next iterate
   VecM Fn = VecM::Zero();  // lm_adaptive trial point
   MatMN Jn = MatMN::Zero();
   while (s.iterations < o.max_iter) {
@@ -226,9 +237,20 @@ void solve(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P:
           if (llt.info() != Eigen::Success) return finish(Status::singular);
           delta = -llt.solve(g);
           if (!(delta.norm() >= o.step_floor)) return finish(Status::stalled);
-          pb.evaluate(q + delta, Fn, Jn);
+          double predicted = 0.0;  // 2 (L(0) - L(d)), L(d) = |F + J d|^2 / 2, for the step d taken
+          if (clamping) {
+            if constexpr (HasJointLimits<P>) {
+              qt = q + delta;
+              pb.project(qt);
+              const VecN d = qt - q;
+              predicted = -2.0 * g.dot(d) - d.dot(A * d);
+              pb.evaluate(qt, Fn, Jn);
+            }
+          } else {
+            pb.evaluate(q + delta, Fn, Jn);
+            predicted = delta.dot(mu * delta - g);  // > 0 by the damped normal equations
+          }
           const double en = Fn.norm();
-          const double predicted = delta.dot(mu * delta - g);  // 2 (L(0) - L(delta)) > 0
           const double rho = std::isfinite(en) ? (f2 - en * en) / predicted : -1.0;
           if (rho > 0.0) {
             lambda_used = mu;
@@ -275,8 +297,20 @@ void solve(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P:
         break;  // handled above
     }
 
-    const double step = delta.norm();
-    q += delta;
+    double step = 0.0;
+    if (clamping) {
+      if constexpr (HasJointLimits<P>) {
+        if (o.method != Method::lm_adaptive) {  // lm_adaptive clamped its trial point already
+          qt = q + delta;
+          pb.project(qt);
+        }
+        step = (qt - q).norm();
+        q = qt;
+      }
+    } else {
+      step = delta.norm();
+      q += delta;
+    }
     if (o.method == Method::lm_adaptive) {
       F = Fn;
       J = Jn;
@@ -291,7 +325,7 @@ void solve(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P:
     if (e < o.tolerance) return finish(Status::converged);
     if (!(step >= o.step_floor)) return finish(Status::stalled);
     watch.push(q, step, e);
-    if (watch.window > 0 && watch.returned(P::revolute, o.cycle_tolerance)) return finish(Status::cycle);
+    if (watch.window > 0 && watch.returned(pb.revolute, o.cycle_tolerance)) return finish(Status::cycle);
   }
   finish(Status::max_iter);
 }
