@@ -211,6 +211,8 @@ TEST(ChainDynamics, PlanarSpecialisationEqualsSpatialAlgorithms) {
       EXPECT_LT(relative_error(a.J, b.J), 1e-13) << c.name;
       EXPECT_LT(relative_error(a.bias, b.bias), 1e-13) << c.name;
       EXPECT_LT((a.tip.p - b.tip.p).norm() + (a.tip.R - b.tip.R).norm(), 1e-13) << c.name;
+      forward_kinematics(c, d1, q);
+      forward_kinematics(s, d2, q);
       for (int i = 0; i < n; ++i) {
         EXPECT_LT((d1.joint[i].p - d2.joint[i].p).norm() + (d1.joint[i].R - d2.joint[i].R).norm(), 1e-13);
         EXPECT_LT((d1.axis[i] - d2.axis[i]).norm(), 1e-13);
