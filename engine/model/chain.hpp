@@ -62,6 +62,13 @@ struct Chain {
   /// masses >= 0, symmetric positive semi-definite inertias, lower <= upper. Otherwise false, with
   /// `why` naming the joint and the rule.
   bool IsValid(std::string* why = nullptr) const;
+
+  /// planar() as of the last prepare(): the dynamics (model/chain_dynamics.hpp) then take their
+  /// 2-D specialisation, decided by this flag rather than by re-testing the geometry per call.
+  /// planar_chain and load_urdf call prepare(); call it again after editing a chain by hand (a chain
+  /// never prepared uses the general spatial algorithms, which are right for every chain).
+  bool planar_fast_path = false;
+  void prepare() { planar_fast_path = planar(); }
 };
 
 /// One link of an n-link planar arm: a revolute joint about z, then the link along its x axis.
@@ -75,10 +82,13 @@ struct PlanarLink {
 };
 
 /// An n-link planar arm in the base xy plane with gravity g along -y [m/s^2]; the tip frame at the
-/// end of the last link. Each body gets I as its z inertia and, so that the chain is a valid 3-D body,
-/// m b^2 / 12-sized inertias about x and y (they never act in the plane).
+/// end of the last link. Joint 0 sits at the base origin, joint i at (l_{i-1}, 0, 0) in joint i-1's
+/// frame. Each body gets I as its z inertia and, so that the chain is a valid 3-D body, the
+/// inertias about x and y of a bar of square section b x b with b^2 = max(0, 12 I / m - l^2): Ixx =
+/// m b^2 / 6, Iyy = I (they never act in the plane). The chain is prepare()d.
 Chain planar_chain(const std::vector<PlanarLink>& links, double g = 9.81, std::string name = "planar");
 /// Uniform bars of thickness b [m]: lc = l / 2, I = m (l^2 + b^2) / 12 (the seed's arm: l = 1, m = (5, 2, 1), b = 0.1).
+/// Throws std::invalid_argument when l and m differ in size.
 std::vector<PlanarLink> planar_bars(const std::vector<double>& l, const std::vector<double>& m, double b);
 
 }  // namespace ks
