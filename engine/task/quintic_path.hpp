@@ -1,7 +1,7 @@
 #pragma once
 // A path through vertices with one quintic per segment (zero velocity and acceleration at both ends,
 // seed 000 Eq. 40): p(t) = p0 + (p1 - p0)(10 s^3 - 15 s^4 + 6 s^5), s = (t - t0) / T.
-// The same type serves positions (Dim = 2, m) and the vertex orientations of vertex_alpha (Dim = 1, rad).
+// The same type serves positions (Dim = 2 or 3, m) and the vertex orientations of vertex_alpha (Dim = 1, rad).
 #include <Eigen/Core>
 #include <stdexcept>
 #include <vector>
@@ -67,7 +67,16 @@ class QuinticPath {
 };
 
 using Path2 = QuinticPath<2>;
+using Path3 = QuinticPath<3>;
 using Profile1 = QuinticPath<1>;
+
+/// A planar path as a path in space: the same vertices with z = 0 [m], the same durations [s].
+inline Path3 lift_to_3d(const Path2& path) {
+  std::vector<Path3::Point> v;
+  v.reserve(path.vertices().size());
+  for (const auto& p : path.vertices()) v.emplace_back(p.x(), p.y(), 0.0);
+  return Path3(std::move(v), path.durations());
+}
 
 /// The seed's square: (1.5, 1.5) -> (1.5, 2) -> (2, 2) -> (2, 1.5) -> (1.5, 1.5), 0.5 s per side.
 inline Path2 seed_square() {

@@ -1,0 +1,158 @@
+#pragma once
+// Joint accelerations of the redundancy resolutions for a serial chain (model/chain.hpp) at one
+// instant: the seed's local methods (methods/resolution.hpp) for any number of joints n and any task
+// dimension m < n, and the non-redundant solve for m = n. Free functions on fixed-maximum-size types
+// (no allocation), templated on the task dimension m so the task-space matrices have fixed size.
+// Every inverse is a solve: an LLT of M (n x n) and one of A = J W^-1 J^T (m x m).
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <array>
+#include <cmath>
+#include <string_view>
+
+#include "methods/resolution.hpp"
+#include "model/chain.hpp"
+
+namespace ks {
+
+/// What the tip must do along the path: which rows of its motion the task prescribes.
+enum class TaskSpace {
+  planar_position,   ///< planar chains: tip x, y (m = 2)
+  planar_pose,       ///< planar chains: tip x, y and its angle alpha about z (m = 3)
+  spatial_position,  ///< tip x, y, z (m = 3)
+  spatial_pose,      ///< tip x, y, z and its orientation, held at the start's (m = 6)
+};
+
+std::string_view to_string(TaskSpace s);
+/// Parse a name; false when unknown.
+bool parse(std::string_view name, TaskSpace& out);
+
+/// Task dimension m: the number of prescribed rows.
+constexpr int task_dimension(TaskSpace s) {
+  switch (s) {
+    case TaskSpace::planar_position: return 2;
+    case TaskSpace::planar_pose: return 3;
+    case TaskSpace::spatial_position: return 3;
+    case TaskSpace::spatial_pose: return 6;
+  }
+  return 0;
+}
+/// True for the tasks of planar chains (tip in the xy plane, orientation one angle about z).
+constexpr bool is_planar(TaskSpace s) { return s == TaskSpace::planar_position || s == TaskSpace::planar_pose; }
+/// Number of position rows of the task (2 planar, 3 spatial): the tracked tip position's dimension.
+constexpr int position_rows(TaskSpace s) { return is_planar(s) ? 2 : 3; }
+
+/// Rows of the 6-row tip Jacobian (linear x, y, z, then angular x, y, z; base frame) that the task
+/// prescribes, in task order. The position rows come first.
+template <TaskSpace S>
+constexpr std::array<int, task_dimension(S)> task_rows() {
+  if constexpr (S == TaskSpace::planar_position) return {0, 1};
+  else if constexpr (S == TaskSpace::planar_pose) return {0, 1, 5};
+  else if constexpr (S == TaskSpace::spatial_position) return {0, 1, 2};
+  else return {0, 1, 2, 3, 4, 5};
+}
+
+template <int m>
+using TaskVec = Eigen::Matrix<double, m, 1>;
+template <int m>
+using TaskMat = Eigen::Matrix<double, m, m>;
+/// A task Jacobian: m task rows x n joints.
+template <int m>
+using TaskJacobian = Eigen::Matrix<double, m, Eigen::Dynamic, 0, m, kMaxJoints>;
+/// n joints x m task columns (W^-1 J^T).
+template <int m>
+using JointTaskMat = Eigen::Matrix<double, Eigen::Dynamic, m, 0, kMaxJoints, m>;
+
+/// The task rows of the 6 x n tip Jacobian. \param[in] J (6 x n). \param[out] Jt (m x n).
+template <TaskSpace S>
+void select_task_rows(const Mat6N& J, TaskJacobian<task_dimension(S)>& Jt) {
+  constexpr auto rows = task_rows<S>();
+  Jt.resize(task_dimension(S), J.cols());
+  for (int r = 0; r < task_dimension(S); ++r) Jt.row(r) = J.row(rows[r]);
+}
+
+/// The task rows of a 6-vector (the tip bias acceleration J̇ q̇, say).
+template <TaskSpace S>
+TaskVec<task_dimension(S)> select_task_rows(const Vec6& v) {
+  constexpr auto rows = task_rows<S>();
+  TaskVec<task_dimension(S)> out;
+  for (int r = 0; r < task_dimension(S); ++r) out[r] = v[rows[r]];
+  return out;
+}
+
+/// det(J J^T) of the first k rows of J (k <= m), the squared manipulability of those rows
+/// [(m or rad)^(2k) per joint unit^2]; clamped at 0 from below (rounding at a singular configuration).
+template <int k, int m>
+double gram_determinant(const TaskJacobian<m>& J) {
+  static_assert(k <= m);
+  double d;
+  if constexpr (k == 2) {
+    const double a = J.row(0).squaredNorm(), b = J.row(0).dot(J.row(1)), c = J.row(1).squaredNorm();
+    d = a * c - b * b;
+  } else {
+    const TaskMat<k> G = J.template topRows<k>() * J.template topRows<k>().transpose();
+    d = G.determinant();
+  }
+  return d > 0.0 ? d : 0.0;
+}
+
+/// Local (instantaneous) resolution at acceleration level for a chain (seed Eqs. 51, 56, generalised):
+///   qdd = J_W+ b - (I - J_W+ J) v,  J_W+ = W^-1 J^T (J W^-1 J^T)^-1,  v = M^-1 (c + k g) + K_N qd,
+/// computed as qdd = Y A^-1 (b + J v) - v with Y = W^-1 J^T (n x m) and A = J Y (m x m, an LLT).
+/// W = M (Weighting::inertia) minimises (tau - (1 - k) g)^T M^-1 (tau - (1 - k) g) among the qdd with
+/// J qdd = b when K_N = 0; W = M^2 (inertia_squared) the same in the identity norm.
+/// Inputs: Mllt, the LLT of M [kg m^2]; J (m x n), the task Jacobian [m or rad per joint unit];
+/// b (m) = task acceleration - task rows of J̇ q̇ [m/s^2 or rad/s^2]; u = c + k g [Nm]; K_N [1/s];
+/// qd [rad/s]. Output: qdd (n) [rad/s^2]. Non-finite input or a singular J gives non-finite output.
+template <int m>
+VecN local_acceleration(Weighting w, const Eigen::LLT<MatN>& Mllt, const TaskJacobian<m>& J, const TaskVec<m>& b,
+                        const VecN& u, double K_N, const VecN& qd) {
+  JointTaskMat<m> Y = J.transpose();
+  Mllt.solveInPlace(Y);
+  if (w == Weighting::inertia_squared) Mllt.solveInPlace(Y);
+  VecN v = u;
+  Mllt.solveInPlace(v);
+  if (K_N != 0.0) v += K_N * qd;
+  const TaskMat<m> A = J * Y;
+  TaskVec<m> r = b + J * v;
+  Eigen::LLT<TaskMat<m>>(A).solveInPlace(r);
+  VecN qdd = Y * r;
+  qdd -= v;
+  return qdd;
+}
+
+/// Non-redundant resolution (m = n; vertex_alpha): solve J qdd = b by LU with partial pivoting.
+/// Inputs: J (m x m) [m or rad per joint unit], b [m/s^2 or rad/s^2]. Output: qdd [rad/s^2];
+/// det_out receives det J, the singularity measure.
+template <int m>
+VecN nonredundant_acceleration(const TaskJacobian<m>& J, const TaskVec<m>& b, double& det_out) {
+  const TaskMat<m> square = J;
+  const Eigen::PartialPivLU<TaskMat<m>> lu(square);
+  det_out = lu.determinant();
+  return VecN(lu.solve(b));
+}
+
+/// The tip angle about z of a planar chain, unwrapped: alpha(q) = offset + sum_i s_i q_i, with s_i the
+/// z component of revolute joint i's axis (+1 or -1 in a planar chain; 0 for prismatic joints) and
+/// offset the angle of the tip frame at q = 0. Equals the angular-z row of the tip Jacobian times q
+/// plus the offset; for the seed arm, theta1 + theta2 + theta3.
+struct PlanarAngle {
+  double offset = 0.0;  ///< [rad]
+  VecN s;               ///< [-] (n)
+
+  /// Reads the joint axes and the frames at q = 0 of a planar chain (see Chain::planar()).
+  explicit PlanarAngle(const Chain& chain) : s(VecN::Zero(chain.dof())) {
+    Frame f;
+    for (int i = 0; i < chain.dof(); ++i) {
+      const ChainJoint& j = chain.joints[static_cast<std::size_t>(i)];
+      f = f * j.origin;
+      if (j.type == JointType::revolute) s[i] = (f.R * j.axis).z();
+    }
+    f = f * chain.tip;
+    offset = std::atan2(f.R(1, 0), f.R(0, 0));
+  }
+  /// alpha [rad] at q (n).
+  double operator()(const VecN& q) const { return offset + s.dot(q); }
+};
+
+}  // namespace ks

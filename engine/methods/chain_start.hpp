@@ -1,0 +1,46 @@
+#pragma once
+// The start of a chain's run: the tip placed on the path's first vertex by a small deterministic
+// damped Newton iteration from an initial guess q0 (minimum-norm steps when the chain is redundant
+// for the start's rows). Depends on nothing but its arguments: the same inputs give the same bits on
+// every thread.
+#include <optional>
+
+#include "model/chain.hpp"
+
+namespace ks {
+
+/// What the start places: three rows. Planar chains: the tip's x, y and its angle about z
+/// (PlanarAngle). Spatial: the tip's x, y, z.
+struct StartTarget {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< [m] (planar: z ignored)
+  bool planar = true;
+  double angle = 0.0;  ///< planar only [rad]
+};
+
+/// Settings of the start solve. Plain values; the defaults are the engine's.
+struct StartSolveOptions {
+  double tolerance = 1e-13;  ///< converged when the residual's 2-norm [m, rad mixed] is at most this
+  int max_iterations = 200;  ///< attempted steps, accepted or not
+};
+
+/// Solve for q with the tip on `target`, starting from q0 (n = chain.dof() values [rad or m]).
+/// Each step is dq = J^T (J J^T + lambda^2 I)^-1 e with e the residual and J the target rows of the tip
+/// Jacobian: for a square J and lambda = 0, Newton's step; for more joints than rows, the
+/// minimum-norm step. lambda^2 starts at 0; while a step does not reduce |e| it is set to 1e-6, then
+/// grows tenfold; after each accepted step it shrinks tenfold (to 0 below 1e-12). Once |e| <= tolerance, up to two more
+/// steps are taken while they reduce |e| (the last bits of a quadratic convergence). Joint limits are
+/// not enforced. Output: q, or std::nullopt when |e| > tolerance after max_iterations (out of reach,
+/// or a guess that does not lead there).
+///
+/// For the seed arm (n = 3, planar) the solution is the analytic IK's branch nearest
+/// q0 in Newton's sense; from planar_start_guess(3) it is the positive-elbow one for every start of
+/// the seed's square (alpha1A from -30 to 30 deg).
+std::optional<VecN> solve_start(const Chain& chain, const StartTarget& target, const VecN& q0,
+                                const StartSolveOptions& options = {});
+
+/// A default guess for planar chains: joint 1 at 0.5 rad, the others at 1.0 rad, alternating in sign
+/// from joint 3 on (0.5, 1.0, -1.0, 1.0, ...). For the seed arm this leads to the positive elbow
+/// (sin theta2 > 0) at the seed's first vertex. Output: n values [rad].
+VecN planar_start_guess(int n);
+
+}  // namespace ks
