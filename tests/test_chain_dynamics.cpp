@@ -14,6 +14,7 @@
 #include "kdl_chain.hpp"
 #include "model/chain_dynamics.hpp"
 #include "model/dynamics.hpp"
+#include "robot/urdf.hpp"
 
 // Counts global operator new calls while `counting` is set (the per-call no-allocation check).
 namespace {
@@ -59,6 +60,10 @@ Chain planar_mixed() {
   c.gravity = Eigen::Vector3d(3.0, -9.0, 0.0);
   c.prepare();
   return c;
+}
+
+Chain arm7() {
+  return load_urdf(KS_SOURCE_DIR "/studies/robots/arm7.urdf", "base_link", "tool", Eigen::Vector3d(0, 0, -9.81));
 }
 
 Chain spatial_copy(Chain c) {
@@ -114,12 +119,13 @@ void expect_matches_kdl(const Chain& c) {
   EXPECT_LT(worst_tau, 1e-9) << c.name;
 }
 
-std::vector<Chain> all_chains() { return {planar4r(), planar_mixed(), seed_chain(), test::test_chain_prismatic()}; }
+std::vector<Chain> all_chains() { return {planar4r(), planar_mixed(), seed_chain(), test::test_chain_prismatic(), arm7()}; }
 
 }  // namespace
 
 TEST(ChainDynamics, Planar4RMatchesKdl) { expect_matches_kdl(planar4r()); }
 TEST(ChainDynamics, PlanarMixedMatchesKdl) { expect_matches_kdl(planar_mixed()); }
+TEST(ChainDynamics, Arm7MatchesKdl) { expect_matches_kdl(arm7()); }
 TEST(ChainDynamics, PrismaticChainMatchesKdl) { expect_matches_kdl(test::test_chain_prismatic()); }
 TEST(ChainDynamics, SpatialAlgorithmsOnPlanarChainMatchKdl) { expect_matches_kdl(spatial_copy(planar_mixed())); }
 
@@ -205,6 +211,8 @@ TEST(ChainDynamics, PlanarSpecialisationEqualsSpatialAlgorithms) {
       EXPECT_LT(relative_error(a.J, b.J), 1e-13) << c.name;
       EXPECT_LT(relative_error(a.bias, b.bias), 1e-13) << c.name;
       EXPECT_LT((a.tip.p - b.tip.p).norm() + (a.tip.R - b.tip.R).norm(), 1e-13) << c.name;
+      forward_kinematics(c, d1, q);
+      forward_kinematics(s, d2, q);
       for (int i = 0; i < n; ++i) {
         EXPECT_LT((d1.joint[i].p - d2.joint[i].p).norm() + (d1.joint[i].R - d2.joint[i].R).norm(), 1e-13);
         EXPECT_LT((d1.axis[i] - d2.axis[i]).norm(), 1e-13);

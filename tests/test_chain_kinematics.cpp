@@ -11,6 +11,7 @@
 #include "kdl_chain.hpp"
 #include "model/chain_kinematics.hpp"
 #include "model/kinematics.hpp"
+#include "robot/urdf.hpp"
 
 using namespace ks;
 
@@ -20,7 +21,10 @@ Chain planar4r() {
   return planar_chain(planar_bars({0.8, 0.8, 0.7, 0.5}, {3.2, 3.2, 2.8, 2.0}, 0.05), 9.81, "planar4r");
 }
 
-std::vector<Chain> chains() { return {planar4r(), test::test_chain_prismatic()}; }
+std::vector<Chain> chains() {
+  return {planar4r(), test::test_chain_prismatic(),
+          load_urdf(KS_SOURCE_DIR "/studies/robots/arm7.urdf", "base_link", "tool", Eigen::Vector3d(0, 0, -9.81))};
+}
 
 Frame tip_frame(const Chain& c, const VecN& q) {
   ChainData d;

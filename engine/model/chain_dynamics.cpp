@@ -62,7 +62,7 @@ struct Spatial {
   static Motion lift(const Chain& chain) { return {V3::Zero(), -chain.gravity}; }
 
   /// Forward kinematics into data, the joint twists and (when `inertias`) the body inertias.
-  static void bodies(const Chain& chain, ChainData& data, const VecN& q, Bodies& B, bool inertias) {
+  static void bodies(const Chain& chain, ChainData& data, const VecN& q, Bodies& B, bool inertias, bool = true) {
     forward_kinematics(chain, data, q);
     for (int i = 0; i < chain.dof(); ++i) {
       const ChainJoint& j = chain.joints[i];
@@ -146,10 +146,11 @@ struct Planar {
   static double dot(const Motion& a, const Force& b) { return a.w * b.n + a.vx * b.fx + a.vy * b.fy; }
   static Motion lift(const Chain& chain) { return {0.0, -chain.gravity.x(), -chain.gravity.y()}; }
 
-  static void bodies(const Chain& chain, ChainData& data, const VecN& q, Bodies& B, bool inertias) {
+  /// As Spatial::bodies, but data's frames are written only when `store_frames`.
+  static void bodies(const Chain& chain, ChainData& data, const VecN& q, Bodies& B, bool inertias, bool store_frames = true) {
     detail::PlanarPose& P = B.P;
     detail::planar_pose(chain, q, P);
-    detail::store_planar_pose(chain, P, data);
+    if (store_frames) detail::store_planar_pose(chain, P, data);
     for (int i = 0; i < chain.dof(); ++i) {
       const ChainJoint& j = chain.joints[i];
       const double c = P.c[i], s = P.s[i], x = P.x[i], y = P.y[i];
@@ -165,19 +166,17 @@ struct Planar {
     }
   }
 
-  static void tip_outputs(const Chain& chain, const ChainData& data, const Bodies& B, const Motion& v, const Motion& a,
+  static void tip_outputs(const Chain& chain, const ChainData&, const Bodies& B, const Motion& v, const Motion& a,
                           Mat6N& J, Vec6& bias, Frame& tip) {
     const double px = B.P.tx, py = B.P.ty;
-    J.setZero(6, chain.dof());
+    J.resize(6, chain.dof());
     for (int i = 0; i < chain.dof(); ++i) {
       const Motion& S = B.S[i];
-      J(0, i) = S.vx - S.w * py;
-      J(1, i) = S.vy + S.w * px;
-      J(5, i) = S.w;
+      J.col(i) << S.vx - S.w * py, S.vy + S.w * px, 0.0, 0.0, 0.0, S.w;
     }
     const double vpx = v.vx - v.w * py, vpy = v.vy + v.w * px;
     bias << a.vx - a.w * py - v.w * vpy, a.vy + a.w * px + v.w * vpx, 0.0, 0.0, 0.0, a.w;
-    tip = data.tip;
+    detail::planar_frame(B.P.tc, B.P.ts, B.P.tx, B.P.ty, tip);
   }
 };
 
@@ -241,7 +240,7 @@ void gravity_impl(const Chain& chain, ChainData& data, const VecN& q, VecN& g) {
 template <class A>
 void evaluate_impl(const Chain& chain, ChainData& data, const VecN& q, const VecN& qd, ChainState& st) {
   typename A::Bodies B;
-  A::bodies(chain, data, q, B, true);
+  A::bodies(chain, data, q, B, true, false);
   const int n = chain.dof();
   typename A::Motion v = A::zero_motion(), a = A::zero_motion();
   typename A::Force f[kMaxJoints];

@@ -29,7 +29,9 @@ struct ChainState {
 };
 
 /// Fill `state` at (q, q̇). Equal (to rounding) to crba, coriolis_torques, gravity_torques,
-/// tip_jacobian and tip_bias_acceleration called one by one; faster.
+/// tip_jacobian and tip_bias_acceleration called one by one; faster. Chains with
+/// Chain::planar_fast_path take the 2-D specialisation, which leaves data's frames as they were (the
+/// other functions here write those of q): call forward_kinematics when they are needed.
 void evaluate_dynamics(const Chain& chain, ChainData& data, const VecN& q, const VecN& qd, ChainState& state);
 
 }  // namespace ks

@@ -1,0 +1,45 @@
+#pragma once
+// A serial chain (model/chain.hpp) from a URDF robot description: the joints on the path from a
+// base link down to a tip link. urdfdom reads the file; nothing of it shows in this header.
+#include <Eigen/Core>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "model/chain.hpp"
+
+namespace ks {
+
+/// A URDF file that cannot be read or does not describe a chain the engine can simulate.
+struct UrdfError : std::runtime_error {
+  std::string file;     ///< the file (or the name given to parse_urdf)
+  int line = 0;         ///< 1-based line of the element at fault; 0 when unknown
+  std::string message;  ///< what is wrong, without the location
+  UrdfError(std::string file, int line, std::string message);
+};
+
+/// The chain from `base_link` to `tip_link` of the URDF text.
+///  - revolute and prismatic joints become chain joints (limits from <limit>); continuous joints
+///    are revolute joints without limits;
+///  - fixed joints are merged: the links they attach join the moving body they hang from (their
+///    <inertial> merged into its mass properties), their transforms fold into the next joint's
+///    origin, or into the tip frame after the last moving joint; links attached by fixed joints
+///    off the path (a sensor, a tool beyond the tip) are merged likewise, while side branches
+///    through moving joints are ignored;
+///  - each link's <inertial> (origin xyz rpy, mass, ixx..izz about the centre of mass in the
+///    inertial frame) is expressed in its body's joint frame about the body's centre of mass;
+///  - links rigidly attached to the base (before the first moving joint) carry no dynamics.
+/// The chain gets `gravity` [m/s^2, base frame], the robot's name, source = `file`, and is
+/// prepare()d. Throws UrdfError: XML or URDF parse failure, unknown base or tip link (naming the
+/// nearest link name), tip not below base, floating or planar joints on the path, no moving joint
+/// or more than kMaxJoints, an invalid inertia, zero total mass, or a chain whose inertia matrix
+/// is singular (a joint moving neither mass nor inertia).
+Chain parse_urdf(std::string_view text, std::string_view base_link, std::string_view tip_link,
+                 const Eigen::Vector3d& gravity, std::string_view file = "<string>");
+
+/// Read `file` and parse_urdf it. Throws UrdfError (also when the file cannot be read).
+Chain load_urdf(const std::filesystem::path& file, std::string_view base_link, std::string_view tip_link,
+                const Eigen::Vector3d& gravity);
+
+}  // namespace ks
