@@ -41,11 +41,16 @@ Study study_parse::Parser::run() {
   parse_study_table(root, s);
   parse_robot(root, s);
   parse_task(root, s);
-  check_task_fits_robot(root.get("task") ? root.get("task")->as_table() : nullptr, s);
   s.arm_chain = s.robot_chain();
   if (!s.robot_text.empty()) s.sha256 = sha256_hex(std::string(text) + std::string(1, '\0') + s.robot_text);  // the robot is part of the study
   if (root.get("block") || !root.get("optimize")) parse_blocks(root, s);
   parse_optimizations(root, s);
+  // the path matters to trajectory runs only (an IK study's chain need not reach the default square)
+  const auto trajectory = [](const Block& b) { return b.kind() == BlockKind::trajectory; };
+  if (std::any_of(s.blocks.begin(), s.blocks.end(), trajectory) ||
+      std::any_of(s.optimizations.begin(), s.optimizations.end(),
+                  [&](const OptimizeBlock& o) { return trajectory(o.block()); }))
+    check_task_fits_robot(root.get("task") ? root.get("task")->as_table() : nullptr, s);
   if (!diags_.empty()) {
     std::stable_sort(diags_.begin(), diags_.end(), [](const StudyDiagnostic& a, const StudyDiagnostic& b) {
       return std::pair(a.line, a.column) < std::pair(b.line, b.column);
