@@ -61,7 +61,8 @@ THESIS_OPTIMA = {
 }
 
 TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged"]
-IK_STATUSES = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution"]
+IK_STATUSES = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution",
+               "out_of_limits"]
 
 
 def _s(v):

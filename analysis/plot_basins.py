@@ -19,7 +19,7 @@ import ksread  # noqa: E402
 
 SOLUTION_COLOURS = ["#1f77b4", "#2ca02c", "#ff7f0e", "#17becf", "#bcbd22", "#8c564b"]
 FAIL_COLOURS = {"stalled": "#8c510a", "singular": "#7b3294", "max_iter": "#d7191c", "cycle": "#f781bf",
-                "diverged": "#111111", "unsupported": "#555555", "no_solution": "#999999",
+                "diverged": "#111111", "unsupported": "#555555", "no_solution": "#999999", "out_of_limits": "#fdae61",
                 "converged, other solution": "#bbbbbb"}
 
 

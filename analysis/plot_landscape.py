@@ -27,7 +27,7 @@ METRIC_LABELS = {"E": "E (mean ‖τ‖)", "E_M": "E_M (mean ‖τ‖ in M⁻¹ 
                  "min_manipulability": "min manipulability", "max_tracking_error": "max tracking error"}
 STATUS_COLOURS = {"unreachable_start": "#b0b0b0", "singular": "#7b3294", "diverged": "#202020",
                   "stalled": "#e08214", "max_iter": "#d7191c", "cycle": "#f4a582",
-                  "unsupported": "#6a6a6a", "no_solution": "#b0b0b0"}
+                  "unsupported": "#6a6a6a", "no_solution": "#b0b0b0", "out_of_limits": "#fdae61"}
 
 
 def parse_args(argv=None):

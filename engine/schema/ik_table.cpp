@@ -84,6 +84,11 @@ std::vector<ParamDef> ik_params(const KindContext& ctx) {
                         [](auto& r) -> auto& { return r.options.tolerance; }));
   t.push_back(integer<Run>("max_iter", "", ik::Options::max_iter_rule, "iteration cap",
                            [](auto& r) -> auto& { return r.options.max_iter; }));
+  t.push_back(named<Run>("joint_limits",
+                         names_of<ik::JointLimits>(ik::JointLimits::none, ik::JointLimits::clamp, ik::JointLimits::reject),
+                         "the robot's joint limits: ignored, iterates clamped into them, or a solution outside "
+                         "them ends out_of_limits (position, pose)",
+                         [](auto& r) -> auto& { return r.options.joint_limits; }, EffectRule{"problem", {"position", "pose"}}));
   t.push_back(named<Run>("z_mode", names_of<ZMode>(ZMode::thesis, ZMode::physical),
                          "SCARA z residual: thesis (+q3) or physical", [](auto& r) -> auto& { return r.z_mode; },
                          EffectRule{"problem", {"scara"}}));

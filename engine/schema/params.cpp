@@ -80,10 +80,10 @@ std::span<const std::string_view> statuses(BlockKind kind) {
   using ik::Status;
   static const std::array<std::string_view, 4> trajectory{to_string(RunStatus::ok), to_string(RunStatus::unreachable_start),
                                                           to_string(RunStatus::singular), to_string(RunStatus::diverged)};
-  static const std::array<std::string_view, 8> ik{
+  static const std::array<std::string_view, 9> ik{
       ik::to_string(Status::converged), ik::to_string(Status::stalled),  ik::to_string(Status::singular),
       ik::to_string(Status::max_iter),  ik::to_string(Status::cycle),    ik::to_string(Status::diverged),
-      ik::to_string(Status::unsupported), ik::to_string(Status::no_solution)};
+      ik::to_string(Status::unsupported), ik::to_string(Status::no_solution), ik::to_string(Status::out_of_limits)};
   if (kind == BlockKind::trajectory) return trajectory;
   return ik;
 }
