@@ -46,7 +46,8 @@ TEST(Space, ColumnsCoverEveryParameterOfTheKind) {
   names.clear();
   for (const auto& c : ik.columns()) names.push_back(c.name);
   EXPECT_EQ(names, (std::vector<std::string>{"problem", "method", "lambda", "q0_1", "q0_2", "q0_3", "target_x",
-                                             "target_y", "target_z", "target_alpha", "tol", "max_iter", "z_mode"}));
+                                             "target_y", "target_z", "target_alpha", "tol", "max_iter", "joint_limits",
+                                             "z_mode"}));
   EXPECT_EQ(ik.columns()[ik.column_index("q0_3")].unit, "mm");
   EXPECT_EQ(ik.columns()[ik.column_index("max_iter")].type, CellType::i64);
   // Seed 001 defaults.

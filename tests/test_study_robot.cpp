@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "model/chain_dynamics.hpp"
+#include "model/dynamics.hpp"
 #include "model/kinematics.hpp"
 #include "schema/params.hpp"
 #include "study/study.hpp"
@@ -57,13 +58,14 @@ void expect_error(const std::string& text, int line, int col, const std::string&
 
 /// A two-link URDF with `joint2` of type `type2`, and a tool link after a fixed joint.
 std::string two_link_urdf(const std::string& type2 = "revolute", double mass2 = 1.0) {
+  const std::string i2 = mass2 > 0 ? R"(ixx="0.001" iyy="0.08" izz="0.08")" : R"(ixx="0" iyy="0" izz="0")";
   return R"(<?xml version="1.0"?>
 <robot name="two">
   <link name="base"/>
   <link name="l1"><inertial><mass value="1"/><origin xyz="0.5 0 0"/>
     <inertia ixx="0.001" iyy="0.08" izz="0.08" ixy="0" ixz="0" iyz="0"/></inertial></link>
   <link name="l2"><inertial><mass value=")" + std::to_string(mass2) + R"("/><origin xyz="0.5 0 0"/>
-    <inertia ixx="0.001" iyy="0.08" izz="0.08" ixy="0" ixz="0" iyz="0"/></inertial></link>
+    <inertia )" + i2 + R"( ixy="0" ixz="0" iyz="0"/></inertial></link>
   <link name="tool"/>
   <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
     <limit lower="-3" upper="3" effort="100" velocity="5"/></joint>
@@ -88,14 +90,14 @@ TEST(StudyRobot, DefaultIsTheSeedClosedForm) {
 }
 
 TEST(StudyRobot, PlanarArmOfFourLinksIsAChainWithPerJointColumns) {
-  const Study s = parse_study("[robot]\nl = [0.8, 0.8, 0.7, 0.5]\nm = [3.2, 3.2, 2.8, 2.0]\nb = 0.08\n" + kTraj, "s.toml");
+  const Study s = parse_study("[robot]\nl = [0.9, 0.9, 0.8, 0.6]\nm = [3.6, 3.6, 3.2, 2.4]\nb = 0.06\n" + kTraj, "s.toml");
   ASSERT_NE(s.chain, nullptr);
   EXPECT_EQ(s.chain->dof(), 4);
   EXPECT_TRUE(s.chain->planar());
   // the chain's tip at q = 0 is the sum of the lengths along x (an oracle independent of the parser)
   ChainData d;
   forward_kinematics(*s.chain, d, VecN::Zero(4));
-  EXPECT_NEAR(d.tip.p.x(), 2.8, 1e-12);
+  EXPECT_NEAR(d.tip.p.x(), 3.2, 1e-12);
   const Block& b = s.blocks.front();
   for (const char* c : {"q0_1", "q0_4", "alpha1A", "k"}) EXPECT_NE(b.column_index(c), Block::npos) << c;
   for (const char* c : {"inertia", "vertex_alpha_2", "q0_5"}) EXPECT_EQ(b.column_index(c), Block::npos) << c;
@@ -121,7 +123,7 @@ TEST(StudyRobot, PlanarArmErrorsAreLocated) {
   expect_error("[robot]\nl = [1]\nm = [1]\n" + kTraj, 2, 5, "expected an array of 2 to 8");
   expect_error("[robot]\nl = [1, 1, 1, 1, 1, 1, 1, 1, 1]\n" + kTraj, 2, 5, "expected an array of 2 to 8");
   expect_error("[robot]\nl = [1, 1, 1, 1]\nm = [1, 1, 1, 1]\nlimits = [[0, 1], [0, 1], [0, 1], [2, 1]]\n" + kTraj, 4,
-               36, "expected lower < upper");
+               35, "expected lower < upper");
   expect_error("[robot]\nl = [1, 1, 1, 1]\nm = [1, 1, 1, 1]\ninertia = \"thesis_m11\"\n" + kTraj, 4, 11,
                "closed form of the seed's 3R");
   expect_error("[robot]\nl = [1, 1, 1, 1]\nm = [1, 1, 1, 1]\ndynamics = \"closed_form\"\n" + kTraj, 4, 12,
@@ -189,13 +191,13 @@ TEST(StudyRobot, MasslessTipIsASingularChain) {
   Folder f;
   f.write("massless.urdf", two_link_urdf("revolute", 0.0));
   const StudyDiagnostic d =
-      first_error("[robot]\nurdf = \"massless.urdf\"\nbase = \"base\"\ntip = \"tool\"\n" + kTraj, f.study());
+      first_error("[robot]\nurdf = \"massless.urdf\"\nbase = \"base\"\ntip = \"tool\"\n" + kIk, f.study());
   EXPECT_EQ(d.line, 2) << d.str();
   EXPECT_NE(d.message.find("expected"), std::string::npos) << d.str();
 }
 
 TEST(StudyRobot, SpatialTaskNeedsThreeCoordinatesAndHoldsOrientation) {
-  const std::string robot = "[robot]\nurdf = \"" + studies_dir() + "robots/arm7.urdf\"\nbase = \"base_link\"\ntip = \"tool0\"\n";
+  const std::string robot = "[robot]\nurdf = \"" + studies_dir() + "robots/arm7.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\n";
   const Study s = parse_study(robot + "[task]\nvertices = [[0.5, -0.1, 0.5], [0.5, 0.1, 0.5]]\ndurations = [1]\n"
                                       "orientation = \"hold\"\n" + kTraj, "s.toml");
   ASSERT_NE(s.chain, nullptr);

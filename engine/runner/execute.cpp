@@ -89,10 +89,14 @@ VecN start_guess(const Chain& chain, const VecN& q0) {
 
 RunOutcome run_chain_trajectory(const Scenario& sc, const TrajectoryRun& run, int stride, RunWorkspace::Impl& ws) {
   const Chain& chain = *sc.chain;
-  const TaskSpace space = task_space(chain, *sc.task);
+  TaskSpace space = task_space(chain, *sc.task);
+  // vertex_alpha: the seed's baseline prescribes the tip angle at the vertices (alpha1A and the run's
+  // vertex_alpha_i): a planar pose task of a 3-joint arm
+  const bool vertex_alpha = run.options.method == TrajectoryMethod::vertex_alpha && space == TaskSpace::planar_position;
+  if (vertex_alpha) space = TaskSpace::planar_pose;
   const ChainTask& task = ws.chain_task_of(*sc.task, space, run.options.dt);
   TrajectoryOptions o = run.options;
-  if (space == TaskSpace::planar_pose) {  // the path's orientation: alpha1A and the later vertices
+  if (space == TaskSpace::planar_pose && !vertex_alpha) {  // the path's orientation: alpha1A and the later vertices
     o.alpha1A = sc.task->orientation.front();
     o.vertex_alpha.assign(sc.task->orientation.begin() + 1, sc.task->orientation.end());
   }

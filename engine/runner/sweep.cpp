@@ -68,7 +68,9 @@ class Accumulator {
         c.value = metric(b, "E");
         for (int j = 0; j < 3; ++j) c.tau[j] = metric(b, "tau" + std::to_string(j + 1) + "_inf");
         c.preset = schema.param_column[b][block.column_index("preset")];
-        c.inertia = schema.param_column[b][block.column_index("inertia")];
+        const std::size_t inertia = block.column_index("inertia");  // the seed's closed-form 3R only
+        c.inertia = inertia == Block::npos ? Columns::npos : schema.param_column[b][inertia];
+        c.seed_arm = block.context().robot.joints == 3 && block.context().robot.planar;
       } else {
         c.value = metric(b, "iterations");
       }
@@ -88,10 +90,10 @@ class Accumulator {
     if (good) consider_best(br, id, as_f64(row.cells[c.value]), row, ref.block);
     if (traj) {
       const std::string& preset = as_str(row.cells[c.preset]);
-      if (!preset.empty() && seed_.size() < 1000 && find_seed_case(preset)) {
+      if (c.seed_arm && !preset.empty() && seed_.size() < 1000 && find_seed_case(preset)) {
         SeedRow s;
         s.preset = preset;
-        s.inertia = as_str(row.cells[c.inertia]);
+        s.inertia = c.inertia == Columns::npos ? "chain" : as_str(row.cells[c.inertia]);
         s.status = status;
         s.E = as_f64(row.cells[c.value]);
         for (int j = 0; j < 3; ++j) s.tau[j] = as_f64(row.cells[c.tau[j]]);
@@ -145,7 +147,9 @@ class Accumulator {
   SweepReport report_;
   std::map<std::uint64_t, SeedRow> seed_;
   struct Columns {  // schema columns a block's rows are read at
+    static constexpr std::size_t npos = std::size_t(-1);
     std::size_t value = 0, preset = 0, inertia = 0, tau[3] = {0, 0, 0};
+    bool seed_arm = true;  ///< a planar 3-joint arm: its preset rows are compared with the thesis' Table 4
   };
   std::vector<Columns> columns_;
 };

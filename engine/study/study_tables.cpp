@@ -189,8 +189,11 @@ void Parser::check_task_fits_robot(const toml::table* task, Study& s) {
       const toml::node* at = vn && vn->as_array() ? vn->as_array()->get(i) : vn;
       if (at) error(*at, "vertex " + std::to_string(i + 1) + " is " + fmt(d) + " m from the first joint; expected a vertex within the "
                               "robot's reach (" + fmt(reach) + " m)");
-      else error(Pos{1, 1}, "vertex " + std::to_string(i + 1) + " of the default path is " + fmt(d) +
-                                " m from the first joint; expected [task] vertices within the robot's reach (" + fmt(reach) + " m)");
+      else {
+        error(Pos{1, 1}, "vertex " + std::to_string(i + 1) + " of the default path (the seed's square) is " + fmt(d) +
+                             " m from the first joint; expected [task] vertices within the robot's reach (" + fmt(reach) + " m)");
+        return;  // one message for the default path
+      }
     }
   }
 }

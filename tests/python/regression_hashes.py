@@ -173,6 +173,8 @@ def main():
     p.add_argument("studies_dir")
     p.add_argument("manifest")
     p.add_argument("--record", action="store_true", help="write MANIFEST instead of comparing")
+    p.add_argument("--add-new", action="store_true",
+                   help="compare the studies MANIFEST holds and add the studies it does not hold (a new shipped study)")
     p.add_argument("--workdir", help="where the results files go (kept); default: a temporary dir")
     p.add_argument("--threads", type=int, default=int(os.environ.get("KS_REGRESSION_THREADS", "2")),
                    help="kinesweep worker threads (default 2, or $KS_REGRESSION_THREADS)")
@@ -208,8 +210,20 @@ def main():
               f"in {args.manifest}")
         return 0
     with open(args.manifest) as f:
-        expected = json.load(f)["studies"]
+        manifest = json.load(f)
+    expected = manifest["studies"]
+    if args.add_new:
+        added = {n: s for n, s in got.items() if n not in expected}
+        if any(not s["items"] for s in added.values()):
+            sys.exit("not adding: a new study failed")
+        got = {n: s for n, s in got.items() if n in expected}
     passed, failed = compare(expected, got)
+    if args.add_new and not failed:
+        manifest["studies"].update(added)
+        with open(args.manifest, "w") as f:
+            json.dump(manifest, f, indent=1, sort_keys=True)
+            f.write("\n")
+        print(f"added {', '.join(sorted(added)) or 'no study'} to {args.manifest}")
     print(f"{passed} passed, {failed} failed")
     return 1 if failed else 0
 

@@ -78,7 +78,7 @@ class BadRobots(TempDirTest):
         cases = {
             "missing_urdf": ('[robot]\nurdf = "nope.urdf"\nbase = "a"\ntip = "b"\n', 2),
             "broken_urdf": ('[robot]\nurdf = "broken.urdf"\nbase = "a"\ntip = "b"\n', 2),
-            "unknown_tip": (f'[robot]\nurdf = "{STUDIES}/robots/arm7.urdf"\nbase = "base_link"\ntip = "tool"\n', 4),
+            "unknown_tip": (f'[robot]\nurdf = "{STUDIES}/robots/arm7.urdf"\nbase = "base_link"\ntip = "tool0"\n', 4),
             "out_of_reach": ('[robot]\nl = [0.3, 0.3, 0.3, 0.3]\nm = [1, 1, 1, 1]\n', None),
             "too_few_joints": ('[robot]\nl = [2, 2]\nm = [1, 1]\n', 4),
         }
@@ -106,9 +106,11 @@ class ChainStudies(TempDirTest):
             self.assertIn("tau7_inf", runs)
             status = [s.decode() if isinstance(s, bytes) else s for s in runs["status"][()]]
             self.assertIn("ok", status)
-            good = [i for i, s in enumerate(status) if s == "ok"]
-            # the tip follows the 3-D path: open-loop drift small against the 0.2 m square
-            self.assertLess(np.max(runs["max_tracking_error"][()][good]), 0.01)
+            method = [s.decode() if isinstance(s, bytes) else s for s in runs["method"][()]]
+            good = [i for i, s in enumerate(status) if s == "ok" and method[i] == "local_weighted"]
+            self.assertGreater(len(good), 20)
+            # the tip follows the 3-D path (RK4): open-loop drift small against the 0.2 m square
+            self.assertLess(np.max(runs["max_tracking_error"][()][good]), 1e-3)
             hist = f["histories"]
             name = sorted(hist)[0]
             self.assertEqual(hist[name]["q"].shape[1], 7)

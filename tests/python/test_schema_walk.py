@@ -60,7 +60,8 @@ class SchemaWalk(TempDirTest):
     def setUpClass(cls):
         out = subprocess.run([KS, "schema", "--format", "json"], capture_output=True, text=True, check=True).stdout
         cls.schema = json.loads(out)
-        cls.tables = {(k["kind"], k["family"]): k for k in cls.schema["kinds"]}
+        # the seed robot's families (a chain robot's tables are walked by test_robots.py's studies)
+        cls.tables = {(k["kind"], k["family"]): k for k in cls.schema["kinds"] if not k["family"].startswith("chain")}
 
     def run_walk(self):
         """name -> results file of each walk study."""
