@@ -3,10 +3,11 @@
 // instant: the seed's local methods (methods/resolution.hpp) for any number of joints n and any task
 // dimension m < n, and the non-redundant solve for m = n. Free functions on fixed-maximum-size types
 // (no allocation), templated on the task dimension m so the task-space matrices have fixed size.
-// Every inverse is a solve: a Cholesky factor of M (n x n) and one of A = J W^-1 J^T (m x m).
+// Every inverse is a solve: an LDL^T factor of M (n x n) and one of A = J W^-1 J^T (m x m).
 #include <Eigen/LU>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string_view>
 
 #include "methods/resolution.hpp"
@@ -100,62 +101,76 @@ double gram_determinant(const TaskJacobian<m>& J) {
   return d > 0.0 ? d : 0.0;
 }
 
-/// Cholesky factor of a small symmetric positive-definite matrix, A = L L^T (n <= Max), in plain loops
-/// over fixed-size storage: at n <= 8 Eigen's dynamic-size LLT and triangular solves cost several
-/// times more than the arithmetic. Keeps 1 / L_ii, so the solves multiply. A matrix that is not
-/// positive definite or not finite leaves NaN in the factor, which every solve carries to its output.
+/// LDL^T factor of a small symmetric positive-definite matrix, A = L D L^T with L unit lower
+/// triangular (n <= Max), in plain loops over fixed-size storage: at n <= 8 Eigen's dynamic-size LLT
+/// and triangular solves cost several times more than the arithmetic, and LDL^T keeps the square
+/// roots of a Cholesky factor off the step's dependency chain. Keeps 1 / D_i, so the solves multiply.
+/// A pivot that is not positive (or not finite) becomes NaN, which every solve carries to its output.
 template <int Max>
-struct SmallCholesky {
+struct SmallLdlt {
   int n = 0;
-  double L[Max][Max];  ///< lower triangle, row-major; L[i][j] for j <= i
-  double inv[Max];     ///< 1 / L[i][i]
+  double L[Max][Max];  ///< strictly lower triangle, row-major; L[i][j] for j < i (unit diagonal)
+  double d[Max];       ///< D_i
+  double inv_d[Max];   ///< 1 / D_i
 
   /// Factor the n x n matrix A (read through A(i, j), lower triangle).
   template <class Matrix>
   void compute(const Matrix& A, int n_) {
     n = n_;
+    double LD[Max];  // L[j][k] D_k of the current row j
     for (int j = 0; j < n; ++j) {
-      double d = A(j, j);
-      for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
-      L[j][j] = std::sqrt(d);
-      inv[j] = 1.0 / L[j][j];
+      double dj = A(j, j);
+      for (int k = 0; k < j; ++k) {
+        LD[k] = L[j][k] * d[k];
+        dj -= L[j][k] * LD[k];
+      }
+      d[j] = dj;
+      inv_d[j] = dj > 0.0 ? 1.0 / dj : std::numeric_limits<double>::quiet_NaN();
       for (int i = j + 1; i < n; ++i) {
         double s = A(i, j);
-        for (int k = 0; k < j; ++k) s -= L[i][k] * L[j][k];
-        L[i][j] = s * inv[j];
+        for (int k = 0; k < j; ++k) s -= L[i][k] * LD[k];
+        L[i][j] = s * inv_d[j];
       }
     }
   }
   /// x <- L^-1 x (x: n values).
   void forward(double* x) const {
-    for (int i = 0; i < n; ++i) {
+    for (int i = 1; i < n; ++i) {
       double s = x[i];
       for (int k = 0; k < i; ++k) s -= L[i][k] * x[k];
-      x[i] = s * inv[i];
+      x[i] = s;
     }
   }
   /// x <- L^-T x.
   void backward(double* x) const {
-    for (int i = n - 1; i >= 0; --i) {
+    for (int i = n - 2; i >= 0; --i) {
       double s = x[i];
       for (int k = i + 1; k < n; ++k) s -= L[k][i] * x[k];
-      x[i] = s * inv[i];
+      x[i] = s;
     }
   }
   /// x <- A^-1 x.
   void solve(double* x) const {
     forward(x);
+    for (int i = 0; i < n; ++i) x[i] *= inv_d[i];
     backward(x);
+  }
+  /// x^T A^-1 x; x is overwritten with L^-1 x.
+  double inverse_quadratic_form(double* x) const {
+    forward(x);
+    double q = 0;
+    for (int i = 0; i < n; ++i) q += x[i] * x[i] * inv_d[i];
+    return q;
   }
 };
 
 /// The factor of a chain's inertia matrix M (n x n).
-using InertiaFactor = SmallCholesky<kMaxJoints>;
+using InertiaFactor = SmallLdlt<kMaxJoints>;
 
 /// Local (instantaneous) resolution at acceleration level for a chain (seed Eqs. 51, 56, generalised):
 ///   qdd = J_W+ b - (I - J_W+ J) v,  J_W+ = W^-1 J^T (J W^-1 J^T)^-1,  v = M^-1 (c + k g) + K_N qd,
 /// computed as qdd = Y A^-1 (b + J v) - v with Y = W^-1 J^T (n x m, solves with the factor of M) and
-/// A = J Y (m x m, a Cholesky factor of its own).
+/// A = J Y (m x m, an LDL^T factor of its own).
 /// W = M (Weighting::inertia) minimises (qdd + v)^T M (qdd + v), i.e. with k = 1 and K_N = 0 the torque
 /// norm tau^T M^-1 tau, among the qdd with J qdd = b; W = M^2 (inertia_squared) minimises
 /// (qdd + v)^T M^2 (qdd + v), with k = 1 and K_N = 0 tau^T tau.
@@ -188,7 +203,7 @@ VecN local_acceleration(Weighting w, const InertiaFactor& Mf, const TaskJacobian
     for (int j = 0; j < n; ++j) jv += J(s, j) * v[j];
     r[s] = b[s] + jv;
   }
-  SmallCholesky<m> Af;
+  SmallLdlt<m> Af;
   Af.compute(A, m);
   Af.solve(r);
   VecN qdd(n);

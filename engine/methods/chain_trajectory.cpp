@@ -47,7 +47,7 @@ enum class Resolution { weighted, unweighted, nonredundant };
 template <int m>
 struct Evaluation {
   ChainState st;           // M, c, g, J (6 x n), bias, tip
-  InertiaFactor Mf;        // M = L L^T
+  InertiaFactor Mf;        // M = L D L^T
   TaskJacobian<m> Jt;      // task rows of J
   VecN qdd;
   double w2 = 0;           // det(Jt Jt^T) (local methods); unused by the non-redundant solve
@@ -174,11 +174,8 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
     }
     // metrics of this sample
     for (int j = 0; j < dof; ++j) inf[j] = std::max(inf[j], std::abs(tau[j]));
-    e.Mf.forward(z.data());  // tau^T M^-1 tau = |L^-1 tau|^2
-    double zz = 0;
-    for (int j = 0; j < dof; ++j) zz += z[j] * z[j];
     sumE += std::sqrt(tt);
-    sumEM += std::sqrt(zz);
+    sumEM += std::sqrt(e.Mf.inverse_quadratic_form(z.data()));  // tau^T M^-1 tau
     if constexpr (P == m && R != Resolution::nonredundant)
       min_w2 = std::min(min_w2, e.w2);
     else
