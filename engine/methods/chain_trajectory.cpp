@@ -1,7 +1,8 @@
 // simulate() for a chain: the closed form's loop (methods/trajectory.cpp) over the chain's dynamics
 // (model/chain_dynamics.hpp) and the resolutions of methods/chain_resolution.hpp. The task space and
 // the method are template parameters of the loop, chosen once per run: the step branches on neither.
-// Fixed-maximum-size types throughout: nothing is allocated per step.
+// Fixed-maximum-size types throughout: nothing is allocated per step. Planar tasks on planar chains of
+// revolute joints take the fixed-size run of methods/planar_chain_run.hpp instead.
 #include "methods/chain_trajectory.hpp"
 
 #include <cmath>
@@ -11,7 +12,9 @@
 #include <string>
 
 #include "common/name_table.hpp"
+#include "methods/planar_chain_run.hpp"
 #include "model/chain_dynamics.hpp"
+#include "model/planar_chain_dynamics.hpp"
 
 namespace ks {
 
@@ -303,6 +306,8 @@ TrajectoryMetrics simulate(const Chain& chain, const ChainTask& task, const VecN
   const std::optional<VecN> start = solve_start(chain, target, q0);
   if (!start) return unreachable(n);
 
+  // planar chains of revolute joints: the run on fixed-size types, chosen by the joint count
+  if (planar && planar_revolute(chain)) return planar_chain_run(chain, task, *start, o, alpha_profile, history);
   switch (task.space) {
     case TaskSpace::planar_position:
       return run_method<TaskSpace::planar_position>(chain, task, *start, o, alpha_profile, history);

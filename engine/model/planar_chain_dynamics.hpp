@@ -1,0 +1,207 @@
+#pragma once
+// Dynamics and tip kinematics of a planar chain of N revolute joints (N a compile-time constant), in
+// one pass over fixed-size arrays: the inner loop of a trajectory run (methods/planar_chain_run.hpp).
+// The algorithms are those of model/chain_dynamics.cpp's planar algebra (motion and force vectors in
+// the base frame at the base origin; composite inertias for M and g, one Newton-Euler pass for c and
+// the tip bias acceleration), specialised to revolute joints about +-z, with the chain's constants
+// read once per run into PlanarChainConstants and the frames carried as the cosine and sine of each
+// joint frame's absolute angle (PlanarChainTrig) instead of rotation matrices.
+#include <cmath>
+
+#include "model/chain.hpp"
+#include "model/sincos.hpp"
+
+namespace ks {
+
+/// True when the fixed-size planar kernel applies to `chain`: chain.planar() and every joint
+/// revolute. (Planar chains with prismatic joints take the general algorithms.)
+inline bool planar_revolute(const Chain& chain) {
+  if (!chain.planar()) return false;
+  for (const ChainJoint& j : chain.joints)
+    if (j.type != JointType::revolute) return false;
+  return true;
+}
+
+/// The constants of a planar revolute chain of N joints, in joint frames (see model/chain.hpp).
+/// Joint i's frame has the absolute angle phi_i = sum_{j <= i} (beta_j + sigma_j q_j) about z.
+template <int N>
+struct PlanarChainConstants {
+  double ox[N], oy[N];    ///< joint i's origin in joint i-1's frame (the base for i = 0) [m]
+  double beta[N];         ///< the angle of joint i's origin rotation about z [rad]
+  double sigma[N];        ///< z component of joint i's axis: +1 or -1 (within Chain::planar's tolerance) [-]
+  double m[N];            ///< body mass [kg]
+  double cx[N], cy[N];    ///< body centre of mass in joint i's frame [m]
+  double Izz[N];          ///< body inertia about z at its centre of mass [kg m^2]
+  double tx, ty;          ///< the tip origin in the last joint's frame [m]
+  double tip_angle;       ///< the tip frame's angle in the last joint's frame [rad]
+  double lx, ly;          ///< -gravity in the base frame [m/s^2]
+
+  /// Reads `chain` (planar_revolute(chain) and chain.dof() == N; not checked).
+  explicit PlanarChainConstants(const Chain& chain) {
+    for (int i = 0; i < N; ++i) {
+      const ChainJoint& j = chain.joints[static_cast<std::size_t>(i)];
+      ox[i] = j.origin.p.x();
+      oy[i] = j.origin.p.y();
+      beta[i] = std::atan2(j.origin.R(1, 0), j.origin.R(0, 0));
+      sigma[i] = j.axis.z();
+      m[i] = j.mass;
+      cx[i] = j.com.x();
+      cy[i] = j.com.y();
+      Izz[i] = j.inertia(2, 2);
+    }
+    tx = chain.tip.p.x();
+    ty = chain.tip.p.y();
+    tip_angle = std::atan2(chain.tip.R(1, 0), chain.tip.R(0, 0));
+    lx = -chain.gravity.x();
+    ly = -chain.gravity.y();
+  }
+
+  /// The absolute joint frame angles phi (N) at q (N) [rad].
+  void frame_angles(const double* q, double* phi) const {
+    double acc = 0.0;
+    for (int i = 0; i < N; ++i) {
+      acc += beta[i] + sigma[i] * q[i];
+      phi[i] = acc;
+    }
+  }
+};
+
+/// The cosines and sines of the joint frames' absolute angles, carried along a time-stepping loop:
+/// after a step q += dq, each frame turns by delta_i = sum_{j <= i} sigma_j dq_j, and its sine and
+/// cosine follow by a rotation through the Taylor series of sin and cos of delta_i (the next terms
+/// are below 2e-18 for |delta_i| < 0.01), which keeps the N sincos calls off the step's dependency
+/// chain. Every `resync` steps, or when a step is not small (some |delta_i| >= 0.01 rad), the values
+/// are evaluated directly. The schedule depends only on the step count and the values.
+template <int N>
+class PlanarChainTrig {
+ public:
+  static constexpr int resync = 64;
+  double s[N], c[N];  ///< sin and cos of phi_i
+
+  /// Direct evaluation at q (N) [rad].
+  void reset(const PlanarChainConstants<N>& k, const double* q) {
+    double phi[N];
+    k.frame_angles(q, phi);
+    for (int i = 0; i < N; ++i) fast_sincos(phi[i], s[i], c[i]);
+    steps_ = 0;
+  }
+  /// After q (N) has become q + dq.
+  void advance(const PlanarChainConstants<N>& k, const double* q, const double* dq) {
+    double d[N], acc = 0.0;
+    bool small = true;
+    for (int i = 0; i < N; ++i) {
+      acc += k.sigma[i] * dq[i];
+      d[i] = acc;
+      small = small && std::abs(acc) < 0.01;  // NaN is not small
+    }
+    if (++steps_ >= resync || !small) {
+      reset(k, q);
+      return;
+    }
+    for (int i = 0; i < N; ++i) {
+      const double z = d[i] * d[i], dz = d[i] * z;
+      const double sd = d[i] + dz * (-1.0 / 6 + z * (1.0 / 120));
+      const double cd = 1.0 + z * (-0.5 + z * (1.0 / 24 + z * (-1.0 / 720)));
+      const double sn = s[i] * cd + c[i] * sd;
+      c[i] = c[i] * cd - s[i] * sd;
+      s[i] = sn;
+    }
+  }
+
+ private:
+  int steps_ = 0;
+};
+
+/// What one step needs at (q, qd): M, c, g and the task rows of the tip Jacobian and of J̇ q̇.
+/// m = 2: tip x, y; m = 3: tip x, y and the angle about z.
+template <int N, int m>
+struct PlanarChainState {
+  double M[N][N];  ///< inertia matrix, both triangles [kg m^2]
+  double c[N];     ///< Coriolis and centrifugal torques [Nm]
+  double g[N];     ///< gravity torques [Nm]
+  double J[m][N];  ///< task rows of the tip Jacobian [m or rad per rad]
+  double bias[m];  ///< task rows of J̇ q̇ [m/s^2 or rad/s^2] (the angle's is 0)
+  double px, py;   ///< tip position [m]
+};
+
+/// Fill `st` from the frames' trig (s, c: N values each, see PlanarChainTrig) and qd (N) [rad/s].
+/// Motion vectors (w; vx, vy) are angular velocities and the velocities of the body point at the
+/// base origin; force vectors (fx, fy; n) forces and moments about the base origin. Joint i's unit
+/// twist is S_i = (sigma_i; sigma_i y_i, -sigma_i x_i) with (x_i, y_i) its origin. Revolute joints
+/// about z give no angular bias acceleration, so the accelerations have linear parts only.
+template <int N, int m>
+inline void planar_chain_state(const PlanarChainConstants<N>& __restrict k, const double* __restrict s,
+                               const double* __restrict c, const double* __restrict qd,
+                               PlanarChainState<N, m>& __restrict st) {
+  static_assert(m == 2 || m == 3);
+  // joint origins (x, y), unit twists S = (sw; svx, svy) and body inertias about the base origin:
+  // mass, first moment h, rotational J
+  double x[N], y[N], sw[N], svx[N], svy[N], hx[N], hy[N], Jz[N];
+  double xp = 0.0, yp = 0.0, cp = 1.0, sp = 0.0;
+  for (int i = 0; i < N; ++i) {
+    x[i] = xp + (cp * k.ox[i] - sp * k.oy[i]);
+    y[i] = yp + (sp * k.ox[i] + cp * k.oy[i]);
+    sw[i] = k.sigma[i];
+    svx[i] = sw[i] * y[i];
+    svy[i] = -sw[i] * x[i];
+    const double bx = x[i] + (c[i] * k.cx[i] - s[i] * k.cy[i]), by = y[i] + (s[i] * k.cx[i] + c[i] * k.cy[i]);
+    hx[i] = k.m[i] * bx;
+    hy[i] = k.m[i] * by;
+    Jz[i] = k.Izz[i] + (hx[i] * bx + hy[i] * by);
+    xp = x[i], yp = y[i], cp = c[i], sp = s[i];
+  }
+  const double px = xp + (cp * k.tx - sp * k.ty), py = yp + (sp * k.tx + cp * k.ty);
+  st.px = px;
+  st.py = py;
+
+  // outward: body velocities v, bias accelerations a (a.w = 0) and body forces I a + v x* (I v)
+  double vw = 0.0, vx = 0.0, vy = 0.0, ax = 0.0, ay = 0.0;
+  double fx[N], fy[N], fn[N];
+  for (int i = 0; i < N; ++i) {
+    const double jw = sw[i] * qd[i], jx = svx[i] * qd[i], jy = svy[i] * qd[i];
+    ax += jw * vy - vw * jy;
+    ay += vw * jx - jw * vx;
+    vw += jw;
+    vx += jx;
+    vy += jy;
+    const double mvx = k.m[i] * vx - vw * hy[i], mvy = k.m[i] * vy + vw * hx[i];  // linear momentum
+    fx[i] = k.m[i] * ax - vw * mvy;
+    fy[i] = k.m[i] * ay + vw * mvx;
+    fn[i] = (hx[i] * ay - hy[i] * ax) + (vx * mvy - vy * mvx);
+  }
+
+  // inward: summed forces for c, composite inertias for g and M
+  double Fx = 0.0, Fy = 0.0, Fn = 0.0, cm = 0.0, chx = 0.0, chy = 0.0, cJ = 0.0;
+  for (int j = N - 1; j >= 0; --j) {
+    Fx += fx[j];
+    Fy += fy[j];
+    Fn += fn[j];
+    cm += k.m[j];
+    chx += hx[j];
+    chy += hy[j];
+    cJ += Jz[j];
+    st.c[j] = sw[j] * Fn + svx[j] * Fx + svy[j] * Fy;
+    st.g[j] = sw[j] * (chx * k.ly - chy * k.lx) + cm * (svx[j] * k.lx + svy[j] * k.ly);
+    // Ic S_j
+    const double Gx = cm * svx[j] - sw[j] * chy, Gy = cm * svy[j] + sw[j] * chx;
+    const double Gn = cJ * sw[j] + (chx * svy[j] - chy * svx[j]);
+    for (int i = 0; i <= j; ++i) {
+      const double Mij = sw[i] * Gn + svx[i] * Gx + svy[i] * Gy;
+      st.M[i][j] = Mij;
+      st.M[j][i] = Mij;
+    }
+  }
+
+  // tip rows: the twists moved to the tip point, and the tip's classical bias acceleration
+  for (int i = 0; i < N; ++i) {
+    st.J[0][i] = svx[i] - sw[i] * py;
+    st.J[1][i] = svy[i] + sw[i] * px;
+    if constexpr (m == 3) st.J[2][i] = sw[i];
+  }
+  const double vpx = vx - vw * py, vpy = vy + vw * px;
+  st.bias[0] = ax - vw * vpy;
+  st.bias[1] = ay + vw * vpx;
+  if constexpr (m == 3) st.bias[2] = 0.0;
+}
+
+}  // namespace ks
