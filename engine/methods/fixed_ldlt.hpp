@@ -17,7 +17,7 @@ struct FixedLdlt {
   double inv_d[N];  ///< 1 / D_i
 
   /// Factor A, read through its lower triangle A[i][j], j <= i.
-  void compute(const double (&A)[N][N]) {
+  [[gnu::always_inline]] void compute(const double (&A)[N][N]) {
     for (int j = 0; j < N; ++j) {
       double LD[N];  // L[j][k] D_k of row j
       double dj = A[j][j];
@@ -35,7 +35,7 @@ struct FixedLdlt {
     }
   }
   /// x <- L^-1 x (N values).
-  void forward(double* x) const {
+  [[gnu::always_inline]] void forward(double* x) const {
     for (int i = 1; i < N; ++i) {
       double s = x[i];
       for (int k = 0; k < i; ++k) s -= L[i][k] * x[k];
@@ -43,7 +43,7 @@ struct FixedLdlt {
     }
   }
   /// x <- L^-T x.
-  void backward(double* x) const {
+  [[gnu::always_inline]] void backward(double* x) const {
     for (int i = N - 2; i >= 0; --i) {
       double s = x[i];
       for (int k = i + 1; k < N; ++k) s -= L[k][i] * x[k];
@@ -51,13 +51,13 @@ struct FixedLdlt {
     }
   }
   /// x <- A^-1 x.
-  void solve(double* x) const {
+  [[gnu::always_inline]] void solve(double* x) const {
     forward(x);
     for (int i = 0; i < N; ++i) x[i] *= inv_d[i];
     backward(x);
   }
   /// x^T A^-1 x; x is overwritten with L^-1 x.
-  double inverse_quadratic_form(double* x) const {
+  [[gnu::always_inline]] double inverse_quadratic_form(double* x) const {
     forward(x);
     double q = 0;
     for (int i = 0; i < N; ++i) q += x[i] * x[i] * inv_d[i];

@@ -125,18 +125,17 @@ struct PlanarChainState {
 };
 
 /// Fill `st` from the frames' trig (s, c: N values each, see PlanarChainTrig) and qd (N) [rad/s].
-/// Motion vectors (w; vx, vy) are angular velocities and the velocities of the body point at the
-/// base origin; force vectors (fx, fy; n) forces and moments about the base origin. Joint i's unit
-/// twist is S_i = (sigma_i; sigma_i y_i, -sigma_i x_i) with (x_i, y_i) its origin. Revolute joints
-/// about z give no angular bias acceleration, so the accelerations have linear parts only.
+/// Joint i's unit twist is S_i = (sigma_i; sigma_i y_i, -sigma_i x_i) with (x_i, y_i) its origin
+/// (angular part; velocity of the body point at the base origin); force vectors (fx, fy; n) are
+/// forces and moments about the base origin, so that a joint's torque is S_i . F.
 template <int N, int m>
-inline void planar_chain_state(const PlanarChainConstants<N>& __restrict k, const double* __restrict s,
+[[gnu::always_inline]] inline void planar_chain_state(const PlanarChainConstants<N>& __restrict k, const double* __restrict s,
                                const double* __restrict c, const double* __restrict qd,
                                PlanarChainState<N, m>& __restrict st) {
   static_assert(m == 2 || m == 3);
-  // joint origins (x, y), unit twists S = (sw; svx, svy) and body inertias about the base origin:
-  // mass, first moment h, rotational J
-  double x[N], y[N], sw[N], svx[N], svy[N], hx[N], hy[N], Jz[N];
+  // joint origins (x, y), unit twists S = (sw; svx, svy), centres of mass relative to the joint
+  // origins (dx, dy) and body inertias about the base origin: mass, first moment h, rotational J
+  double x[N], y[N], sw[N], svx[N], svy[N], dx[N], dy[N], hx[N], hy[N], Jz[N];
   double xp = 0.0, yp = 0.0, cp = 1.0, sp = 0.0;
   for (int i = 0; i < N; ++i) {
     x[i] = xp + (cp * k.ox[i] - sp * k.oy[i]);
@@ -144,7 +143,9 @@ inline void planar_chain_state(const PlanarChainConstants<N>& __restrict k, cons
     sw[i] = k.sigma[i];
     svx[i] = sw[i] * y[i];
     svy[i] = -sw[i] * x[i];
-    const double bx = x[i] + (c[i] * k.cx[i] - s[i] * k.cy[i]), by = y[i] + (s[i] * k.cx[i] + c[i] * k.cy[i]);
+    dx[i] = c[i] * k.cx[i] - s[i] * k.cy[i];
+    dy[i] = s[i] * k.cx[i] + c[i] * k.cy[i];
+    const double bx = x[i] + dx[i], by = y[i] + dy[i];
     hx[i] = k.m[i] * bx;
     hy[i] = k.m[i] * by;
     Jz[i] = k.Izz[i] + (hx[i] * bx + hy[i] * by);
@@ -154,23 +155,26 @@ inline void planar_chain_state(const PlanarChainConstants<N>& __restrict k, cons
   st.px = px;
   st.py = py;
 
-  // outward: body velocities v, bias accelerations a (a.w = 0) and body forces I a + v x* (I v)
-  double vw = 0.0, vx = 0.0, vy = 0.0, ax = 0.0, ay = 0.0;
+  // outward, with qdd = 0: angular velocities w, joint origin accelerations ao (each origin is a
+  // point of the previous body, which turns at constant rate: ao_i = ao_{i-1} - w_{i-1}^2 (o_i -
+  // o_{i-1})) and the centres of mass' (ab_i = ao_i - w_i^2 d_i); the bodies' inertial forces m ab
+  // and their moments about the base origin b x m ab (the angular accelerations are zero)
+  double w = 0.0, w2 = 0.0, aox = 0.0, aoy = 0.0;
   double fx[N], fy[N], fn[N];
   for (int i = 0; i < N; ++i) {
-    const double jw = sw[i] * qd[i], jx = svx[i] * qd[i], jy = svy[i] * qd[i];
-    ax += jw * vy - vw * jy;
-    ay += vw * jx - jw * vx;
-    vw += jw;
-    vx += jx;
-    vy += jy;
-    const double mvx = k.m[i] * vx - vw * hy[i], mvy = k.m[i] * vy + vw * hx[i];  // linear momentum
-    fx[i] = k.m[i] * ax - vw * mvy;
-    fy[i] = k.m[i] * ay + vw * mvx;
-    fn[i] = (hx[i] * ay - hy[i] * ax) + (vx * mvy - vy * mvx);
+    if (i > 0) {
+      aox -= w2 * (x[i] - x[i - 1]);
+      aoy -= w2 * (y[i] - y[i - 1]);
+    }
+    w += sw[i] * qd[i];
+    w2 = w * w;
+    fx[i] = k.m[i] * (aox - w2 * dx[i]);
+    fy[i] = k.m[i] * (aoy - w2 * dy[i]);
+    fn[i] = (x[i] + dx[i]) * fy[i] - (y[i] + dy[i]) * fx[i];
   }
 
-  // inward: summed forces for c, composite inertias for g and M
+  // inward: c_j = sigma_j z . sum_{i >= j} (b_i - o_j) x m_i ab_i from the summed forces and
+  // moments; composite inertias for g and M
   double Fx = 0.0, Fy = 0.0, Fn = 0.0, cm = 0.0, chx = 0.0, chy = 0.0, cJ = 0.0;
   for (int j = N - 1; j >= 0; --j) {
     Fx += fx[j];
@@ -192,15 +196,14 @@ inline void planar_chain_state(const PlanarChainConstants<N>& __restrict k, cons
     }
   }
 
-  // tip rows: the twists moved to the tip point, and the tip's classical bias acceleration
+  // tip rows: the twists moved to the tip point, and the tip's acceleration at qdd = 0
   for (int i = 0; i < N; ++i) {
     st.J[0][i] = svx[i] - sw[i] * py;
     st.J[1][i] = svy[i] + sw[i] * px;
     if constexpr (m == 3) st.J[2][i] = sw[i];
   }
-  const double vpx = vx - vw * py, vpy = vy + vw * px;
-  st.bias[0] = ax - vw * vpy;
-  st.bias[1] = ay + vw * vpx;
+  st.bias[0] = aox - w2 * (px - xp);
+  st.bias[1] = aoy - w2 * (py - yp);
   if constexpr (m == 3) st.bias[2] = 0.0;
 }
 
