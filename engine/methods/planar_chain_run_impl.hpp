@@ -185,16 +185,17 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
   const PlanarChainConstants<N> k(chain);
   const double alpha_offset = PlanarAngle(chain).offset;
   const Stepper<N, S, R> stepper(k, path, o, alpha_profile);
-  const auto alpha_of = [&](const double* q) {
+  const auto alpha_of = [&](const double* u) {  // the tip angle at u [rad]
     double a = 0;
-    for (int j = 0; j < N; ++j) a += k.sigma[j] * q[j];
+    for (int j = 0; j < N; ++j) a += u[j];
     return alpha_offset + a;
   };
 
   TrajectoryMetrics out;
   Evaluation<N, m> e, s;  // e: at the sample; s: RK4 stages
+  // q, qd, qdd, tau: in the coordinates u = sigma q of the kernel (model/planar_chain_dynamics.hpp)
   double q[N], qd[N], tau[N], inf[N];
-  for (int j = 0; j < N; ++j) q[j] = q_start[j], qd[j] = 0.0, inf[j] = 0.0;
+  for (int j = 0; j < N; ++j) q[j] = k.sigma[j] * q_start[j], qd[j] = 0.0, inf[j] = 0.0;
   PlanarChainTrig<N> trig, stage;  // trig: the sample's, carried from step to step (semi-implicit Euler)
   trig.reset(k, q);
   RootSums roots;
@@ -256,10 +257,10 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       const Eigen::Index col = history->size++;
       history->t[col] = t;
       for (int j = 0; j < N; ++j) {
-        history->q(j, col) = q[j];
-        history->qd(j, col) = qd[j];
-        history->qdd(j, col) = e.qdd[j];
-        history->tau(j, col) = tau[j];
+        history->q(j, col) = k.sigma[j] * q[j];
+        history->qd(j, col) = k.sigma[j] * qd[j];
+        history->qdd(j, col) = k.sigma[j] * e.qdd[j];
+        history->tau(j, col) = k.sigma[j] * tau[j];
       }
       history->x(0, col) = e.st.px;
       history->x(1, col) = e.st.py;

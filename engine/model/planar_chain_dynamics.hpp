@@ -1,11 +1,16 @@
 #pragma once
 // Dynamics and tip kinematics of a planar chain of N revolute joints (N a compile-time constant), in
 // one pass over fixed-size arrays: the inner loop of a trajectory run (methods/planar_chain_run.hpp).
-// The algorithms are those of model/chain_dynamics.cpp's planar algebra (motion and force vectors in
-// the base frame at the base origin; composite inertias for M and g, one Newton-Euler pass for c and
-// the tip bias acceleration), specialised to revolute joints about +-z, with the chain's constants
-// read once per run into PlanarChainConstants and the frames carried as the cosine and sine of each
+// Vectors in the base frame; composite inertias about the base origin for M and g (as in
+// model/chain_dynamics.cpp's planar algebra), and c and the tip's J̇ u̇ from the bodies' accelerations
+// at zero joint accelerations, one outward and one inward pass; the chain's constants read once per run into PlanarChainConstants and the frames carried as the cosine and sine of each
 // joint frame's absolute angle (PlanarChainTrig) instead of rotation matrices.
+//
+// Joint coordinates: everything here is written in u_i = sigma_i q_i, with sigma_i = +1 or -1 the
+// direction of joint i's axis along z, i.e. as if every axis were +z. With D = diag(sigma) (D = D^-1),
+// the chain's own quantities are q = D u, tau = D tau_u, M = D M_u D, J = J_u D: the run maps its
+// inputs and outputs exactly (a multiplication by +-1), and every redundancy resolution of
+// methods/chain_resolution.hpp gives the same joint motion in either coordinates.
 #include <cmath>
 
 #include "model/chain.hpp"
@@ -14,7 +19,8 @@
 namespace ks {
 
 /// True when the fixed-size planar kernel applies to `chain`: chain.planar() and every joint
-/// revolute. (Planar chains with prismatic joints take the general algorithms.)
+/// revolute. (Planar chains with prismatic joints take the general algorithms.) The kernel takes each
+/// axis as exactly +z or -z (Chain::planar allows 1e-12 off).
 inline bool planar_revolute(const Chain& chain) {
   if (!chain.planar()) return false;
   for (const ChainJoint& j : chain.joints)
@@ -23,12 +29,12 @@ inline bool planar_revolute(const Chain& chain) {
 }
 
 /// The constants of a planar revolute chain of N joints, in joint frames (see model/chain.hpp).
-/// Joint i's frame has the absolute angle phi_i = sum_{j <= i} (beta_j + sigma_j q_j) about z.
+/// Joint i's frame has the absolute angle phi_i = sum_{j <= i} (beta_j + u_j) about z, u_j = sigma_j q_j.
 template <int N>
 struct PlanarChainConstants {
   double ox[N], oy[N];    ///< joint i's origin in joint i-1's frame (the base for i = 0) [m]
   double beta[N];         ///< the angle of joint i's origin rotation about z [rad]
-  double sigma[N];        ///< z component of joint i's axis: +1 or -1 (within Chain::planar's tolerance) [-]
+  double sigma[N];        ///< direction of joint i's axis: +1 (+z) or -1 (-z), the sign of axis.z() [-]
   double m[N];            ///< body mass [kg]
   double cx[N], cy[N];    ///< body centre of mass in joint i's frame [m]
   double Izz[N];          ///< body inertia about z at its centre of mass [kg m^2]
@@ -43,7 +49,7 @@ struct PlanarChainConstants {
       ox[i] = j.origin.p.x();
       oy[i] = j.origin.p.y();
       beta[i] = std::atan2(j.origin.R(1, 0), j.origin.R(0, 0));
-      sigma[i] = j.axis.z();
+      sigma[i] = j.axis.z() > 0.0 ? 1.0 : -1.0;
       m[i] = j.mass;
       cx[i] = j.com.x();
       cy[i] = j.com.y();
@@ -56,18 +62,18 @@ struct PlanarChainConstants {
     ly = -chain.gravity.y();
   }
 
-  /// The absolute joint frame angles phi (N) at q (N) [rad].
-  void frame_angles(const double* q, double* phi) const {
+  /// The absolute joint frame angles phi (N) at u (N) [rad].
+  void frame_angles(const double* u, double* phi) const {
     double acc = 0.0;
     for (int i = 0; i < N; ++i) {
-      acc += beta[i] + sigma[i] * q[i];
+      acc += beta[i] + u[i];
       phi[i] = acc;
     }
   }
 };
 
 /// The cosines and sines of the joint frames' absolute angles, carried along a time-stepping loop:
-/// after a step q += dq, each frame turns by delta_i = sum_{j <= i} sigma_j dq_j, and its sine and
+/// after a step u += du, each frame turns by delta_i = sum_{j <= i} du_j, and its sine and
 /// cosine follow by a rotation through the Taylor series of sin and cos of delta_i (the next terms
 /// are below 2e-18 for |delta_i| < 0.01), which keeps the N sincos calls off the step's dependency
 /// chain. Every `resync` steps, or when a step is not small (some |delta_i| >= 0.01 rad), the values
@@ -78,24 +84,24 @@ class PlanarChainTrig {
   static constexpr int resync = 64;
   double s[N], c[N];  ///< sin and cos of phi_i
 
-  /// Direct evaluation at q (N) [rad].
-  void reset(const PlanarChainConstants<N>& k, const double* q) {
+  /// Direct evaluation at u (N) [rad].
+  void reset(const PlanarChainConstants<N>& k, const double* u) {
     double phi[N];
-    k.frame_angles(q, phi);
+    k.frame_angles(u, phi);
     for (int i = 0; i < N; ++i) fast_sincos(phi[i], s[i], c[i]);
     steps_ = 0;
   }
-  /// After q (N) has become q + dq.
-  void advance(const PlanarChainConstants<N>& k, const double* q, const double* dq) {
+  /// After u (N) has become u + du.
+  void advance(const PlanarChainConstants<N>& k, const double* u, const double* du) {
     double d[N], acc = 0.0;
     bool small = true;
     for (int i = 0; i < N; ++i) {
-      acc += k.sigma[i] * dq[i];
+      acc += du[i];
       d[i] = acc;
       small = small && std::abs(acc) < 0.01;  // NaN is not small
     }
     if (++steps_ >= resync || !small) {
-      reset(k, q);
+      reset(k, u);
       return;
     }
     for (int i = 0; i < N; ++i) {
@@ -112,8 +118,8 @@ class PlanarChainTrig {
   int steps_ = 0;
 };
 
-/// What one step needs at (q, qd): M, c, g and the task rows of the tip Jacobian and of J̇ q̇.
-/// m = 2: tip x, y; m = 3: tip x, y and the angle about z.
+/// What one step needs at (u, ud): M, c, g and the task rows of the tip Jacobian and of J̇ u̇, in the
+/// coordinates u (see above). m = 2: tip x, y; m = 3: tip x, y and the angle about z.
 template <int N, int m>
 struct PlanarChainState {
   double M[N][N];  ///< inertia matrix, both triangles [kg m^2]
@@ -124,25 +130,27 @@ struct PlanarChainState {
   double px, py;   ///< tip position [m]
 };
 
-/// Fill `st` from the frames' trig (s, c: N values each, see PlanarChainTrig) and qd (N) [rad/s].
-/// Joint i's unit twist is S_i = (sigma_i; sigma_i y_i, -sigma_i x_i) with (x_i, y_i) its origin
+/// Fill `st` from the frames' trig (s, c: N values each, see PlanarChainTrig) and ud (N) [rad/s].
+/// Joint i's unit twist is S_i = (1; y_i, -x_i) with (x_i, y_i) its origin
 /// (angular part; velocity of the body point at the base origin); force vectors (fx, fy; n) are
 /// forces and moments about the base origin, so that a joint's torque is S_i . F.
 template <int N, int m>
 [[gnu::always_inline]] inline void planar_chain_state(const PlanarChainConstants<N>& __restrict k, const double* __restrict s,
-                               const double* __restrict c, const double* __restrict qd,
+                               const double* __restrict c, const double* __restrict ud,
                                PlanarChainState<N, m>& __restrict st) {
   static_assert(m == 2 || m == 3);
-  // joint origins (x, y), unit twists S = (sw; svx, svy), centres of mass relative to the joint
-  // origins (dx, dy) and body inertias about the base origin: mass, first moment h, rotational J
-  double x[N], y[N], sw[N], svx[N], svy[N], dx[N], dy[N], hx[N], hy[N], Jz[N];
+  // joint origins (x, y), centres of mass relative to them (dx, dy) and body inertias about the
+  // base origin: mass, first moment h, rotational J
+  double x[N], y[N], dx[N], dy[N], hx[N], hy[N], Jz[N];
   double xp = 0.0, yp = 0.0, cp = 1.0, sp = 0.0;
   for (int i = 0; i < N; ++i) {
-    x[i] = xp + (cp * k.ox[i] - sp * k.oy[i]);
-    y[i] = yp + (sp * k.ox[i] + cp * k.oy[i]);
-    sw[i] = k.sigma[i];
-    svx[i] = sw[i] * y[i];
-    svy[i] = -sw[i] * x[i];
+    if (i == 0) {  // the base frame
+      x[i] = k.ox[i];
+      y[i] = k.oy[i];
+    } else {
+      x[i] = xp + (cp * k.ox[i] - sp * k.oy[i]);
+      y[i] = yp + (sp * k.ox[i] + cp * k.oy[i]);
+    }
     dx[i] = c[i] * k.cx[i] - s[i] * k.cy[i];
     dy[i] = s[i] * k.cx[i] + c[i] * k.cy[i];
     const double bx = x[i] + dx[i], by = y[i] + dy[i];
@@ -155,10 +163,10 @@ template <int N, int m>
   st.px = px;
   st.py = py;
 
-  // outward, with qdd = 0: angular velocities w, joint origin accelerations ao (each origin is a
-  // point of the previous body, which turns at constant rate: ao_i = ao_{i-1} - w_{i-1}^2 (o_i -
-  // o_{i-1})) and the centres of mass' (ab_i = ao_i - w_i^2 d_i); the bodies' inertial forces m ab
-  // and their moments about the base origin b x m ab (the angular accelerations are zero)
+  // outward, with the accelerations zero: angular velocities w, joint origin accelerations ao (each
+  // origin is a point of the previous body, which turns at a constant rate: ao_i = ao_{i-1} -
+  // w_{i-1}^2 (o_i - o_{i-1})) and the centres of mass' (ab_i = ao_i - w_i^2 d_i); the bodies'
+  // inertial forces m ab and their moments about the base origin b x m ab (no angular acceleration)
   double w = 0.0, w2 = 0.0, aox = 0.0, aoy = 0.0;
   double fx[N], fy[N], fn[N];
   for (int i = 0; i < N; ++i) {
@@ -166,15 +174,15 @@ template <int N, int m>
       aox -= w2 * (x[i] - x[i - 1]);
       aoy -= w2 * (y[i] - y[i - 1]);
     }
-    w += sw[i] * qd[i];
+    w += ud[i];
     w2 = w * w;
     fx[i] = k.m[i] * (aox - w2 * dx[i]);
     fy[i] = k.m[i] * (aoy - w2 * dy[i]);
     fn[i] = (x[i] + dx[i]) * fy[i] - (y[i] + dy[i]) * fx[i];
   }
 
-  // inward: c_j = sigma_j z . sum_{i >= j} (b_i - o_j) x m_i ab_i from the summed forces and
-  // moments; composite inertias for g and M
+  // inward: c_j = S_j . F_j = z . sum_{i >= j} (b_i - o_j) x m_i ab_i from the summed forces F and
+  // moments; composite inertias Ic for g_j = S_j . (Ic_j (-gravity)) and M_ij = S_i . (Ic_j S_j)
   double Fx = 0.0, Fy = 0.0, Fn = 0.0, cm = 0.0, chx = 0.0, chy = 0.0, cJ = 0.0;
   for (int j = N - 1; j >= 0; --j) {
     Fx += fx[j];
@@ -184,23 +192,22 @@ template <int N, int m>
     chx += hx[j];
     chy += hy[j];
     cJ += Jz[j];
-    st.c[j] = sw[j] * Fn + svx[j] * Fx + svy[j] * Fy;
-    st.g[j] = sw[j] * (chx * k.ly - chy * k.lx) + cm * (svx[j] * k.lx + svy[j] * k.ly);
-    // Ic S_j
-    const double Gx = cm * svx[j] - sw[j] * chy, Gy = cm * svy[j] + sw[j] * chx;
-    const double Gn = cJ * sw[j] + (chx * svy[j] - chy * svx[j]);
+    st.c[j] = Fn + (y[j] * Fx - x[j] * Fy);
+    st.g[j] = (chx * k.ly - chy * k.lx) + cm * (y[j] * k.lx - x[j] * k.ly);
+    const double Gx = cm * y[j] - chy, Gy = chx - cm * x[j];  // Ic_j S_j
+    const double Gn = cJ - (chx * x[j] + chy * y[j]);
     for (int i = 0; i <= j; ++i) {
-      const double Mij = sw[i] * Gn + svx[i] * Gx + svy[i] * Gy;
+      const double Mij = Gn + (y[i] * Gx - x[i] * Gy);
       st.M[i][j] = Mij;
       st.M[j][i] = Mij;
     }
   }
 
-  // tip rows: the twists moved to the tip point, and the tip's acceleration at qdd = 0
+  // tip rows: the twists moved to the tip point, and the tip's acceleration at zero accelerations
   for (int i = 0; i < N; ++i) {
-    st.J[0][i] = svx[i] - sw[i] * py;
-    st.J[1][i] = svy[i] + sw[i] * px;
-    if constexpr (m == 3) st.J[2][i] = sw[i];
+    st.J[0][i] = y[i] - py;
+    st.J[1][i] = px - x[i];
+    if constexpr (m == 3) st.J[2][i] = 1.0;
   }
   st.bias[0] = aox - w2 * (px - xp);
   st.bias[1] = aoy - w2 * (py - yp);
