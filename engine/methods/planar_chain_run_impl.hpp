@@ -319,7 +319,8 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
   }
   out.samples = done;
   roots.flush();
-  out.tau_inf = Eigen::Map<const Eigen::Matrix<double, N, 1>>(inf);
+  out.tau_inf.resize(N);
+  for (int j = 0; j < N; ++j) out.tau_inf[j] = inf[j];
   if (done > 0) {
     out.E = roots.sumE / static_cast<double>(done);
     out.E_M = roots.sumEM / static_cast<double>(done);
