@@ -187,7 +187,8 @@ TEST(ChainResolution, SatisfiesTheTaskAndMatchesTheKktSolve) {
       TaskVec<m> b;
       for (int r = 0; r < m; ++r) b[r] = 3.0 * U(rng);
       const double k = trial % 3 == 0 ? 1.0 : 0.3, KN = trial % 2 ? 1.5 : 0.0;
-      const Eigen::LLT<MatN> llt(st.M);
+      InertiaFactor llt;
+      llt.compute(st.M, n);
       const VecN u = st.c + k * st.g;
       const Eigen::MatrixXd M = st.M;
       const Eigen::PartialPivLU<Eigen::MatrixXd> Mlu(M);
@@ -235,7 +236,8 @@ TEST(ChainResolution, WeightedMinimisesTauMInvTauInTheNullSpace) {
   TaskJacobian<m> J;
   select_task_rows<TaskSpace::planar_position>(st.J, J);
   const TaskVec<m> b(0.4, -0.7);
-  const Eigen::LLT<MatN> llt(st.M);
+  InertiaFactor llt;
+  llt.compute(st.M, 5);
   const VecN u = st.c + st.g;
   const VecN qdd = local_acceleration<m>(Weighting::inertia, llt, J, b, u, 0.0, qd);
   const Eigen::MatrixXd M = st.M;

@@ -3,11 +3,11 @@
 // instant: the seed's local methods (methods/resolution.hpp) for any number of joints n and any task
 // dimension m < n, and the non-redundant solve for m = n. Free functions on fixed-maximum-size types
 // (no allocation), templated on the task dimension m so the task-space matrices have fixed size.
-// Every inverse is a solve: an LLT of M (n x n) and one of A = J W^-1 J^T (m x m).
-#include <Eigen/Cholesky>
+// Every inverse is a solve: an LDL^T factor of M (n x n) and one of A = J W^-1 J^T (m x m).
 #include <Eigen/LU>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string_view>
 
 #include "methods/resolution.hpp"
@@ -87,7 +87,12 @@ double gram_determinant(const TaskJacobian<m>& J) {
   static_assert(k <= m);
   double d;
   if constexpr (k == 2) {
-    const double a = J.row(0).squaredNorm(), b = J.row(0).dot(J.row(1)), c = J.row(1).squaredNorm();
+    double a = 0, b = 0, c = 0;
+    for (Eigen::Index j = 0; j < J.cols(); ++j) {
+      a += J(0, j) * J(0, j);
+      b += J(0, j) * J(1, j);
+      c += J(1, j) * J(1, j);
+    }
     d = a * c - b * b;
   } else {
     const TaskMat<k> G = J.template topRows<k>() * J.template topRows<k>().transpose();
@@ -96,28 +101,117 @@ double gram_determinant(const TaskJacobian<m>& J) {
   return d > 0.0 ? d : 0.0;
 }
 
+/// LDL^T factor of a small symmetric positive-definite matrix, A = L D L^T with L unit lower
+/// triangular (n <= Max), in plain loops over fixed-size storage: at n <= 8 Eigen's dynamic-size LLT
+/// and triangular solves cost several times more than the arithmetic, and LDL^T keeps the square
+/// roots of a Cholesky factor off the step's dependency chain. Keeps 1 / D_i, so the solves multiply.
+/// A pivot that is not positive (or not finite) becomes NaN, which every solve carries to its output.
+template <int Max>
+struct SmallLdlt {
+  int n = 0;
+  double L[Max][Max];  ///< strictly lower triangle, row-major; L[i][j] for j < i (unit diagonal)
+  double d[Max];       ///< D_i
+  double inv_d[Max];   ///< 1 / D_i
+
+  /// Factor the n x n matrix A (read through A(i, j), lower triangle).
+  template <class Matrix>
+  void compute(const Matrix& A, int n_) {
+    n = n_;
+    double LD[Max];  // L[j][k] D_k of the current row j
+    for (int j = 0; j < n; ++j) {
+      double dj = A(j, j);
+      for (int k = 0; k < j; ++k) {
+        LD[k] = L[j][k] * d[k];
+        dj -= L[j][k] * LD[k];
+      }
+      d[j] = dj;
+      inv_d[j] = dj > 0.0 ? 1.0 / dj : std::numeric_limits<double>::quiet_NaN();
+      for (int i = j + 1; i < n; ++i) {
+        double s = A(i, j);
+        for (int k = 0; k < j; ++k) s -= L[i][k] * LD[k];
+        L[i][j] = s * inv_d[j];
+      }
+    }
+  }
+  /// x <- L^-1 x (x: n values).
+  void forward(double* x) const {
+    for (int i = 1; i < n; ++i) {
+      double s = x[i];
+      for (int k = 0; k < i; ++k) s -= L[i][k] * x[k];
+      x[i] = s;
+    }
+  }
+  /// x <- L^-T x.
+  void backward(double* x) const {
+    for (int i = n - 2; i >= 0; --i) {
+      double s = x[i];
+      for (int k = i + 1; k < n; ++k) s -= L[k][i] * x[k];
+      x[i] = s;
+    }
+  }
+  /// x <- A^-1 x.
+  void solve(double* x) const {
+    forward(x);
+    for (int i = 0; i < n; ++i) x[i] *= inv_d[i];
+    backward(x);
+  }
+  /// x^T A^-1 x; x is overwritten with L^-1 x.
+  double inverse_quadratic_form(double* x) const {
+    forward(x);
+    double q = 0;
+    for (int i = 0; i < n; ++i) q += x[i] * x[i] * inv_d[i];
+    return q;
+  }
+};
+
+/// The factor of a chain's inertia matrix M (n x n).
+using InertiaFactor = SmallLdlt<kMaxJoints>;
+
 /// Local (instantaneous) resolution at acceleration level for a chain (seed Eqs. 51, 56, generalised):
 ///   qdd = J_W+ b - (I - J_W+ J) v,  J_W+ = W^-1 J^T (J W^-1 J^T)^-1,  v = M^-1 (c + k g) + K_N qd,
-/// computed as qdd = Y A^-1 (b + J v) - v with Y = W^-1 J^T (n x m) and A = J Y (m x m, an LLT).
-/// W = M (Weighting::inertia) minimises (tau - (1 - k) g)^T M^-1 (tau - (1 - k) g) among the qdd with
-/// J qdd = b when K_N = 0; W = M^2 (inertia_squared) the same in the identity norm.
-/// Inputs: Mllt, the LLT of M [kg m^2]; J (m x n), the task Jacobian [m or rad per joint unit];
-/// b (m) = task acceleration - task rows of J̇ q̇ [m/s^2 or rad/s^2]; u = c + k g [Nm]; K_N [1/s];
-/// qd [rad/s]. Output: qdd (n) [rad/s^2]. Non-finite input or a singular J gives non-finite output.
+/// computed as qdd = Y A^-1 (b + J v) - v with Y = W^-1 J^T (n x m, solves with the factor of M) and
+/// A = J Y (m x m, an LDL^T factor of its own).
+/// W = M (Weighting::inertia) minimises (qdd + v)^T M (qdd + v), i.e. with k = 1 and K_N = 0 the torque
+/// norm tau^T M^-1 tau, among the qdd with J qdd = b; W = M^2 (inertia_squared) minimises
+/// (qdd + v)^T M^2 (qdd + v), with k = 1 and K_N = 0 tau^T tau.
+/// Inputs: Mf, the factor of M [kg m^2]; J (m x n), the task Jacobian [m or rad per joint unit];
+/// b (m) = task acceleration - task rows of J̇ q̇ [m/s^2 or rad/s^2]; u = c + k g (n) [Nm]; K_N [1/s];
+/// qd (n) [rad/s]. Output: qdd (n) [rad/s^2]. Non-finite input or a singular J gives non-finite output.
 template <int m>
-VecN local_acceleration(Weighting w, const Eigen::LLT<MatN>& Mllt, const TaskJacobian<m>& J, const TaskVec<m>& b,
+VecN local_acceleration(Weighting w, const InertiaFactor& Mf, const TaskJacobian<m>& J, const TaskVec<m>& b,
                         const VecN& u, double K_N, const VecN& qd) {
-  JointTaskMat<m> Y = J.transpose();
-  Mllt.solveInPlace(Y);
-  if (w == Weighting::inertia_squared) Mllt.solveInPlace(Y);
-  VecN v = u;
-  Mllt.solveInPlace(v);
-  if (K_N != 0.0) v += K_N * qd;
-  const TaskMat<m> A = J * Y;
-  TaskVec<m> r = b + J * v;
-  Eigen::LLT<TaskMat<m>>(A).solveInPlace(r);
-  VecN qdd = Y * r;
-  qdd -= v;
+  const int n = static_cast<int>(J.cols());
+  double Y[m][kMaxJoints], v[kMaxJoints];
+  for (int s = 0; s < m; ++s) {
+    for (int j = 0; j < n; ++j) Y[s][j] = J(s, j);
+    Mf.solve(Y[s]);
+    if (w == Weighting::inertia_squared) Mf.solve(Y[s]);
+  }
+  for (int j = 0; j < n; ++j) v[j] = u[j];
+  Mf.solve(v);
+  if (K_N != 0.0)
+    for (int j = 0; j < n; ++j) v[j] += K_N * qd[j];
+  TaskMat<m> A;
+  double r[m];
+  for (int s = 0; s < m; ++s) {
+    for (int t = 0; t <= s; ++t) {
+      double a = 0;
+      for (int j = 0; j < n; ++j) a += J(s, j) * Y[t][j];
+      A(s, t) = a;  // the factor reads the lower triangle
+    }
+    double jv = 0;
+    for (int j = 0; j < n; ++j) jv += J(s, j) * v[j];
+    r[s] = b[s] + jv;
+  }
+  SmallLdlt<m> Af;
+  Af.compute(A, m);
+  Af.solve(r);
+  VecN qdd(n);
+  for (int j = 0; j < n; ++j) {
+    double x = -v[j];
+    for (int s = 0; s < m; ++s) x += Y[s][j] * r[s];
+    qdd[j] = x;
+  }
   return qdd;
 }
 

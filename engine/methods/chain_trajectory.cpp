@@ -1,7 +1,8 @@
 // simulate() for a chain: the closed form's loop (methods/trajectory.cpp) over the chain's dynamics
 // (model/chain_dynamics.hpp) and the resolutions of methods/chain_resolution.hpp. The task space and
 // the method are template parameters of the loop, chosen once per run: the step branches on neither.
-// Fixed-maximum-size types throughout: nothing is allocated per step.
+// Fixed-maximum-size types throughout: nothing is allocated per step. Planar tasks on planar chains of
+// revolute joints take the fixed-size run of methods/planar_chain_run.hpp instead.
 #include "methods/chain_trajectory.hpp"
 
 #include <cmath>
@@ -11,7 +12,9 @@
 #include <string>
 
 #include "common/name_table.hpp"
+#include "methods/planar_chain_run.hpp"
 #include "model/chain_dynamics.hpp"
+#include "model/planar_chain_dynamics.hpp"
 
 namespace ks {
 
@@ -47,7 +50,7 @@ enum class Resolution { weighted, unweighted, nonredundant };
 template <int m>
 struct Evaluation {
   ChainState st;           // M, c, g, J (6 x n), bias, tip
-  Eigen::LLT<MatN> llt;    // of M
+  InertiaFactor Mf;        // M = L D L^T
   TaskJacobian<m> Jt;      // task rows of J
   VecN qdd;
   double w2 = 0;           // det(Jt Jt^T) (local methods); unused by the non-redundant solve
@@ -75,7 +78,8 @@ class ChainResolver {
     evaluate_dynamics(chain_, data_, q, qd, e.st);
     select_task_rows<S>(e.st.J, e.Jt);
     const TaskVec<m> b = xdd - select_task_rows<S>(e.st.bias);
-    e.llt.compute(e.st.M);
+    const int n = static_cast<int>(q.size());
+    e.Mf.compute(e.st.M, n);
     if constexpr (R == Resolution::nonredundant) {
       double det = 0;
       e.qdd = nonredundant_acceleration<m>(e.Jt, b, det);
@@ -83,10 +87,10 @@ class ChainResolver {
     } else {
       e.w2 = gram_determinant<m, m>(e.Jt);
       if (!(e.w2 >= o_.singular_tolerance * o_.singular_tolerance)) return false;
-      u_ = e.st.c;
-      if (o_.k != 0.0) u_ += o_.k * e.st.g;
+      u_.resize(n);
+      for (int j = 0; j < n; ++j) u_[j] = e.st.c[j] + o_.k * e.st.g[j];
       constexpr Weighting w = R == Resolution::unweighted ? Weighting::inertia_squared : Weighting::inertia;
-      e.qdd = local_acceleration<m>(w, e.llt, e.Jt, b, u_, o_.null_damping, qd);
+      e.qdd = local_acceleration<m>(w, e.Mf, e.Jt, b, u_, o_.null_damping, qd);
       return true;
     }
   }
@@ -153,28 +157,34 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       out.status = RunStatus::singular;
       break;
     }
-    tau.noalias() = e.st.M * e.qdd;
-    tau += e.st.c;
-    tau += e.st.g;
-    const double tt = tau.squaredNorm();
-    // NaN fails every comparison: one test catches non-finite values and the bound
-    if (!((tau.array().abs() <= o.torque_bound).all() && std::isfinite(tt))) {
+    double tt = 0, p6 = 0;
+    bool bounded = true;
+    for (int j = 0; j < dof; ++j) {
+      double Mqdd = 0;
+      for (int k = 0; k < dof; ++k) Mqdd += e.st.M(j, k) * e.qdd[k];
+      const double tj = Mqdd + e.st.c[j] + e.st.g[j];
+      tau[j] = z[j] = tj;
+      tt += tj * tj;
+      const double pj = tj * qd[j];
+      p6 += pj * pj;
+      const double a = std::abs(tj);
+      bounded = bounded && a <= o.torque_bound;  // NaN fails the comparison
+    }
+    // one test catches non-finite values and the bound
+    if (!(bounded && std::isfinite(tt))) {
       out.status = RunStatus::diverged;
       break;
     }
     // metrics of this sample
-    z = tau;
-    e.llt.matrixL().solveInPlace(z);  // tau^T M^-1 tau = |L^-1 tau|^2
+    for (int j = 0; j < dof; ++j) inf[j] = std::max(inf[j], std::abs(tau[j]));
     sumE += std::sqrt(tt);
-    sumEM += std::sqrt(z.squaredNorm());
-    inf = inf.cwiseMax(tau.cwiseAbs());
+    sumEM += std::sqrt(e.Mf.inverse_quadratic_form(z.data()));  // tau^T M^-1 tau
     if constexpr (P == m && R != Resolution::nonredundant)
       min_w2 = std::min(min_w2, e.w2);
     else
       min_w2 = std::min(min_w2, gram_determinant<P, m>(e.Jt));
     const Eigen::Matrix<double, P, 1> err = e.st.tip.p.template head<P>() - sampled.position(i).template head<P>();
     max_err2 = std::max(max_err2, err.squaredNorm());
-    const double p6 = tau.cwiseProduct(qd).squaredNorm();
     // trapezoidal rule: sums of every sample, half of the first and last taken off at the end
     f5 += tt;
     f6 += p6;
@@ -200,8 +210,10 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
     if (i + 1 == n) break;  // the last sample is measured, not integrated past
     // integrate to the next sample
     if (o.integrator == Integrator::semi_implicit_euler) {
-      qd += dt * e.qdd;
-      q += dt * qd;
+      for (int j = 0; j < dof; ++j) {
+        qd[j] += dt * e.qdd[j];
+        q[j] += dt * qd[j];
+      }
     } else {
       const double th = t + 0.5 * dt, t1 = t + dt;
       const std::size_t sh = path.segment_at(th), s1 = path.segment_at(t1);
@@ -294,6 +306,8 @@ TrajectoryMetrics simulate(const Chain& chain, const ChainTask& task, const VecN
   const std::optional<VecN> start = solve_start(chain, target, q0);
   if (!start) return unreachable(n);
 
+  // planar chains of revolute joints: the run on fixed-size types, chosen by the joint count
+  if (planar && planar_revolute(chain)) return planar_chain_run(chain, task, *start, o, alpha_profile, history);
   switch (task.space) {
     case TaskSpace::planar_position:
       return run_method<TaskSpace::planar_position>(chain, task, *start, o, alpha_profile, history);

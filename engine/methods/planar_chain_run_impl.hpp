@@ -1,0 +1,367 @@
+#pragma once
+// The definition of planar_chain_run_n<N> (methods/planar_chain_run.hpp), included by the files that
+// instantiate it. The loop is methods/chain_trajectory.cpp's, step for step (same samples, statuses,
+// metrics and history), with the chain's dynamics from model/planar_chain_dynamics.hpp and the
+// resolutions written out on fixed-size arrays: an LDL^T factor of M (N x N) and one of
+// A = J W^-1 J^T (m x m), N + m divisions per evaluation.
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "methods/chain_resolution.hpp"
+#include "methods/fixed_ldlt.hpp"
+#include "methods/planar_chain_run.hpp"
+#include "model/planar_chain_dynamics.hpp"
+
+namespace ks {
+namespace planar_run {
+
+enum class Resolution { weighted, unweighted, nonredundant };
+
+/// Everything one evaluation of the method at (t, q, qd) produces.
+template <int N, int m>
+struct Evaluation {
+  PlanarChainState<N, m> st;
+  FixedLdlt<N> Mf;  // M = L D L^T
+  double qdd[N];
+  double w2 = 0;    // det(J J^T) of the task rows (local methods)
+};
+
+/// det(G) of the Gram matrix G = J J^T of the first k task rows of J (k = 2 or 3), clamped at 0 from
+/// below (rounding at a singular configuration) [(m or rad)^(2k) per rad^2].
+template <int k, int N, int m>
+double gram_det(const double (&J)[m][N]) {
+  static_assert(k <= m && (k == 2 || k == 3));
+  double G[k][k];
+  for (int r = 0; r < k; ++r)
+    for (int s = 0; s <= r; ++s) {
+      double a = 0;
+      for (int j = 0; j < N; ++j) a += J[r][j] * J[s][j];
+      G[r][s] = a;
+    }
+  double d;
+  if constexpr (k == 2) {
+    d = G[0][0] * G[1][1] - G[1][0] * G[1][0];
+  } else {
+    d = G[0][0] * (G[1][1] * G[2][2] - G[2][1] * G[2][1]) - G[1][0] * (G[1][0] * G[2][2] - G[2][1] * G[2][0]) +
+        G[2][0] * (G[1][0] * G[2][1] - G[1][1] * G[2][0]);
+  }
+  return d > 0.0 ? d : 0.0;
+}
+
+/// The method at one instant: joint accelerations from the task acceleration and (q, qd).
+template <int N, TaskSpace S, Resolution R>
+class Stepper {
+ public:
+  static constexpr int m = task_dimension(S);
+
+  Stepper(const PlanarChainConstants<N>& k, const QuinticPath<3>& path, const TrajectoryOptions& o,
+          const std::optional<Profile1>& alpha)
+      : k_(k), path_(path), o_(o), alpha_(alpha) {}
+
+  /// Task acceleration xdd (m) at time t [s] on path segment `segment`.
+  void task(double t, std::size_t segment, double* xdd) const { task_of(path_.sample_on(segment, t).a, segment, t, xdd); }
+  /// Task acceleration xdd (m) at sample i of the sampled path.
+  void task(const SampledPath3& p, std::size_t i, double* xdd) const {
+    task_of(p.acceleration(i), p.segment(i), p.time(i), xdd);
+  }
+
+  /// Joint accelerations e.qdd for task acceleration xdd (m) at the frames' trig (s, c) and qd (N);
+  /// fills every intermediate in `e`. Returns false when the task Jacobian is singular.
+  bool evaluate(const double* xdd, const double* s, const double* c, const double* qd, Evaluation<N, m>& e) const {
+    planar_chain_state<N, m>(k_, s, c, qd, e.st);
+    double b[m];
+    for (int r = 0; r < m; ++r) b[r] = xdd[r] - e.st.bias[r];
+    e.Mf.compute(e.st.M);
+    if constexpr (R == Resolution::nonredundant) {
+      static_assert(N == m);
+      Eigen::Matrix<double, m, m> J;
+      Eigen::Matrix<double, m, 1> bv;
+      for (int r = 0; r < m; ++r) {
+        for (int j = 0; j < N; ++j) J(r, j) = e.st.J[r][j];
+        bv[r] = b[r];
+      }
+      const Eigen::PartialPivLU<Eigen::Matrix<double, m, m>> lu(J);
+      const Eigen::Matrix<double, m, 1> x = lu.solve(bv);
+      for (int j = 0; j < N; ++j) e.qdd[j] = x[j];
+      return std::abs(lu.determinant()) >= o_.singular_tolerance;
+    } else {
+      e.w2 = gram_det<m>(e.st.J);
+      if (!(e.w2 >= o_.singular_tolerance * o_.singular_tolerance)) return false;
+      local_acceleration(e, b, qd);
+      return true;
+    }
+  }
+
+ private:
+  /// qdd = Y A^-1 (b + J v) - v with Y = W^-1 J^T, A = J Y, v = M^-1 (c + k g) + K_N qd (see
+  /// local_acceleration in methods/chain_resolution.hpp).
+  void local_acceleration(Evaluation<N, m>& e, const double* b, const double* qd) const {
+    const auto& J = e.st.J;
+    double Y[m][N], v[N];
+    for (int s = 0; s < m; ++s) {
+      for (int j = 0; j < N; ++j) Y[s][j] = J[s][j];
+      e.Mf.solve(Y[s]);
+      if constexpr (R == Resolution::unweighted) e.Mf.solve(Y[s]);
+    }
+    for (int j = 0; j < N; ++j) v[j] = e.st.c[j] + o_.k * e.st.g[j];
+    e.Mf.solve(v);
+    if (o_.null_damping != 0.0)
+      for (int j = 0; j < N; ++j) v[j] += o_.null_damping * qd[j];
+    double A[m][m], r[m];
+    for (int s = 0; s < m; ++s) {
+      for (int t = 0; t <= s; ++t) {
+        double a = 0;
+        for (int j = 0; j < N; ++j) a += J[s][j] * Y[t][j];
+        A[s][t] = a;  // the factor reads the lower triangle
+      }
+      double jv = 0;
+      for (int j = 0; j < N; ++j) jv += J[s][j] * v[j];
+      r[s] = b[s] + jv;
+    }
+    FixedLdlt<m> Af;
+    Af.compute(A);
+    Af.solve(r);
+    for (int j = 0; j < N; ++j) {
+      double x = -v[j];
+      for (int s = 0; s < m; ++s) x += Y[s][j] * r[s];
+      e.qdd[j] = x;
+    }
+  }
+
+  void task_of(const Eigen::Vector3d& a, std::size_t segment, double t, double* xdd) const {
+    xdd[0] = a[0];
+    xdd[1] = a[1];
+    if constexpr (m == 3) xdd[2] = alpha_->sample_on(segment, t).a[0];
+  }
+
+  const PlanarChainConstants<N>& k_;
+  const QuinticPath<3>& path_;
+  const TrajectoryOptions& o_;
+  const std::optional<Profile1>& alpha_;
+};
+
+/// The square roots of E and E_M, taken a block of samples at a time (a block runs back to back,
+/// vectorised, off the step's dependency chain). The sums are taken in sample order.
+class RootSums {
+ public:
+  /// tt = tau^T tau; qf = tau^T M^-1 tau.
+  void add(double tt, double qf) {
+    tt_[n_] = tt;
+    qf_[n_] = qf;
+    if (++n_ == kBlock) flush();
+  }
+  void flush() {
+    alignas(32) double e[kBlock], em[kBlock];
+    for (int j = 0; j < kBlock; ++j) {  // whole block: fixed trip count, vectorised
+      e[j] = std::sqrt(tt_[j]);
+      em[j] = std::sqrt(qf_[j]);
+    }
+    for (int j = 0; j < n_; ++j) {
+      sumE += e[j];
+      sumEM += em[j];
+    }
+    n_ = 0;
+  }
+  double sumE = 0, sumEM = 0;
+
+ private:
+  static constexpr int kBlock = 32;
+  alignas(32) double tt_[kBlock] = {}, qf_[kBlock] = {};
+  int n_ = 0;
+};
+
+/// The loop of one run from q_start at rest.
+template <int N, TaskSpace S, Resolution R>
+TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_start, const TrajectoryOptions& o,
+                      const std::optional<Profile1>& alpha_profile, ChainHistory* history) {
+  constexpr int m = task_dimension(S), P = position_rows(S);
+  static_assert(P == 2);
+  const SampledPath3& sampled = task.path;
+  const QuinticPath<3>& path = sampled.path();
+  const std::size_t n = sampled.size();
+  const PlanarChainConstants<N> k(chain);
+  const double alpha_offset = PlanarAngle(chain).offset;
+  const Stepper<N, S, R> stepper(k, path, o, alpha_profile);
+  const auto alpha_of = [&](const double* u) {  // the tip angle at u [rad]
+    double a = 0;
+    for (int j = 0; j < N; ++j) a += u[j];
+    return alpha_offset + a;
+  };
+
+  TrajectoryMetrics out;
+  Evaluation<N, m> e, s;  // e: at the sample; s: RK4 stages
+  // q, qd, qdd, tau: in the coordinates u = sigma q of the kernel (model/planar_chain_dynamics.hpp)
+  double q[N], qd[N], tau[N], inf[N];
+  for (int j = 0; j < N; ++j) q[j] = k.sigma[j] * q_start[j], qd[j] = 0.0, inf[j] = 0.0;
+  PlanarChainTrig<N> trig, stage;  // trig: the sample's, carried from step to step (semi-implicit Euler)
+  trig.reset(k, q);
+  RootSums roots;
+  double min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0;
+  double f5 = 0, f6 = 0, first5 = 0, first6 = 0, last5 = 0, last6 = 0;
+  const double dt = o.dt;
+  std::size_t done = 0;
+  double last_t = 0, last_alpha = alpha_of(q);
+  double xdd[m];
+
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = sampled.time(i);
+    stepper.task(sampled, i, xdd);
+    if (!stepper.evaluate(xdd, trig.s, trig.c, qd, e)) {
+      out.status = RunStatus::singular;
+      break;
+    }
+    double tt = 0, p6 = 0;
+    bool bounded = true;
+    for (int j = 0; j < N; ++j) {
+      double Mqdd = 0;
+      for (int l = 0; l < N; ++l) Mqdd += e.st.M[j][l] * e.qdd[l];
+      const double tj = Mqdd + e.st.c[j] + e.st.g[j];
+      tau[j] = tj;
+      tt += tj * tj;
+      const double pj = tj * qd[j];
+      p6 += pj * pj;
+      bounded = bounded && std::abs(tj) <= o.torque_bound;  // NaN fails the comparison
+    }
+    // one test catches non-finite values and the bound
+    if (!(bounded && std::isfinite(tt))) {
+      out.status = RunStatus::diverged;
+      break;
+    }
+    // metrics of this sample
+    for (int j = 0; j < N; ++j) inf[j] = std::max(inf[j], std::abs(tau[j]));
+    double z[N];
+    for (int j = 0; j < N; ++j) z[j] = tau[j];
+    roots.add(tt, e.Mf.inverse_quadratic_form(z));  // tau^T M^-1 tau
+    if constexpr (P == m && R != Resolution::nonredundant)
+      min_w2 = std::min(min_w2, e.w2);
+    else
+      min_w2 = std::min(min_w2, gram_det<P>(e.st.J));
+    const Eigen::Vector3d ref = sampled.position(i);
+    const double ex = e.st.px - ref[0], ey = e.st.py - ref[1];
+    max_err2 = std::max(max_err2, ex * ex + ey * ey);
+    // trapezoidal rule: sums of every sample, half of the first and last taken off at the end
+    f5 += tt;
+    f6 += p6;
+    if (i == 0) {
+      first5 = tt;
+      first6 = p6;
+    }
+    last5 = tt;
+    last6 = p6;
+    last_t = t;
+    last_alpha = alpha_of(q);
+    if (history && (i % history->stride == 0 || i + 1 == n)) {
+      const Eigen::Index col = history->size++;
+      history->t[col] = t;
+      for (int j = 0; j < N; ++j) {
+        history->q(j, col) = k.sigma[j] * q[j];
+        history->qd(j, col) = k.sigma[j] * qd[j];
+        history->qdd(j, col) = k.sigma[j] * e.qdd[j];
+        history->tau(j, col) = k.sigma[j] * tau[j];
+      }
+      history->x(0, col) = e.st.px;
+      history->x(1, col) = e.st.py;
+      history->alpha[col] = last_alpha;
+    }
+    ++done;
+    if (i + 1 == n) break;  // the last sample is measured, not integrated past
+    // integrate to the next sample
+    if (o.integrator == Integrator::semi_implicit_euler) {
+      double dq[N];
+      for (int j = 0; j < N; ++j) {
+        qd[j] += dt * e.qdd[j];
+        dq[j] = dt * qd[j];
+        q[j] += dq[j];
+      }
+      trig.advance(k, q, dq);
+    } else {
+      const double h = 0.5 * dt, th = t + h, t1 = t + dt;
+      const std::size_t sh = path.segment_at(th), s1 = path.segment_at(t1);
+      double xh[m], x1[m], k2q[N], k3q[N], k4q[N], k2v[N], k3v[N], yq[N], yv[N];
+      stepper.task(th, sh, xh);
+      stepper.task(t1, s1, x1);
+      // stage 2 at (q + h k1q, qd + h k1v) with k1q = qd, k1v = qdd
+      for (int j = 0; j < N; ++j) {
+        yq[j] = q[j] + h * qd[j];
+        k2q[j] = yv[j] = qd[j] + h * e.qdd[j];
+      }
+      stage.reset(k, yq);
+      bool good = stepper.evaluate(xh, stage.s, stage.c, yv, s);
+      for (int j = 0; j < N; ++j) {
+        k2v[j] = s.qdd[j];
+        yq[j] = q[j] + h * k2q[j];
+        k3q[j] = yv[j] = qd[j] + h * k2v[j];
+      }
+      stage.reset(k, yq);
+      good = good && stepper.evaluate(xh, stage.s, stage.c, yv, s);
+      for (int j = 0; j < N; ++j) {
+        k3v[j] = s.qdd[j];
+        yq[j] = q[j] + dt * k3q[j];
+        k4q[j] = yv[j] = qd[j] + dt * k3v[j];
+      }
+      stage.reset(k, yq);
+      good = good && stepper.evaluate(x1, stage.s, stage.c, yv, s);
+      if (!good) {
+        out.status = RunStatus::singular;
+        break;
+      }
+      const double w = dt / 6.0;
+      for (int j = 0; j < N; ++j) {
+        const double k4v = s.qdd[j];
+        q[j] += w * (qd[j] + 2.0 * k2q[j] + 2.0 * k3q[j] + k4q[j]);
+        qd[j] += w * (e.qdd[j] + 2.0 * k2v[j] + 2.0 * k3v[j] + k4v);
+      }
+      trig.reset(k, q);
+    }
+  }
+  out.samples = done;
+  roots.flush();
+  out.tau_inf.resize(N);
+  for (int j = 0; j < N; ++j) out.tau_inf[j] = inf[j];
+  if (done > 0) {
+    out.E = roots.sumE / static_cast<double>(done);
+    out.E_M = roots.sumEM / static_cast<double>(done);
+    out.min_manipulability = std::sqrt(min_w2);
+    out.torque_sq_integral = dt * (f5 - 0.5 * (first5 + last5));
+    out.power_sq_integral = dt * (f6 - 0.5 * (first6 + last6));
+    out.max_tracking_error = std::sqrt(max_err2);
+  }
+  out.final_alpha = last_alpha;
+  out.stop_time = last_t;
+  return out;
+}
+
+}  // namespace planar_run
+
+template <int N>
+TrajectoryMetrics planar_chain_run_n(const Chain& chain, const ChainTask& task, const VecN& q_start,
+                                     const TrajectoryOptions& o, const std::optional<Profile1>& alpha,
+                                     ChainHistory* history) {
+  using planar_run::Resolution;
+  using planar_run::run;
+  constexpr TaskSpace position = TaskSpace::planar_position, pose = TaskSpace::planar_pose;
+  if (task.space == position) {
+    if (o.method == TrajectoryMethod::local_weighted)
+      return run<N, position, Resolution::weighted>(chain, task, q_start, o, alpha, history);
+    if (o.method == TrajectoryMethod::local_unweighted)
+      return run<N, position, Resolution::unweighted>(chain, task, q_start, o, alpha, history);
+  } else if (task.space == pose) {
+    if constexpr (N > 3) {
+      if (o.method == TrajectoryMethod::local_weighted)
+        return run<N, pose, Resolution::weighted>(chain, task, q_start, o, alpha, history);
+      if (o.method == TrajectoryMethod::local_unweighted)
+        return run<N, pose, Resolution::unweighted>(chain, task, q_start, o, alpha, history);
+    }
+    if constexpr (N == 3) {
+      if (o.method == TrajectoryMethod::vertex_alpha)
+        return run<N, pose, Resolution::nonredundant>(chain, task, q_start, o, alpha, history);
+    }
+  }
+  throw std::invalid_argument("planar_chain_run: the task space and method do not fit a planar chain of " +
+                              std::to_string(N) + " joints");
+}
+
+}  // namespace ks
