@@ -150,13 +150,17 @@ def run_study(exe, toml, out, threads):
     return hist, seconds, time.monotonic() - start, items
 
 
-def compare(expected, got):
-    """Print every difference; return (passed, failed) item counts."""
+def compare(expected, got, new_items=None):
+    """Print every difference; return (passed, failed) item counts. With `new_items` (a dict), items
+    the manifest lacks (a new column) are collected there per study instead of failing."""
     passed = failed = 0
     for study in sorted(set(expected) | set(got)):
         exp = expected.get(study, {}).get("items", {})
         new = got.get(study, {}).get("items", {})
         for item in sorted(set(exp) | set(new)):
+            if new_items is not None and item not in exp:
+                new_items.setdefault(study, {})[item] = new[item]
+                continue
             e, g = exp.get(item, "(missing from manifest)"), new.get(item, "(not produced)")
             if e == g:
                 passed += 1
@@ -174,7 +178,7 @@ def main():
     p.add_argument("manifest")
     p.add_argument("--record", action="store_true", help="write MANIFEST instead of comparing")
     p.add_argument("--add-new", action="store_true",
-                   help="compare the studies MANIFEST holds and add the studies it does not hold (a new shipped study)")
+                   help="compare every item MANIFEST holds; add the studies and items (new columns) it does not hold")
     p.add_argument("--workdir", help="where the results files go (kept); default: a temporary dir")
     p.add_argument("--threads", type=int, default=int(os.environ.get("KS_REGRESSION_THREADS", "2")),
                    help="kinesweep worker threads (default 2, or $KS_REGRESSION_THREADS)")
@@ -217,9 +221,13 @@ def main():
         if any(not s["items"] for s in added.values()):
             sys.exit("not adding: a new study failed")
         got = {n: s for n, s in got.items() if n in expected}
-    passed, failed = compare(expected, got)
+    new_items = {} if args.add_new else None
+    passed, failed = compare(expected, got, new_items)
     if args.add_new and not failed:
         manifest["studies"].update(added)
+        for study, items in (new_items or {}).items():
+            manifest["studies"][study]["items"].update(items)
+            print(f"added {len(items)} new items to {study}: {', '.join(sorted(items))}")
         with open(args.manifest, "w") as f:
             json.dump(manifest, f, indent=1, sort_keys=True)
             f.write("\n")
