@@ -30,6 +30,7 @@
 // Joint limits: the chain's [lower, upper] (HasJointLimits: project clamps q, admit tests a solution,
 // moving revolute joints by multiples of 2 pi into their limits when possible).
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <array>
 #include <cmath>
 
