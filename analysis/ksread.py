@@ -460,19 +460,21 @@ def cluster_solutions(q, revolute, tolerance=1e-3):
     q = np.asarray(q, dtype=float)
     rev = np.asarray(revolute, dtype=bool)
     labels = np.full(len(q), -1, dtype=int)
-    firsts = []
+    firsts = np.empty((len(q), q.shape[1] if q.ndim == 2 else 0))  # the clusters' first members, in order
+    count = 0
     for i, row in enumerate(q):
         if not np.all(np.isfinite(row)):
             continue
-        for label, f in enumerate(firsts):
-            d = row - f
-            d[rev] = np.remainder(d[rev] + np.pi, 2 * np.pi) - np.pi
-            if np.max(np.abs(d)) <= tolerance:
-                labels[i] = label
-                break
-        else:
-            labels[i] = len(firsts)
-            firsts.append(row)
+        if count:
+            d = row - firsts[:count]
+            d[:, rev] = np.remainder(d[:, rev] + np.pi, 2 * np.pi) - np.pi
+            near = np.flatnonzero(np.max(np.abs(d), axis=1) <= tolerance)
+            if near.size:
+                labels[i] = near[0]  # the first cluster (lowest label) within tolerance
+                continue
+        labels[i] = count
+        firsts[count] = row
+        count += 1
     return labels
 
 

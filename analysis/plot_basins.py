@@ -102,6 +102,7 @@ def main(argv=None):
     # "rad or mm": the third joint is the SCARA's d in mm, else an angle
     qunits = [("mm" if scara else "rad") if runs.units[c].startswith("rad or") else runs.units[c] for c in qcols]
     clustered = False
+    continuum = {}
     if not np.any((runs["solution"] >= 0) & sel):
         # No closed form (a chain robot): name the distinct solutions by clustering the converged final
         # iterates (ksread.cluster_solutions, tolerance CLUSTER_TOLERANCE), in run order, and grid them:
@@ -110,7 +111,21 @@ def main(argv=None):
         conv = runs["done"][rows] & (runs["status"][rows] == "converged")
         q = np.column_stack([runs[c][rows] for c in qcols])
         q[~conv] = np.nan
-        labels = ksread.cluster_solutions(q, [u == "rad" for u in qunits], CLUSTER_TOLERANCE).astype(float)
+        revolute = [u == "rad" for u in qunits]
+        labels = ksread.cluster_solutions(q, revolute, CLUSTER_TOLERANCE)
+        if labels.max(initial=-1) + 1 > len(SOLUTION_COLOURS):
+            # A continuum (a redundant problem): name the solutions by the joints whose final values
+            # take a few distinct values over the converged runs (e.g. an S-R-S arm's elbow angle).
+            discrete = [j for j in range(q.shape[1])
+                        if ksread.cluster_solutions(q[:, [j]], [revolute[j]], CLUSTER_TOLERANCE).max(initial=-1) + 1
+                        <= len(SOLUTION_COLOURS)]
+            continuum["discrete"] = [qcols[j] for j in discrete]
+            continuum["postures"] = int(labels.max(initial=-1) + 1)
+            labels = (ksread.cluster_solutions(q[:, discrete], [revolute[j] for j in discrete], CLUSTER_TOLERANCE)
+                      if discrete else np.where(np.isfinite(q[:, 0]), 0, -1))
+            qcols = [qcols[j] for j in discrete] or qcols[:0]
+            qunits = [qunits[j] for j in discrete]
+        labels = labels.astype(float)
         labels[labels < 0] = np.nan
         shape = ls.metrics["solution"].shape
         if labels.size == int(np.prod(shape)):
@@ -122,7 +137,11 @@ def main(argv=None):
     sol_label = {}
     for s in sol_ids:
         m = sel & (runs["solution"] == s) & (runs["status"] == "converged")
-        sol_label[s] = f"solution {s}" + (": " + joint_text(runs, qcols, qunits, m) if m.any() else "")
+        text = joint_text(runs, qcols, qunits, m) if m.any() and qcols else ""
+        sol_label[s] = f"solution {s}" + (": " + text if text else "")
+        if continuum:
+            sol_label[s] = (f"{text}: {continuum['postures']} distinct postures in all (a continuum)" if text
+                            else f"converged: a continuum of {continuum['postures']} distinct postures")
     if len(sol_ids) > len(SOLUTION_COLOURS):  # a continuum (redundant problem): too many to tell apart
         sol_label = {s: sol_label[s] for s in sol_ids[:len(SOLUTION_COLOURS)]}
 
@@ -188,7 +207,7 @@ def main(argv=None):
         {"file": args.file, "block": ls.block, "panel_axis": panel_axis,
          "x": {"name": xa.name, "unit": xa.unit, "values": xa.values},
          "y": {"name": ya.name, "unit": ya.unit, "values": ya.values},
-         "panels": data_panels, "solutions": sol_label, "clustered": clustered})
+         "panels": data_panels, "solutions": sol_label, "clustered": clustered, "continuum": continuum})
 
 
 if __name__ == "__main__":

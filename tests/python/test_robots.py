@@ -4,6 +4,7 @@ robot studies run and read back with h5py (per-joint columns, histories of width
 
 usage: /usr/bin/python3 test_robots.py KINESWEEP_BINARY STUDIES_DIR
 """
+import json
 import os
 import subprocess
 import sys
@@ -16,6 +17,7 @@ from e2e_common import TempDirTest
 
 KS = None
 STUDIES = None
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 TABLE4 = """
 [study]
@@ -126,6 +128,40 @@ class ChainStudies(TempDirTest):
             status = [s.decode() if isinstance(s, bytes) else s for s in runs["status"][()]]
             self.assertGreater(status.count("converged"), len(status) // 4)
             self.assertIn("q_final_7", runs)
+        # the basins plot names the solutions by clustering (no closed form for a 7-DOF arm); a pose
+        # target leaves redundancy 1, a continuum, named by the joints that stay discrete (the elbow)
+        png = os.path.join(self.dir, "basins.png")
+        r = subprocess.run(["/usr/bin/python3", os.path.join(REPO, "analysis", "plot_basins.py"), out, "--x", "q0_2",
+                            "--y", "q0_4", "-o", png, "--print-data"], capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        data = json.loads(r.stdout)
+        self.assertTrue(data["clustered"])
+        self.assertEqual(data["continuum"]["discrete"], ["q_final_4"])
+        self.assertEqual(len(data["solutions"]), 2)
+        self.assertGreater(os.path.getsize(png), 10000)
+
+
+class ClusterSolutions(unittest.TestCase):
+    def test_every_member_is_near_its_clusters_first_and_firsts_are_apart(self):
+        sys.path.insert(0, os.path.join(REPO, "analysis"))
+        import ksread
+        rng = np.random.default_rng(7)
+        centres = rng.uniform(-np.pi, np.pi, size=(5, 3))
+        q = centres[rng.integers(0, 5, 400)] + rng.uniform(-4e-4, 4e-4, size=(400, 3))
+        q[::7] += 2 * np.pi  # the same solution one turn away
+        q[3, 1] = np.nan
+        labels = ksread.cluster_solutions(q, [True, True, True], 1e-3)
+        self.assertEqual(labels[3], -1)
+        firsts = {}
+        for i, l in enumerate(labels):
+            if l < 0:
+                continue
+            f = firsts.setdefault(l, i)
+            d = np.remainder(q[i] - q[f] + np.pi, 2 * np.pi) - np.pi
+            self.assertLessEqual(np.max(np.abs(d)), 1e-3)
+        self.assertEqual(sorted(firsts), list(range(len(firsts))))  # labels in order of first members
+        self.assertEqual(sorted(firsts.values()), [firsts[l] for l in range(len(firsts))])
+        self.assertEqual(len(firsts), 5)  # 5 well separated centres, one turn counted as the same
 
 
 if __name__ == "__main__":
