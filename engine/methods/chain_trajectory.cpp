@@ -4,6 +4,7 @@
 // Fixed-maximum-size types throughout: nothing is allocated per step. Planar tasks on planar chains of
 // revolute joints take the fixed-size run of methods/planar_chain_run.hpp instead.
 #include "methods/chain_trajectory.hpp"
+#include "methods/run_sums.hpp"
 
 #include <cmath>
 #include <limits>
@@ -146,7 +147,7 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
   VecN q = q_start, qd = VecN::Zero(dof), tau(dof), z(dof), inf = VecN::Zero(dof);
   VecN k1q, k1v, k2q, k2v, k3q, k3v, k4q, k4v;
   double sumE = 0, sumEM = 0, min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0;
-  double f5 = 0, f6 = 0, first5 = 0, first6 = 0, last5 = 0, last6 = 0;
+  TrapezoidSums trapezoid;
   const double dt = o.dt;
   std::size_t done = 0;
   double last_t = 0, last_alpha = angle ? (*angle)(q) : nan;
@@ -185,15 +186,7 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       min_w2 = std::min(min_w2, gram_determinant<P, m>(e.Jt));
     const Eigen::Matrix<double, P, 1> err = e.st.tip.p.template head<P>() - sampled.position(i).template head<P>();
     max_err2 = std::max(max_err2, err.squaredNorm());
-    // trapezoidal rule: sums of every sample, half of the first and last taken off at the end
-    f5 += tt;
-    f6 += p6;
-    if (i == 0) {
-      first5 = tt;
-      first6 = p6;
-    }
-    last5 = tt;
-    last6 = p6;
+    trapezoid.add(i, tt, p6);
     last_t = t;
     if (angle) last_alpha = (*angle)(q);
     if (history && (i % history->stride == 0 || i + 1 == n)) {
@@ -243,8 +236,8 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
     out.E = sumE / static_cast<double>(done);
     out.E_M = sumEM / static_cast<double>(done);
     out.min_manipulability = std::sqrt(min_w2);
-    out.torque_sq_integral = dt * (f5 - 0.5 * (first5 + last5));
-    out.power_sq_integral = dt * (f6 - 0.5 * (first6 + last6));
+    out.torque_sq_integral = trapezoid.torque(dt);
+    out.power_sq_integral = trapezoid.power(dt);
     out.max_tracking_error = std::sqrt(max_err2);
   }
   out.final_alpha = last_alpha;

@@ -12,6 +12,7 @@
 
 #include "methods/chain_resolution.hpp"
 #include "methods/fixed_ldlt.hpp"
+#include "methods/run_sums.hpp"
 #include "methods/planar_chain_run.hpp"
 #include "model/planar_chain_dynamics.hpp"
 
@@ -143,36 +144,6 @@ class Stepper {
   const std::optional<Profile1>& alpha_;
 };
 
-/// The square roots of E and E_M, taken a block of samples at a time (a block runs back to back,
-/// vectorised, off the step's dependency chain). The sums are taken in sample order.
-class RootSums {
- public:
-  /// tt = tau^T tau; qf = tau^T M^-1 tau.
-  void add(double tt, double qf) {
-    tt_[n_] = tt;
-    qf_[n_] = qf;
-    if (++n_ == kBlock) flush();
-  }
-  void flush() {
-    alignas(32) double e[kBlock], em[kBlock];
-    for (int j = 0; j < kBlock; ++j) {  // whole block: fixed trip count, vectorised
-      e[j] = std::sqrt(tt_[j]);
-      em[j] = std::sqrt(qf_[j]);
-    }
-    for (int j = 0; j < n_; ++j) {
-      sumE += e[j];
-      sumEM += em[j];
-    }
-    n_ = 0;
-  }
-  double sumE = 0, sumEM = 0;
-
- private:
-  static constexpr int kBlock = 32;
-  alignas(32) double tt_[kBlock] = {}, qf_[kBlock] = {};
-  int n_ = 0;
-};
-
 /// The loop of one run from q_start at rest.
 template <int N, TaskSpace S, Resolution R>
 TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_start, const TrajectoryOptions& o,
@@ -200,7 +171,7 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
   trig.reset(k, q);
   RootSums roots;
   double min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0;
-  double f5 = 0, f6 = 0, first5 = 0, first6 = 0, last5 = 0, last6 = 0;
+  TrapezoidSums trapezoid;
   const double dt = o.dt;
   std::size_t done = 0;
   double last_t = 0, last_alpha = alpha_of(q);
@@ -242,15 +213,7 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
     const Eigen::Vector3d ref = sampled.position(i);
     const double ex = e.st.px - ref[0], ey = e.st.py - ref[1];
     max_err2 = std::max(max_err2, ex * ex + ey * ey);
-    // trapezoidal rule: sums of every sample, half of the first and last taken off at the end
-    f5 += tt;
-    f6 += p6;
-    if (i == 0) {
-      first5 = tt;
-      first6 = p6;
-    }
-    last5 = tt;
-    last6 = p6;
+    trapezoid.add(i, tt, p6);
     last_t = t;
     last_alpha = alpha_of(q);
     if (history && (i % history->stride == 0 || i + 1 == n)) {
@@ -325,8 +288,8 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
     out.E = roots.sumE / static_cast<double>(done);
     out.E_M = roots.sumEM / static_cast<double>(done);
     out.min_manipulability = std::sqrt(min_w2);
-    out.torque_sq_integral = dt * (f5 - 0.5 * (first5 + last5));
-    out.power_sq_integral = dt * (f6 - 0.5 * (first6 + last6));
+    out.torque_sq_integral = trapezoid.torque(dt);
+    out.power_sq_integral = trapezoid.power(dt);
     out.max_tracking_error = std::sqrt(max_err2);
   }
   out.final_alpha = last_alpha;

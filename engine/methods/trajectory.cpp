@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "methods/resolution.hpp"
+#include "methods/run_sums.hpp"
 #include "model/dynamics.hpp"
 
 namespace ks {
@@ -94,42 +95,6 @@ class Resolver {
   const std::optional<Profile1>& alpha_;
 };
 
-/// The square roots and divisions of E and E_M, taken a block of samples at a time: in the step they
-/// would compete for the divider with the step's own division and hold the out-of-order window
-/// behind them; a block runs back to back, vectorised. The sums are taken in sample order, so the
-/// result is the same as summing sample by sample.
-class RootSums {
- public:
-  RootSums() {
-    for (double& d : det_) d = 1.0;  // the unfilled tail of a last, partial block stays harmless
-  }
-  /// tt = tau^T tau; qf / det = tau^T M^-1 tau.
-  void add(double tt, double qf, double det) {
-    tt_[n_] = tt;
-    qf_[n_] = qf;
-    det_[n_] = det;
-    if (++n_ == kBlock) flush();
-  }
-  void flush() {
-    alignas(32) double e[kBlock], em[kBlock];
-    for (int j = 0; j < kBlock; ++j) {  // whole block: fixed trip count, vectorised
-      e[j] = std::sqrt(tt_[j]);
-      em[j] = std::sqrt(qf_[j] / det_[j]);
-    }
-    for (int j = 0; j < n_; ++j) {
-      sumE += e[j];
-      sumEM += em[j];
-    }
-    n_ = 0;
-  }
-  double sumE = 0, sumEM = 0;
-
- private:
-  static constexpr int kBlock = 32;
-  alignas(32) double tt_[kBlock] = {}, qf_[kBlock] = {}, det_[kBlock];
-  int n_ = 0;
-};
-
 }  // namespace
 
 TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const TrajectoryOptions& o,
@@ -171,7 +136,7 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
   TrigTracker trig(q);  // the sample's trig, carried from step to step (semi-implicit Euler)
   RootSums roots;
   double min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0;
-  double f5 = 0, f6 = 0, first5 = 0, first6 = 0, last5 = 0, last6 = 0;
+  TrapezoidSums trapezoid;
   double inf0 = 0, inf1 = 0, inf2 = 0;
   const double dt = o.dt;
   std::size_t done = 0;
@@ -204,15 +169,7 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
     max_err2 = std::max(max_err2, ex * ex + ey * ey);
     const double p0 = tau0 * qd[0], p1 = tau1 * qd[1], p2 = tau2 * qd[2];
     const double p6 = p0 * p0 + p1 * p1 + p2 * p2;
-    // trapezoidal rule: sums of every sample, half of the first and last taken off at the end
-    f5 += tt;
-    f6 += p6;
-    if (i == 0) {
-      first5 = tt;
-      first6 = p6;
-    }
-    last5 = tt;
-    last6 = p6;
+    trapezoid.add(i, tt, p6);
     last_t = t;
     last_alpha = q[0] + q[1] + q[2];
     if (history && (i % history->stride == 0 || i + 1 == n)) {
@@ -260,8 +217,8 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
     out.E_M = roots.sumEM / static_cast<double>(done);
     out.tau_inf = Vec3(inf0, inf1, inf2);  // VecN of size 3: no allocation
     out.min_manipulability = std::sqrt(min_w2);
-    out.torque_sq_integral = dt * (f5 - 0.5 * (first5 + last5));
-    out.power_sq_integral = dt * (f6 - 0.5 * (first6 + last6));
+    out.torque_sq_integral = trapezoid.torque(dt);
+    out.power_sq_integral = trapezoid.power(dt);
     out.max_tracking_error = std::sqrt(max_err2);
   }
   out.final_alpha = last_alpha;

@@ -11,6 +11,21 @@
 namespace ks::store {
 using namespace detail;
 
+namespace {
+/// The UTF-8 text of scalar dataset `name` in `group` ("" when it holds a null string).
+std::string read_text_dataset(hid_t group, const char* name, const std::string& path) {
+  const std::string what = std::string("/study/") + name;
+  Hid d(check(H5Dopen2(group, name, H5P_DEFAULT), path, "open " + what));
+  Hid t(utf8_vlen_type());
+  Hid s(H5Dget_space(d));
+  char* p = nullptr;
+  check(H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, &p), path, "read " + what);
+  std::string text = p ? p : "";
+  H5Dvlen_reclaim(t, s, H5P_DEFAULT, &p);
+  return text;
+}
+}  // namespace
+
 struct ResultsReader::Impl {
   std::string path;
   Hid file;
@@ -37,23 +52,10 @@ struct ResultsReader::Impl {
     meta.study_name = read_str_attr(f, "study_name");
     Hid study(check(H5Gopen2(f, "study", H5P_DEFAULT), path, "open /study"));
     meta.study_path = read_str_attr(study, "path");
-    {
-      Hid d(check(H5Dopen2(study, "text", H5P_DEFAULT), path, "open /study/text"));
-      Hid t(utf8_vlen_type());
-      Hid s(H5Dget_space(d));
-      char* p = nullptr;
-      check(H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, &p), path, "read /study/text");
-      meta.study_text = p ? p : "";
-      H5Dvlen_reclaim(t, s, H5P_DEFAULT, &p);
-    }
+    meta.study_text = read_text_dataset(study, "text", path);
     if (H5Lexists(study, "robot", H5P_DEFAULT) > 0) {
+      meta.robot_text = read_text_dataset(study, "robot", path);
       Hid d(check(H5Dopen2(study, "robot", H5P_DEFAULT), path, "open /study/robot"));
-      Hid t(utf8_vlen_type());
-      Hid s(H5Dget_space(d));
-      char* p = nullptr;
-      check(H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, &p), path, "read /study/robot");
-      meta.robot_text = p ? p : "";
-      H5Dvlen_reclaim(t, s, H5P_DEFAULT, &p);
       meta.robot_path = read_str_attr(d, "path");
     }
     columns = read_run_columns(f, path, n_runs, meta.format_version >= 2);
