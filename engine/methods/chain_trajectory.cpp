@@ -230,18 +230,8 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       qd += dt / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
     }
   }
-  out.samples = done;
   out.tau_inf = inf;
-  if (done > 0) {
-    out.E = sumE / static_cast<double>(done);
-    out.E_M = sumEM / static_cast<double>(done);
-    out.min_manipulability = std::sqrt(min_w2);
-    out.torque_sq_integral = trapezoid.torque(dt);
-    out.power_sq_integral = trapezoid.power(dt);
-    out.max_tracking_error = std::sqrt(max_err2);
-  }
-  out.final_alpha = last_alpha;
-  out.stop_time = last_t;
+  finish_metrics(out, done, sumE, sumEM, min_w2, max_err2, trapezoid, dt, last_alpha, last_t);
   return out;
 }
 

@@ -280,20 +280,10 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       trig.reset(k, q);
     }
   }
-  out.samples = done;
   roots.flush();
   out.tau_inf.resize(N);
   for (int j = 0; j < N; ++j) out.tau_inf[j] = inf[j];
-  if (done > 0) {
-    out.E = roots.sumE / static_cast<double>(done);
-    out.E_M = roots.sumEM / static_cast<double>(done);
-    out.min_manipulability = std::sqrt(min_w2);
-    out.torque_sq_integral = trapezoid.torque(dt);
-    out.power_sq_integral = trapezoid.power(dt);
-    out.max_tracking_error = std::sqrt(max_err2);
-  }
-  out.final_alpha = last_alpha;
-  out.stop_time = last_t;
+  finish_metrics(out, done, roots.sumE, roots.sumEM, min_w2, max_err2, trapezoid, dt, last_alpha, last_t);
   return out;
 }
 

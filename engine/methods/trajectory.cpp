@@ -210,19 +210,9 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
       trig.reset(q);
     }
   }
-  out.samples = done;
   roots.flush();
-  if (done > 0) {
-    out.E = roots.sumE / static_cast<double>(done);
-    out.E_M = roots.sumEM / static_cast<double>(done);
-    out.tau_inf = Vec3(inf0, inf1, inf2);  // VecN of size 3: no allocation
-    out.min_manipulability = std::sqrt(min_w2);
-    out.torque_sq_integral = trapezoid.torque(dt);
-    out.power_sq_integral = trapezoid.power(dt);
-    out.max_tracking_error = std::sqrt(max_err2);
-  }
-  out.final_alpha = last_alpha;
-  out.stop_time = last_t;
+  if (done > 0) out.tau_inf = Vec3(inf0, inf1, inf2);  // VecN of size 3: no allocation
+  finish_metrics(out, done, roots.sumE, roots.sumEM, min_w2, max_err2, trapezoid, dt, last_alpha, last_t);
   return out;
 }
 

@@ -39,24 +39,11 @@ namespace study_parse {
 std::optional<std::vector<double>> Parser::get_joint_numbers(const toml::table& t, std::string_view key,
                                                              std::size_t count, std::string_view what,
                                                              std::string_view unit) {
-  const toml::node* n = t.get(key);
-  if (!n) return std::nullopt;
-  const auto* a = n->as_array();
   const std::string want = count > 0 ? std::to_string(count) + " numbers [" + std::string(unit) + "] (one per link)"
                                      : "2 to " + std::to_string(kMaxJoints) + " numbers [" + std::string(unit) +
                                            "] (one per link)";
-  if (!a || (count > 0 ? a->size() != count : a->size() < 2 || a->size() > std::size_t(kMaxJoints))) {
-    error(*n, std::string(what) + " is " + (a ? "an array of " + std::to_string(a->size()) : type_name(*n)) +
-                  "; expected an array of " + want);
-    return std::nullopt;
-  }
-  std::vector<double> v;
-  for (const auto& e : *a) {
-    auto x = get_number(e, std::string(what) + " element");
-    if (!x) return std::nullopt;
-    v.push_back(*x);
-  }
-  return v;
+  return count > 0 ? get_numbers(t, key, count, count, what, want)
+                   : get_numbers(t, key, 2, std::size_t(kMaxJoints), what, want);
 }
 
 void Parser::parse_robot(const toml::table& root, Study& s) {

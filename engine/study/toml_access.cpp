@@ -214,12 +214,18 @@ std::optional<std::int64_t> ParserCore::get_integer(const toml::node& n, std::st
 
 std::optional<std::vector<double>> ParserCore::get_numbers(const toml::table& t, std::string_view key,
                                                        std::size_t count, std::string_view what) {
+  return get_numbers(t, key, count, count, what, std::to_string(count) + " numbers");
+}
+
+std::optional<std::vector<double>> ParserCore::get_numbers(const toml::table& t, std::string_view key,
+                                                       std::size_t min_count, std::size_t max_count,
+                                                       std::string_view what, std::string_view expected) {
   const toml::node* n = t.get(key);
   if (!n) return std::nullopt;
   const auto* a = n->as_array();
-  if (!a || a->size() != count) {
+  if (!a || a->size() < min_count || a->size() > max_count) {
     error(*n, std::string(what) + " is " + (a ? "an array of " + std::to_string(a->size()) : type_name(*n)) +
-                  "; expected an array of " + std::to_string(count) + " numbers");
+                  "; expected an array of " + std::string(expected));
     return std::nullopt;
   }
   std::vector<double> v;

@@ -68,6 +68,9 @@ class ParserCore {
   std::optional<std::int64_t> get_integer(const toml::node& n, std::string_view what);
   std::optional<std::vector<double>> get_numbers(const toml::table& t, std::string_view key, std::size_t count,
                                                  std::string_view what);
+  /// The same for min_count .. max_count numbers; `expected` says what ("3 numbers [m]").
+  std::optional<std::vector<double>> get_numbers(const toml::table& t, std::string_view key, std::size_t min_count,
+                                                 std::size_t max_count, std::string_view what, std::string_view expected);
 
   std::string file_;
   std::vector<StudyDiagnostic> diags_;
