@@ -2,7 +2,8 @@
 // `kinesweep query FILE [--where EXPR]... [--columns a,b,c|all] [--sort COL[:desc]]... [--limit N]
 //  [--format table|csv|json] [--radians] [--include-pending]`
 // `kinesweep query FILE --run ID --history NAME[,NAME...]|all [--format table|csv|json] [--limit N]`
-// `kinesweep query FILE --optimization NAME [--format table|csv|json] [--limit N] [--radians]`
+// `kinesweep query FILE --optimization NAME [--where ...] [--sort ...] [--format ...] [--limit N] [--radians]
+// `kinesweep query FILE --group-by COL[,COL] [--agg min:E,count,...] [--where ...]`
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -25,6 +26,8 @@ struct QueryArgs {
   std::int64_t run = -1;           ///< history mode: the run id
   std::string history;             ///< history mode: array name(s)
   std::string optimization;        ///< optimisation mode: the /optimizations group whose evaluations to print
+  std::string group_by;            ///< comma list of columns: one output row per group of equal values
+  std::string agg;                 ///< with group_by: count, FN:COL (min, max, mean, median, sum, argmin, argmax)
 };
 
 /// Register the subcommand; returns the argument struct it fills.

@@ -99,7 +99,15 @@ bool Selector::test(const Condition& k, std::int64_t r) const {
   return false;
 }
 
-std::vector<Condition> parse_where(const std::string& expr, const RunsTable& t) {
+bool Selector::test(const Disjunction& d, std::int64_t r) const {
+  return std::any_of(d.begin(), d.end(), [&](const Conjunction& c) {
+    return std::all_of(c.begin(), c.end(), [&](const Condition& k) { return test(k, r); });
+  });
+}
+
+namespace {
+
+Disjunction parse_alternative(const std::string& expr, const RunsTable& t) {
   std::vector<std::string> operands, ops;
   std::string cur;
   for (std::size_t i = 0; i < expr.size();) {
@@ -116,7 +124,8 @@ std::vector<Condition> parse_where(const std::string& expr, const RunsTable& t) 
   }
   operands.push_back(trim(cur));
   const std::string syntax =
-      "; expected COL OP VALUE (OP one of = != < <= > >=), COL=A,B,C, COL=LO..HI or LO<=COL<=HI";
+      "; expected COL OP VALUE (OP one of = != < <= > >=), COL=A,B,C, COL=LO..HI, LO<=COL<=HI, or "
+      "alternatives A | B";
   if (ops.empty() || ops.size() > 2) throw ArgError("--where '" + expr + "': cannot parse" + syntax);
   std::vector<Op> o;
   for (auto& s : ops) {
@@ -128,17 +137,16 @@ std::vector<Condition> parse_where(const std::string& expr, const RunsTable& t) 
     if (s.empty()) throw ArgError("--where '" + expr + "': missing operand" + syntax);
 
   auto make = [&](const RunsColumn* c, Op op, const std::string& rhs) {
-    std::vector<Condition> out;
+    Disjunction out;
     const bool str = c->type == CellType::str;
     const auto dots = rhs.find("..");
     if (!str && dots != std::string::npos && (op == Op::eq || op == Op::ne)) {
       const double lo = parse_number(rhs.substr(0, dots), *c, expr), hi = parse_number(rhs.substr(dots + 2), *c, expr);
       if (op == Op::eq) {
-        out.push_back({c, Op::ge, {lo}, {}});
-        out.push_back({c, Op::le, {hi}, {}});
+        out.push_back({{c, Op::ge, {lo}, {}}, {c, Op::le, {hi}, {}}});
       } else {
-        out.push_back({c, Op::lt, {lo}, {}});
-        out.push_back({c, Op::gt, {hi}, {}, true});
+        out.push_back({{c, Op::lt, {lo}, {}}});
+        out.push_back({{c, Op::gt, {hi}, {}}});
       }
       return out;
     }
@@ -148,7 +156,7 @@ std::vector<Condition> parse_where(const std::string& expr, const RunsTable& t) 
       if (str) k.strs.push_back(v);
       else k.nums.push_back(parse_number(v, *c, expr));
     }
-    out.push_back(k);
+    out.push_back({k});
     return out;
   };
 
@@ -163,10 +171,34 @@ std::vector<Condition> parse_where(const std::string& expr, const RunsTable& t) 
   const bool up = (o[0] == Op::lt || o[0] == Op::le) && (o[1] == Op::lt || o[1] == Op::le);
   const bool down = (o[0] == Op::gt || o[0] == Op::ge) && (o[1] == Op::gt || o[1] == Op::ge);
   if (!up && !down) throw ArgError("--where '" + expr + "': a range needs two < / <= (or two > / >=)" + syntax);
-  auto a = make(c, flip(o[0]), operands[0]);
-  auto b = make(c, o[1], operands[2]);
-  a.insert(a.end(), b.begin(), b.end());
-  return a;
+  const Disjunction a = make(c, flip(o[0]), operands[0]), b = make(c, o[1], operands[2]);
+  Disjunction both;  // (a1 | a2 ...) & (b1 | b2 ...), distributed
+  for (const Conjunction& x : a)
+    for (const Conjunction& y : b) {
+      both.push_back(x);
+      both.back().insert(both.back().end(), y.begin(), y.end());
+    }
+  return both;
+}
+
+}  // namespace
+
+Disjunction parse_where(const std::string& expr, const RunsTable& t) {
+  Disjunction out;
+  for (const std::string& part : split(expr, '|')) {
+    if (part.empty())
+      throw ArgError("--where '" + expr + "': an empty alternative; expected A | B with a condition on each side");
+    const Disjunction d = parse_alternative(part, t);
+    out.insert(out.end(), d.begin(), d.end());
+  }
+  return out;
+}
+
+std::vector<Condition> all_conditions(const std::vector<Disjunction>& filters) {
+  std::vector<Condition> out;
+  for (const Disjunction& d : filters)
+    for (const Conjunction& c : d) out.insert(out.end(), c.begin(), c.end());
+  return out;
 }
 
 std::vector<std::string> unheld_value_notes(const std::vector<Condition>& conditions, const RunsTable& t,

@@ -30,8 +30,12 @@ struct Condition {
   Op op = Op::eq;
   std::vector<double> nums;
   std::vector<std::string> strs;
-  bool or_prev = false;  ///< OR with the previous condition (COL!=LO..HI: below LO or above HI)
 };
+
+/// Conditions that all hold (AND).
+using Conjunction = std::vector<Condition>;
+/// One --where expression in disjunctive form: it holds when any of its conjunctions holds.
+using Disjunction = std::vector<Conjunction>;
 
 /// Tests rows against conditions; numbers as shown (angles in degrees unless `radians`).
 struct Selector {
@@ -40,14 +44,19 @@ struct Selector {
 
   double value(const RunsColumn& c, std::int64_t r) const;
   bool test(const Condition& k, std::int64_t r) const;
+  bool test(const Disjunction& d, std::int64_t r) const;  ///< any conjunction whose conditions all hold
 };
 
-/// Parse one --where expression into conditions (a range gives two). Throws ArgError.
+/// Parse one --where expression. Throws ArgError.
 ///   COL OP VALUE          OP: = == != < <= > >=   (VALUE OP COL also works)
 ///   COL=V1,V2,...         any of the values (!=: none of them)
-///   COL=LO..HI            LO <= COL <= HI (!=: outside)
+///   COL=LO..HI            LO <= COL <= HI (!=: outside: below LO or above HI)
 ///   LO<COL<=HI            chained range (< or <=, or > / >= descending)
-std::vector<Condition> parse_where(const std::string& expr, const RunsTable& t);
+///   A | B | ...           any of the alternatives (each one of the forms above)
+Disjunction parse_where(const std::string& expr, const RunsTable& t);
+
+/// Every condition of the expressions, flattened (for notes and the columns a query mentions).
+std::vector<Condition> all_conditions(const std::vector<Disjunction>& filters);
 
 /// For each text value of an = / != condition that no row holds (among the done rows, or all rows
 /// with `include_pending`): "no row has method = 'local_weightd'; did you mean 'local_weighted'?"

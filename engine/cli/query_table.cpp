@@ -1,0 +1,316 @@
+// `kinesweep query` on a table in memory (see query_table.hpp).
+#include "cli/query_table.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <map>
+#include <set>
+
+#include "cli/query_where.hpp"
+
+namespace ks::cli {
+
+namespace {
+
+struct SortKey {
+  const RunsColumn* col;
+  bool desc;
+};
+
+std::string shown_unit(const RunsColumn& c, bool radians) { return c.angle() && !radians ? "deg" : c.unit; }
+
+std::vector<SortKey> parse_sort(const QueryArgs& a, const RunsTable& t) {
+  std::vector<SortKey> keys;
+  for (const auto& s : a.sort) {
+    for (auto& part : split(s, ',')) {
+      std::string name = part;
+      bool desc = false;
+      if (const auto colon = part.rfind(':'); colon != std::string::npos) {
+        const std::string dir = part.substr(colon + 1);
+        if (dir != "desc" && dir != "asc") throw ArgError("--sort '" + part + "': expected COL, COL:asc or COL:desc");
+        desc = dir == "desc";
+        name = part.substr(0, colon);
+      }
+      const RunsColumn* c = t.find(name);
+      if (!c) throw ArgError(unknown_column_message(name, t, " in --sort"));
+      keys.push_back({c, desc});
+    }
+  }
+  return keys;
+}
+
+/// Stable sort (ties stay in row order); NaN last in either direction.
+void sort_rows(std::vector<std::int64_t>& rows, const std::vector<SortKey>& keys, const Selector& sel) {
+  if (keys.empty()) return;
+  std::stable_sort(rows.begin(), rows.end(), [&](std::int64_t x, std::int64_t y) {
+    for (const SortKey& k : keys) {
+      const RunsColumn& c = *k.col;
+      if (c.type == CellType::str) {
+        if (c.s[x] == c.s[y]) continue;
+        return k.desc ? c.s[x] > c.s[y] : c.s[x] < c.s[y];
+      }
+      const double u = sel.value(c, x), v = sel.value(c, y);
+      const bool nu = std::isnan(u), nv = std::isnan(v);
+      if (nu || nv) {
+        if (nu && nv) continue;
+        return nv;  // the non-NaN one first
+      }
+      if (u == v) continue;
+      return k.desc ? u > v : u < v;
+    }
+    return false;
+  });
+}
+
+OutCell cell(const RunsColumn& c, std::int64_t r, const Selector& sel) {
+  switch (c.type) {
+    case CellType::f64: return sel.value(c, r);
+    case CellType::i64: return c.i[r];
+    case CellType::str: return c.s[r];
+  }
+  return {};
+}
+
+/// The default columns of table output: run id, block (when several), the parameters that vary, the
+/// key metrics of the kinds of the rows shown, status, and every column a filter or sort mentions.
+std::vector<const RunsColumn*> compact_columns(const RunsTable& t, const std::vector<std::int64_t>& selected,
+                                               const std::set<const RunsColumn*>& mentioned) {
+  std::set<std::string> kinds;
+  for (auto r : selected) kinds.insert(t.kind(r));
+  std::set<const RunsColumn*> key_metrics;
+  for (const auto& kind : kinds)
+    for (const RunsColumn* c : t.key_metrics(kind)) key_metrics.insert(c);
+  auto varies = [&](const RunsColumn& c) {
+    for (std::size_t i = 1; i < selected.size(); ++i) {
+      const auto r0 = selected[0], r = selected[i];
+      if (c.type == CellType::str ? c.s[r] != c.s[r0]
+          : c.type == CellType::i64 ? c.i[r] != c.i[r0]
+                                    : !(c.f[r] == c.f[r0] || (std::isnan(c.f[r]) && std::isnan(c.f[r0]))))
+        return true;
+    }
+    return false;
+  };
+  std::vector<const RunsColumn*> cols;
+  for (auto& c : t.cols) {
+    bool take = mentioned.count(&c) > 0 || key_metrics.count(&c) > 0;
+    if (c.name == "run_id" || c.name == "status") take = true;  // bookkeeping shown always
+    if ((c.name == "block" || c.role == Role::parameter) && varies(c)) take = true;
+    if (take) cols.push_back(&c);
+  }
+  return cols;
+}
+
+// --- --group-by / --agg ---
+
+enum class Agg { count, min, max, mean, median, sum, argmin, argmax };
+struct AggSpec {
+  Agg fn;
+  const RunsColumn* col = nullptr;  ///< null for count
+  std::string name;                 ///< output column name: "count", "min(E)", ...
+};
+
+std::vector<AggSpec> parse_agg(const std::string& spec, const RunsTable& t) {
+  static const std::map<std::string, Agg> fns = {{"min", Agg::min},     {"max", Agg::max},       {"mean", Agg::mean},
+                                                 {"median", Agg::median}, {"sum", Agg::sum},   {"argmin", Agg::argmin},
+                                                 {"argmax", Agg::argmax}};
+  std::vector<AggSpec> out;
+  for (const std::string& part : split(spec.empty() ? "count" : spec, ',')) {
+    if (part == "count") {
+      out.push_back({Agg::count, nullptr, "count"});
+      continue;
+    }
+    const auto colon = part.find(':');
+    const std::string fn = colon == std::string::npos ? part : part.substr(0, colon);
+    const auto it = fns.find(fn);
+    if (it == fns.end() || colon == std::string::npos) {
+      std::vector<std::string> names{"count"};
+      for (auto& [k, v] : fns) names.push_back(k);
+      std::string m = "--agg '" + part + "': expected count or FN:COL with FN one of min, max, mean, median, sum, "
+                      "argmin, argmax (e.g. --agg min:E,count)";
+      if (it == fns.end() && !fn.empty()) {
+        const std::string dym = did_you_mean(fn, names);
+        if (!dym.empty()) m += "; did you mean '" + dym + "'?";
+      }
+      throw ArgError(m);
+    }
+    const std::string name = part.substr(colon + 1);
+    const RunsColumn* c = t.find(name);
+    if (!c) throw ArgError(unknown_column_message(name, t, " in --agg '" + part + "'"));
+    if (c->type == CellType::str)
+      throw ArgError("--agg '" + part + "': column " + name + " holds text; " + fn + " needs a numeric column");
+    out.push_back({it->second, c, fn + "(" + name + ")"});
+  }
+  return out;
+}
+
+/// One group's aggregate of one spec; `id` gives the run id (or row index) printed by argmin/argmax.
+OutCell aggregate(const AggSpec& s, const std::vector<std::int64_t>& rows, const Selector& sel, const RunsColumn* id) {
+  if (s.fn == Agg::count) return static_cast<std::int64_t>(rows.size());
+  std::vector<std::pair<double, std::int64_t>> v;  // finite values and their rows
+  for (auto r : rows) {
+    const double x = sel.value(*s.col, r);
+    if (!std::isnan(x)) v.emplace_back(x, r);
+  }
+  if (v.empty()) return s.fn == Agg::argmin || s.fn == Agg::argmax ? OutCell{std::int64_t{-1}} : OutCell{std::nan("")};
+  auto less = [](const auto& p, const auto& q) { return p.first < q.first; };
+  switch (s.fn) {
+    case Agg::min: return std::min_element(v.begin(), v.end(), less)->first;
+    case Agg::max: return std::max_element(v.begin(), v.end(), less)->first;
+    case Agg::argmin:
+    case Agg::argmax: {
+      const auto it = s.fn == Agg::argmin ? std::min_element(v.begin(), v.end(), less)
+                                          : std::max_element(v.begin(), v.end(), less);  // first of ties
+      return id ? id->i[it->second] : it->second;
+    }
+    case Agg::sum:
+    case Agg::mean: {
+      double sum = 0;
+      for (auto& p : v) sum += p.first;
+      return s.fn == Agg::sum ? sum : sum / static_cast<double>(v.size());
+    }
+    case Agg::median: {
+      std::sort(v.begin(), v.end(), less);
+      const std::size_t n = v.size();
+      return n % 2 ? v[n / 2].first : 0.5 * (v[n / 2 - 1].first + v[n / 2].first);
+    }
+    case Agg::count: break;
+  }
+  return {};
+}
+
+int group_mode(const QueryArgs& a, const RunsTable& t, Format fmt, const std::vector<std::int64_t>& selected,
+               const Selector& sel) {
+  if (!a.sort.empty() || !a.columns.empty())
+    throw ArgError("--group-by prints one row per group, in the order of the group values; --sort and --columns "
+                   "apply to rows (use --agg to choose the group's columns)");
+  std::vector<const RunsColumn*> keys;
+  for (const std::string& name : split(a.group_by, ',')) {
+    const RunsColumn* c = t.find(name);
+    if (!c) throw ArgError(unknown_column_message(name, t, " in --group-by"));
+    keys.push_back(c);
+  }
+  const std::vector<AggSpec> specs = parse_agg(a.agg, t);
+  const RunsColumn* id = t.find("run_id");
+  if (id && id->type != CellType::i64) id = nullptr;
+  // Groups in the order of their key values (numbers as shown, text lexicographic; NaN last).
+  std::vector<std::int64_t> order = selected;
+  std::vector<SortKey> sk;
+  for (auto* c : keys) sk.push_back({c, false});
+  sort_rows(order, sk, sel);
+  auto same = [&](std::int64_t x, std::int64_t y) {
+    for (const RunsColumn* c : keys) {
+      if (c->type == CellType::str ? c->s[x] != c->s[y] : c->type == CellType::i64 ? c->i[x] != c->i[y] : false)
+        return false;
+      if (c->type == CellType::f64) {
+        const double u = sel.value(*c, x), v = sel.value(*c, y);
+        if (!(u == v || (std::isnan(u) && std::isnan(v)))) return false;
+      }
+    }
+    return true;
+  };
+  OutTable out;
+  std::vector<std::string> converted;
+  for (const RunsColumn* c : keys) {
+    out.names.push_back(c->name);
+    out.units.push_back(shown_unit(*c, a.radians));
+    out.csv_names.push_back(c->angle() && !a.radians ? c->name + " [deg]" : c->name);
+    if (c->angle() && !a.radians) converted.push_back(c->name);
+  }
+  for (const AggSpec& s : specs) {
+    const bool value = s.col && s.fn != Agg::argmin && s.fn != Agg::argmax;
+    const std::string unit = value ? shown_unit(*s.col, a.radians) : "";
+    out.names.push_back(s.name);
+    out.units.push_back(unit);
+    out.csv_names.push_back(unit == "deg" && s.col->angle() ? s.name + " [deg]" : s.name);
+  }
+  std::size_t groups = 0;
+  for (std::size_t i = 0; i < order.size();) {
+    std::size_t j = i;
+    std::vector<std::int64_t> members;
+    while (j < order.size() && same(order[i], order[j])) members.push_back(order[j++]);
+    ++groups;
+    if (a.limit < 0 || out.rows.size() < static_cast<std::size_t>(a.limit)) {
+      std::vector<OutCell> row;
+      for (const RunsColumn* c : keys) row.push_back(cell(*c, order[i], sel));
+      for (const AggSpec& s : specs) row.push_back(aggregate(s, members, sel, id));
+      out.rows.push_back(std::move(row));
+    }
+    i = j;
+  }
+  print_out(out, fmt, std::cout);
+  if (fmt == Format::table) {
+    std::cout << "(" << out.rows.size() << " of " << groups << " groups of " << selected.size() << " rows"
+              << (id ? "; argmin/argmax give the run_id" : "; argmin/argmax give the row index");
+    if (!converted.empty()) std::cout << "; angles in degrees (stored in radians): " << join(converted, ", ");
+    std::cout << ")\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+int table_mode(const QueryArgs& a, const RunsTable& t, Format fmt, const TableWording& wording) {
+  Selector sel{t, a.radians};
+  std::vector<Disjunction> filters;
+  for (const auto& w : a.where) filters.push_back(parse_where(w, t));
+  const std::vector<Condition> conds = all_conditions(filters);
+  for (const std::string& note : unheld_value_notes(conds, t, a.include_pending))
+    std::cerr << "kinesweep query: note: " << note << '\n';
+  std::set<const RunsColumn*> mentioned;
+  for (const Condition& c : conds) mentioned.insert(c.col);
+  const std::vector<SortKey> keys = parse_sort(a, t);
+  for (const SortKey& k : keys) mentioned.insert(k.col);
+
+  std::vector<std::int64_t> selected;
+  for (std::int64_t r = 0; r < t.n_runs; ++r) {
+    if (!a.include_pending && !t.done[static_cast<std::size_t>(r)]) continue;
+    if (std::all_of(filters.begin(), filters.end(), [&](const Disjunction& d) { return sel.test(d, r); }))
+      selected.push_back(r);
+  }
+  if (!a.group_by.empty()) return group_mode(a, t, fmt, selected, sel);
+  if (!a.agg.empty()) throw ArgError("--agg needs --group-by COL (e.g. --group-by method --agg min:E,count)");
+
+  std::vector<const RunsColumn*> cols;
+  if (a.columns == "all" || (a.columns.empty() && (fmt != Format::table || !wording.compact_default))) {
+    for (auto& c : t.cols) cols.push_back(&c);
+  } else if (!a.columns.empty()) {
+    for (auto& name : split(a.columns, ',')) {
+      if (name.empty()) continue;
+      const RunsColumn* c = t.find(name);
+      if (!c) throw ArgError(unknown_column_message(name, t, " in --columns"));
+      cols.push_back(c);
+    }
+  } else {
+    cols = compact_columns(t, selected, mentioned);
+  }
+  sort_rows(selected, keys, sel);
+  const std::size_t matching = selected.size();
+  if (a.limit >= 0 && selected.size() > static_cast<std::size_t>(a.limit)) selected.resize(static_cast<std::size_t>(a.limit));
+
+  OutTable out;
+  std::vector<std::string> converted;
+  for (const RunsColumn* c : cols) {
+    const bool deg = c->angle() && !a.radians;
+    out.names.push_back(c->name);
+    out.units.push_back(shown_unit(*c, a.radians));
+    out.csv_names.push_back(deg ? c->name + " [deg]" : c->name);
+    if (deg) converted.push_back(c->name);
+  }
+  for (auto r : selected) {
+    std::vector<OutCell> row;
+    for (const RunsColumn* c : cols) row.push_back(cell(*c, r, sel));
+    out.rows.push_back(std::move(row));
+  }
+  print_out(out, fmt, std::cout);
+  if (fmt == Format::table) {
+    std::cout << "(" << out.rows.size() << " of " << matching << " " << wording.rows;
+    if (!wording.summary.empty()) std::cout << "; " << wording.summary;
+    if (!converted.empty()) std::cout << "; angles in degrees (stored in radians): " << join(converted, ", ");
+    if (a.columns.empty() && wording.compact_default) std::cout << "; --columns all shows every column";
+    std::cout << ")\n";
+  }
+  return 0;
+}
+
+}  // namespace ks::cli

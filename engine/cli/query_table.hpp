@@ -1,0 +1,22 @@
+#pragma once
+// `kinesweep query` on a table in memory (the /runs rows, or one optimisation's evaluations): the
+// --where filter, --sort, --columns, --limit, and --group-by with --agg.
+#include <string>
+
+#include "cli/query_command.hpp"
+#include "cli/query_util.hpp"
+
+namespace ks::cli {
+
+/// What a table's rows are called in the trailer of table output.
+struct TableWording {
+  std::string rows = "matching rows";  ///< "(3 of 10 matching rows; ...)"
+  std::string summary;                 ///< the trailer's second part, e.g. "8 of 10 runs done"
+  bool compact_default = true;         ///< table format without --columns: run_id, varying parameters, key metrics
+};
+
+/// Filter, sort and print `t` (or its groups, with --group-by) as the arguments say.
+/// Throws ArgError on a bad argument.
+int table_mode(const QueryArgs& a, const RunsTable& t, Format fmt, const TableWording& wording);
+
+}  // namespace ks::cli
