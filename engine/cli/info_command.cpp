@@ -189,7 +189,12 @@ std::string axis_text(const store::LandscapeAxis& a) {
   } else if (!a.values.empty()) {
     const bool deg = a.unit == "rad";
     const double k = deg ? kRadToDeg : 1.0;
-    o << ", " << format_double(a.values.front() * k) << " .. " << format_double(a.values.back() * k);
+    // Grid axes in their order (a descending one stays descending); drawn ones (random, LHS) by range.
+    const bool up = std::is_sorted(a.values.begin(), a.values.end());
+    const bool down = std::is_sorted(a.values.rbegin(), a.values.rend());
+    const auto [lo, hi] = std::minmax_element(a.values.begin(), a.values.end());
+    const double first = up || down ? a.values.front() : *lo, last = up || down ? a.values.back() : *hi;
+    o << (up || down ? ", " : ", drawn in ") << format_double(first * k) << " .. " << format_double(last * k);
     if (deg) o << " deg";
     else if (!a.unit.empty()) o << " " << a.unit;
   }
