@@ -7,12 +7,14 @@
 #include "cli/run_command.hpp"
 #include "cli/schema_command.hpp"
 #include "cli/table4.hpp"
+#include "common/shell_word.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"kinesweep: parameter-sweep studies of redundant manipulators"};
   app.set_version_flag("--version", std::string("kinesweep ") + KINESWEEP_VERSION);
   app.require_subcommand(1);
   ks::cli::RunArgs& run = ks::cli::add_run_command(app);
+  run.program = ks::command_name(argc > 0 ? argv[0] : "");
   ks::cli::InfoArgs& info = ks::cli::add_info_command(app);
   ks::cli::QueryArgs& query = ks::cli::add_query_command(app);
   ks::cli::SchemaArgs& schema = ks::cli::add_schema_command(app);

@@ -7,9 +7,13 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <thread>
 
+#include "cli/dry_run.hpp"
+#include "cli/human_units.hpp"
+#include "common/shell_word.hpp"
 #include "runner/run_study.hpp"
 #include "store/store.hpp"
 #include "study/study.hpp"
@@ -44,62 +48,16 @@ bool parse_histories(const std::string& s, HistoryPolicy& p) {
   return false;
 }
 
-std::string human_bytes(double b) {
-  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
-  int u = 0;
-  while (b >= 1024 && u < 4) b /= 1024, ++u;
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f %s", b, units[u]);
-  return buf;
-}
-std::string human_time(double s) {
-  char buf[32];
-  if (s < 120) std::snprintf(buf, sizeof buf, "%.1f s", s);
-  else if (s < 7200) std::snprintf(buf, sizeof buf, "%.1f min", s / 60);
-  else std::snprintf(buf, sizeof buf, "%.1f h", s / 3600);
-  return buf;
-}
-
-int dry_run(const Study& study, const StudySchema& schema, const HistoryPolicy& h, int threads, int level) {
-  std::cout << "study " << study.name << " (" << study.file << "), sha256 " << study.sha256 << '\n';
-  for (const Block& b : study.blocks) {
-    std::cout << "  block " << b.name() << " (" << to_string(b.kind()) << "): " << b.run_count() << " runs =";
-    const auto shape = b.shape();
-    if (shape.empty()) std::cout << " 1";
-    for (std::size_t d = 0; d < shape.size(); ++d) std::cout << (d ? " x " : " ") << shape[d];
-    std::cout << '\n';
-  }
-  // Estimate from a few runs spread over the study, executed here on one thread.
-  const std::uint64_t total = study.run_count();
-  const int stride = h.mode == HistoryPolicy::Mode::none ? 0 : h.stride;
-  const std::uint64_t samples = std::min<std::uint64_t>(total, 24);
-  RunWorkspace ws;
-  double seconds = 0, bytes = 0;
-  for (std::uint64_t i = 0; i < samples; ++i) {
-    const std::uint64_t id = samples > 1 ? i * (total - 1) / (samples - 1) : 0;
-    const RunRef ref = study.locate(id);
-    const RunSpec run = study.blocks[ref.block].run(ref.local);
-    const auto t0 = std::chrono::steady_clock::now();
-    const RunOutcome o = execute(Scenario::of(study), run, stride, ws);
-    const store::EncodedHistory encoded = store::encode_history(o.history, level);
-    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    for (const auto& a : encoded.arrays) bytes += static_cast<double>(a.bytes.size()) + 600;
-  }
-  const double per_run_s = samples ? seconds / samples : 0, per_run_b = samples ? bytes / samples : 0;
-  const int n = threads > 0 ? threads : static_cast<int>(std::thread::hardware_concurrency());
-  std::cout << "  total: " << total << " runs; histories " << h.str() << "\n  estimated size: "
-            << human_bytes(total * (per_run_b + 9.0 * schema.columns.size())) << "; estimated time: "
-            << human_time(total * per_run_s / std::max(1, n)) << " on " << n << " threads (from " << samples
-            << " sample runs)\n";
-  for (const OptimizeBlock& ob : study.optimizations) {  // run after the sweep
-    std::cout << "  optimization " << ob.name << ": minimise " << ob.objective_text << " over";
-    for (const auto& v : ob.variables) std::cout << ' ' << v.name;
-    if (!ob.polish_block.empty()) std::cout << "; sweep " << ob.polish_block << " (best " << ob.polish_best << ")";
-    if (ob.global) std::cout << "; global " << opt::to_string(ob.global->algorithm) << " (max_evals " << ob.global->max_evals << ")";
-    if (ob.local) std::cout << "; local " << opt::to_string(ob.local->algorithm) << " (max_evals " << ob.local->max_evals << ")";
-    std::cout << '\n';
-  }
-  return 0;
+/// Why `path` cannot name a results file ("" when it can): the file is HDF5, so its name ends in
+/// .h5 or .hdf5 (a .csv or .json name would hide what it holds; `kinesweep query` exports those).
+std::string output_name_problem(const std::string& path) {
+  const std::filesystem::path p(path);
+  const std::string ext = p.extension().string();
+  if (ext == ".h5" || ext == ".hdf5") return "";
+  std::string m = "a results file is HDF5; expected a name ending in .h5 (or .hdf5)";
+  if (ext == ".csv" || ext == ".json")
+    m += "; for " + ext.substr(1) + ", run into FILE.h5, then: kinesweep query FILE.h5 --format " + ext.substr(1);
+  return m;
 }
 
 class ProgressDisplay {
@@ -167,11 +125,19 @@ int run_command(const RunArgs& a) {
     std::cerr << "kinesweep run: --resume and --overwrite exclude each other\n";
     return 2;
   }
-  if (a.dry_run) return dry_run(study, make_schema(study), histories, a.threads, a.compression);
+  const std::string output = a.output.empty() ? study.output : a.output;
+  if (const std::string why = output_name_problem(output); !why.empty()) {
+    std::cerr << "kinesweep run: " << (a.output.empty() ? "the study's output " : "-o ") << shell_word(output) << ": "
+              << why << '\n';
+    return 2;
+  }
+  if (a.dry_run)
+    return dry_run(study, make_schema(study), {histories, a.threads, a.compression, output}, std::cout, std::cerr);
 
   RunRequest r;
   r.study_arg = a.study;
-  r.output = a.output.empty() ? study.output : a.output;
+  r.program = a.program;
+  r.output = output;
   r.resume = a.resume;
   r.overwrite = a.overwrite;
   r.quiet = a.quiet;

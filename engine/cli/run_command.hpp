@@ -17,6 +17,7 @@ struct RunArgs {
   std::string histories;   ///< empty: the study's policy
   bool quiet = false;      ///< no progress display
   int compression = 1;     ///< history deflate level (0: raw chunks, no filter)
+  std::string program = "kinesweep";  ///< how the user invoked kinesweep (argv[0]), for printed commands
 };
 
 /// Register the subcommand; returns the argument struct it fills.

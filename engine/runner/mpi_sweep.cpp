@@ -22,6 +22,7 @@
 #include <memory>
 #include <thread>
 
+#include "common/shell_word.hpp"
 #include "runner/mpi_work.hpp"
 #include "runner/sweep_backend.hpp"
 
@@ -176,7 +177,8 @@ class MpiBackend final : public SweepBackend {
     return "the results file and the shards " + shard_path(r.output, 0) + " ...";
   }
   std::string resume_command(const RunRequest& r) const override {
-    return "mpirun -np " + std::to_string(size_) + " kinesweep run " + r.study_arg + " -o " + r.output + " --resume";
+    return "mpirun -np " + std::to_string(size_) + " " + r.program + " run " + shell_word(r.study_arg) + " -o " +
+           shell_word(r.output) + " --resume";
   }
 
   int open(const Study& study, const StudySchema& schema, const RunRequest& r, std::ostream& err) override {

@@ -5,6 +5,7 @@
 #include <optional>
 #include <ostream>
 
+#include "common/shell_word.hpp"
 #include "runner/optimize_blocks.hpp"
 #include "runner/sweep_backend.hpp"
 
@@ -77,7 +78,7 @@ class LocalBackend final : public SweepBackend {
 
   std::string kept_in(const RunRequest& r) const override { return r.output; }
   std::string resume_command(const RunRequest& r) const override {
-    return "kinesweep run " + r.study_arg + " -o " + r.output + " --resume";
+    return r.program + " run " + shell_word(r.study_arg) + " -o " + shell_word(r.output) + " --resume";
   }
   int finish(int code) override { return code; }
 

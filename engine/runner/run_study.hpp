@@ -12,6 +12,7 @@ namespace ks {
 
 struct RunRequest {
   std::string study_arg;   ///< the study path as the user gave it (for the resume hint)
+  std::string program = "kinesweep";  ///< the command that runs kinesweep, one shell word (for the hint)
   std::string output;      ///< the results file
   bool resume = false, overwrite = false, quiet = false;
   /// threads (per process or rank; 0: all cores, shared fairly between the ranks on a node),

@@ -32,7 +32,10 @@ void Parser::parse_study_table(const toml::table& root, Study& s) {
   if (auto v = get_string(*t, "description", "description")) s.description = *v;
   s.output = "results/" + s.name + ".h5";
   if (auto v = get_string(*t, "output", "output")) {
+    const bool hdf5 = v->ends_with(".h5") || v->ends_with(".hdf5");
     if (v->empty()) error(*t->get("output"), "output is empty; expected a file path");
+    else if (!hdf5)
+      error(*t->get("output"), "output '" + *v + "': a results file is HDF5; expected a name ending in .h5 (or .hdf5)");
     else s.output = *v;
   }
   if (auto v = get_string(*t, "histories", "histories")) {

@@ -5,6 +5,7 @@ usage: /usr/bin/python3 test_cli_run.py KINESWEEP_BINARY STUDIES_DIR
 """
 import hashlib
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -94,6 +95,38 @@ class Outputs(Base):
         self.assertFalse(os.path.exists(out))
 
 
+    def test_output_must_be_named_as_hdf5(self):
+        study = self.write("ok.toml", SWEEP)
+        out = os.path.join(self.dir, "r.csv")
+        r = run("run", study, "-o", out, "-q")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("expected a name ending in .h5", r.stderr)
+        self.assertIn("--format csv", r.stderr)
+        self.assertEqual(os.listdir(self.dir), ["ok.toml"])
+        bad = self.write("bad.toml", SWEEP.replace('[study]\n', '[study]\noutput = "x.json"\n', 1))
+        r = run("run", bad, "-q")
+        self.assertEqual(r.returncode, 2)
+        self.assertRegex(r.stderr, r"bad\.toml:\d+:\d+")
+        self.assertIn("expected a name ending in .h5", r.stderr)
+
+    def test_dry_run_names_the_output_and_estimates_the_size_within_2x(self):
+        # The estimate is measured from sample runs written here; the real file's size (h5py-free: the
+        # file system) must be within a factor 2, with and without histories.
+        for histories in ("none", "every=10", "full"):
+            with self.subTest(histories):
+                study = self.write("ok.toml", SWEEP)
+                out = os.path.join(self.dir, f"r_{histories}.h5")
+                r = run("run", study, "-o", out, "--dry-run", "--histories", histories)
+                self.assertEqual(r.returncode, 0, r.stderr)
+                self.assertIn("output " + out, r.stdout)
+                m = re.search(r"estimated size: ([\d.]+) (B|KiB|MiB|GiB)", r.stdout)
+                self.assertIsNotNone(m, r.stdout)
+                est = float(m.group(1)) * 1024 ** ["B", "KiB", "MiB", "GiB"].index(m.group(2))
+                self.assertEqual(run("run", study, "-o", out, "-q", "--histories", histories).returncode, 0)
+                real = os.path.getsize(out)
+                self.assertLess(max(est / real, real / est), 2.0, f"estimated {est:.0f} B, file {real} B")
+
+
 class Reproducibility(Base):
     def test_results_identical_whatever_the_thread_count(self):
         study = self.write("ok.toml", SWEEP)
@@ -164,10 +197,14 @@ class CrashAndResume(Base):
         p.send_signal(signal.SIGINT)
         stdout, _ = p.communicate()
         if p.returncode == 130:
-            self.assertIn("--resume", stdout)
+            # The hint is a command that works as printed (the binary as it was invoked).
+            hint = [line for line in stdout.splitlines() if line.startswith("resume with: ")]
+            self.assertEqual(len(hint), 1, stdout)
+            self.assertIn(KS, hint[0])
+            r = subprocess.run(["bash", "-c", hint[0][len("resume with: "):] + " -q"], capture_output=True, text=True)
         else:
             self.assertEqual(p.returncode, 0)  # finished before the signal arrived
-        r = run("run", study, "-o", out, "--resume", "-q")
+            r = run("run", study, "-o", out, "--resume", "-q")
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertTrue(same_tables(runs_table(out), ref))
 

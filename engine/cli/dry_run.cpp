@@ -1,0 +1,160 @@
+// `kinesweep run --dry-run` (see dry_run.hpp).
+//
+// Each block's runs are sampled along a golden-ratio sequence of its run indices (any prefix is spread
+// over the block), executed and encoded as the sweep does (compute time and history bytes per run),
+// then all samples are written through the store into a temporary results file: its size beyond a
+// file of one empty row gives the bytes per run on disk (rows, history objects, index), and the
+// writer's time the serial cost per run. The sweep overlaps computing (all threads) with the single
+// writer, so its time is about max((compute + write) / threads, write).
+#include "cli/dry_run.hpp"
+#include "cli/human_units.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <ostream>
+#include <thread>
+
+#include "runner/execute.hpp"
+#include "runner/run_study.hpp"
+#include "store/store.hpp"
+
+namespace ks::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+struct Sample {
+  std::size_t block;
+  std::uint64_t local;
+  Record row;
+  store::EncodedHistory history;
+};
+
+struct BlockEstimate {
+  std::uint64_t runs = 0;
+  std::size_t sampled = 0;
+  double compute_s = 0;  ///< per run
+};
+
+/// Run-index sequence over [0, n): the golden-ratio (Weyl) sequence, distinct indices, any prefix spread.
+std::vector<std::uint64_t> spread_indices(std::uint64_t n, std::size_t max) {
+  std::vector<std::uint64_t> out;
+  const double phi = 0.6180339887498949;
+  double x = 0.5;
+  for (std::size_t tries = 0; out.size() < std::min<std::uint64_t>(n, max) && tries < 16 * max; ++tries) {
+    const auto i = std::min<std::uint64_t>(n - 1, static_cast<std::uint64_t>(x * static_cast<double>(n)));
+    if (std::find(out.begin(), out.end(), i) == out.end()) out.push_back(i);
+    x += phi;
+    x -= std::floor(x);
+  }
+  return out;
+}
+
+/// Size in bytes of a results file of `samples` (run ids 0..n-1) with `columns`, and the writer's time.
+std::pair<double, double> write_samples(const std::string& path, const Study& study, const StudySchema& schema,
+                                        const std::vector<Sample>& samples) {
+  const auto t0 = Clock::now();
+  {
+    auto w = store::ResultsWriter::create(path, store_meta(study), schema.columns,
+                                          static_cast<std::int64_t>(std::max<std::size_t>(samples.size(), 1)),
+                                          {.overwrite = true});
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      Record row = samples[i].row;
+      row.cells[schema.run_id] = static_cast<std::int64_t>(i);
+      w->write_run(static_cast<std::int64_t>(i), row, samples[i].history);
+    }
+    w->close();
+  }
+  const double s = std::chrono::duration<double>(Clock::now() - t0).count();
+  const double bytes = static_cast<double>(fs::file_size(path));
+  fs::remove(path);
+  return {bytes, s};
+}
+
+}  // namespace
+
+int dry_run(const Study& study, const StudySchema& schema, const DryRunOptions& opt, std::ostream& out,
+            std::ostream& err) {
+  out << "study " << study.name << " (" << study.file << "), sha256 " << study.sha256 << '\n';
+  out << "output " << opt.output << (fs::exists(opt.output) ? " (exists: --resume completes it, --overwrite replaces it)" : "")
+      << '\n';
+  const HistoryPolicy& h = opt.histories;
+  const int stride = h.mode == HistoryPolicy::Mode::none ? 0 : h.stride;
+  const Scenario scenario = Scenario::of(study);
+  RunWorkspace ws;
+  std::vector<Sample> samples;
+  std::vector<BlockEstimate> est(study.blocks.size());
+  for (std::size_t b = 0; b < study.blocks.size(); ++b) {
+    const Block& block = study.blocks[b];
+    out << "  block " << block.name() << " (" << to_string(block.kind()) << "): " << block.run_count() << " runs =";
+    const auto shape = block.shape();
+    if (shape.empty()) out << " 1";
+    for (std::size_t d = 0; d < shape.size(); ++d) out << (d ? " x " : " ") << shape[d];
+    out << '\n';
+    est[b].runs = block.run_count();
+    const auto start = Clock::now();
+    double compute = 0;
+    for (const std::uint64_t local : spread_indices(block.run_count(), 64)) {
+      if (est[b].sampled >= 4 && std::chrono::duration<double>(Clock::now() - start).count() > opt.seconds_per_block)
+        break;
+      const RunSpec run = block.run(local);
+      const auto t0 = Clock::now();
+      const RunOutcome o = execute(scenario, run, stride, ws);
+      store::EncodedHistory hist;
+      if (!o.history.arrays.empty()) hist = store::encode_history(o.history, opt.compression);
+      const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+      compute += wall;
+      samples.push_back({b, local, schema.row(study.first_run(b) + local, b, block, run, o, wall), std::move(hist)});
+      ++est[b].sampled;
+    }
+    est[b].compute_s = est[b].sampled ? compute / static_cast<double>(est[b].sampled) : 0;
+  }
+  // Bytes and writer time per run, from the sample file beyond a file of one empty row.
+  const fs::path tmp = fs::temp_directory_path() / ("kinesweep-dry-run-" + std::to_string(getpid()) + ".h5");
+  double file_bytes = 0, empty_bytes = 0, write_s = 0, empty_s = 0;
+  try {
+    std::tie(empty_bytes, empty_s) = write_samples(tmp.string(), study, schema, {});
+    std::tie(file_bytes, write_s) = write_samples(tmp.string(), study, schema, samples);
+  } catch (const std::exception& e) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    err << "kinesweep run: --dry-run: cannot write a sample results file in " << tmp.parent_path().string() << ": "
+        << e.what() << '\n';
+    return 1;
+  }
+  const double n_sampled = static_cast<double>(std::max<std::size_t>(samples.size(), 1));
+  const double bytes_per_run = std::max(0.0, file_bytes - empty_bytes) / n_sampled;
+  const double write_per_run = std::max(0.0, write_s - empty_s) / n_sampled;
+  double total_runs = 0, compute_total = 0;
+  for (const BlockEstimate& e : est) {
+    total_runs += static_cast<double>(e.runs);
+    compute_total += static_cast<double>(e.runs) * e.compute_s;
+  }
+  const int n = opt.threads > 0 ? opt.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const double write_total = total_runs * write_per_run;
+  const double seconds = std::max((compute_total + write_total) / n, write_total) + empty_s;
+  out << "  total: " << static_cast<std::uint64_t>(total_runs) << " runs; histories " << h.str()
+      << "\n  estimated size: " << human_bytes(empty_bytes + total_runs * bytes_per_run) << " ("
+      << human_bytes(bytes_per_run) << " per run); estimated time: " << human_time(seconds) << " on " << n
+      << " thread" << (n == 1 ? "" : "s") << " (from " << samples.size() << " sample runs executed and written here)\n";
+  for (const OptimizeBlock& ob : study.optimizations) {  // run after the sweep; not part of the estimates
+    out << "  optimization " << ob.name << ": minimise " << ob.objective_text << " over";
+    for (const auto& v : ob.variables) out << ' ' << v.name;
+    if (!ob.polish_block.empty()) out << "; sweep " << ob.polish_block << " (best " << ob.polish_best << ")";
+    if (ob.global) out << "; global " << opt::to_string(ob.global->algorithm) << " (max_evals " << ob.global->max_evals << ")";
+    if (ob.local) out << "; local " << opt::to_string(ob.local->algorithm) << " (max_evals " << ob.local->max_evals << ")";
+    out << '\n';
+  }
+  if (!study.optimizations.empty())
+    out << "  (the estimates cover the sweep; the optimization blocks run after it, up to their max_evals runs)\n";
+  return 0;
+}
+
+}  // namespace ks::cli
