@@ -100,7 +100,7 @@ RunArgs& add_run_command(CLI::App& app) {
   c->add_option("--threads", a.threads, "worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   c->add_flag("--resume", a.resume, "complete only the runs missing from an existing results file");
   c->add_flag("--overwrite", a.overwrite, "replace an existing results file");
-  c->add_flag("--dry-run", a.dry_run, "print runs per block and estimated size and time; write nothing");
+  c->add_flag("--dry-run", a.dry_run, "print the output path, runs per block, estimated size and time (from sample runs); write nothing");
   c->add_option("--histories", a.histories, "full | every=N | none (default: the study's)");
   c->add_option("--compression", a.compression, "deflate level of the histories, after HDF5's shuffle (default 1; 0: raw chunks, no filter)")
       ->check(CLI::Range(0, 9));
