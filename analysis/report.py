@@ -53,7 +53,7 @@ def grid_sections(res, cap_total):
     lss = [res.landscape(b, degrees=True) for b in names]
     ik = [ls for ls in lss if ls.kind == "ik"]
     n_fig = len(lss) + len(ik)
-    cap = max(500, cap_total // max(1, n_fig))
+    cap = max(min(500, cap_total), cap_total // max(1, n_fig))
     land = "".join(_landscape_html(i, ls, cap) for i, ls in enumerate(lss))
     basins = []
     for i, ls in enumerate(ik):
