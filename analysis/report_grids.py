@@ -200,6 +200,8 @@ def landscape_figure(ls, cap):
     pos = "%{x}" + (f" {xa.unit}" if xa.unit else "")
     head = f"{xa.name} = {pos}" + (f"<br>{ya.name} = %{{y}}" + (f" {ya.unit}" if ya.unit else "") if ya else "")
     frames, failed_seen, cells = [], {}, 0
+    fail_all = np.isfinite(status) & (status != 0)
+    dropdown = len(sel.frames) > MAX_FACETS  # then every frame carries its colour bar and legend entry
     for (flabel, f), v in zip(sel.frames, frames_val):
         ctx = (f"<br>{esc(flabel)}" if flabel else "") + "".join(
             f"<br>{esc(value_text(ls.axes[d], sel.fixed[d]))}" for d in sel.held)
@@ -213,7 +215,7 @@ def landscape_figure(ls, cap):
         cb = {"title": {"text": label, "side": "right"}, **(ticks or {})}
         traces = [{"type": "heatmap", "x": xs, "y": ys, "z": zt, "customdata": custom, "hovertemplate": tmpl,
                    "colorscale": "Viridis", "zmin": zmin, "zmax": zmax, "colorbar": cb, "hoverongaps": False,
-                   "showscale": not frames, "name": metric}]
+                   "showscale": dropdown or not frames, "name": metric}]
         fail = np.where(np.isfinite(st) & (st != 0), st, np.nan)
         codes = sorted({int(c) for c in fail[np.isfinite(fail)].ravel()})
         if codes:
@@ -221,16 +223,23 @@ def landscape_figure(ls, cap):
                 failed_seen[c] = failed_seen.get(c, 0) + int(np.sum(sel.slice(status, f) == c))
             names = np.array([statuses[int(c)] if np.isfinite(c) else "" for c in fail.ravel()],
                              dtype=object).reshape(fail.shape)
-            traces.append({"type": "heatmap", "x": xs, "y": ys, "z": fail, "customdata": names,
+            # the failed runs' metrics that have values (an IK failure's iterations and final error)
+            fm = [m for m in ls.metrics if m not in ("ok", "converged", "status_code")
+                  and np.isfinite(np.where(fail_all, ls.metrics[m], np.nan)).any()]
+            fcustom = np.stack([names] + [sel.slice(ls.metrics[m], f)[np.ix_(yi, xi)].astype(object) for m in fm],
+                               axis=-1)
+            ftmpl = head + ctx + "<br>status %{customdata[0]}" + "".join(
+                f"<br>{m} = %{{customdata[{k + 1}]:.5g}}" + (f" {ls.units[m]}" if ls.units[m] else "")
+                for k, m in enumerate(fm)) + "<extra></extra>"
+            traces.append({"type": "heatmap", "x": xs, "y": ys, "z": fail, "customdata": fcustom,
                            "zmin": 0, "zmax": max(1, len(statuses) - 1), "colorscale": _steps(statuses),
-                           "showscale": False, "hoverongaps": False, "name": "failed",
-                           "hovertemplate": head + ctx + "<br>status %{customdata}<extra></extra>"})
+                           "showscale": False, "hoverongaps": False, "name": "failed", "hovertemplate": ftmpl})
         if np.isfinite(v).any():
             i, j = np.unravel_index(np.nanargmin(v), v.shape)
             bx = axis_values(xa, [j])[0]
             by = axis_values(ya, [i])[0] if ya is not None else ""
             traces.append({"type": "scatter", "x": [bx], "y": [by], "mode": "markers", "name": "best cell",
-                           "showlegend": not frames, "legendgroup": "best",
+                           "showlegend": dropdown or not frames, "legendgroup": "best",
                            "marker": {"symbol": "star", "size": 16, "color": "#ff3030",
                                       "line": {"color": "white", "width": 1.5}},
                            "hovertemplate": f"best cell: {metric} = {fmt(v[i, j], 6)} {unit}<extra></extra>"})

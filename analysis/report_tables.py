@@ -95,10 +95,10 @@ def varying_parameters(view, block, rows):
     for c in view.res.parameters(kind or None):
         v = view.t[c][rows]
         if v.dtype.kind == "f":
-            vals = {round(float(x), 12) for x in v if np.isfinite(x)}
+            n = np.unique(np.round(v[np.isfinite(v)], 12)).size
         else:
-            vals = set(v.tolist())
-        (varying if len(vals) > 1 else fixed).append(c)
+            n = len(set(v.tolist()))
+        (varying if n > 1 else fixed).append(c)
     return varying, fixed
 
 
