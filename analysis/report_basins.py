@@ -50,8 +50,21 @@ def basins_figure(res, ls, cap):
     rows, q, qcols, units = final_iterates(res, ls.block)
     if len(rows) != int(np.prod(shape)) or not qcols:
         return None
-    labels = cluster_solutions(q, [u == "rad" for u in units], CLUSTER_TOLERANCE)
+    revolute = [u == "rad" for u in units]
+    labels = cluster_solutions(q, revolute, CLUSTER_TOLERANCE)
     n_sol = int(labels.max(initial=-1)) + 1
+    continuum, n_all = "", n_sol
+    if n_sol > len(SOLUTION_COLOURS):
+        # A continuum (a redundant problem): name the solutions by the joints whose final values take
+        # a few distinct values over the converged runs (e.g. an S-R-S arm's elbow), as plot_basins does.
+        few = [j for j in range(q.shape[1]) if cluster_solutions(q[:, [j]], [revolute[j]], CLUSTER_TOLERANCE)
+               .max(initial=-1) + 1 <= len(SOLUTION_COLOURS)]
+        if few:
+            continuum = (f" They form a continuum of postures: the colours name them "
+                         f"by the joints that take a few values ({', '.join(qcols[j] for j in few)}).")
+            q, qcols, units = q[:, few], [qcols[j] for j in few], [units[j] for j in few]
+            labels = cluster_solutions(q, [revolute[j] for j in few], CLUSTER_TOLERANCE)
+            n_sol = int(labels.max(initial=-1)) + 1
     counts = np.bincount(labels[labels >= 0], minlength=n_sol)
     # The largest clusters get their own colours (in order of first appearance); the rest share one.
     named = sorted(np.argsort(-counts, kind="stable")[:len(SOLUTION_COLOURS)].tolist()) if n_sol else []
@@ -121,12 +134,12 @@ def basins_figure(res, ls, cap):
     layout["legend"] = {"orientation": "h", "y": -0.16, "x": 0, "font": {"size": 11}}
     layout["height"] = 520 + 22 * ((len(used) + 1) // 2)
     cap_text = (f"Basins of attraction of block {esc(ls.block)} over the initial guesses {esc(xa.name)} × "
-                f"{esc(ya.name)}: each cell is coloured by the solution its run converged to ({n_sol} distinct "
+                f"{esc(ya.name)}: each cell is coloured by the solution its run converged to ({n_all} distinct "
                 f"final iterates within {CLUSTER_TOLERANCE:g} in the max-norm, angles mod 360°, named by "
                 "kssolutions.cluster_solutions)" + (f"; the {len(named)} largest have their own colour, the other "
                                                     f"{n_sol - len(named)} are grey" if other else "")
-                + "; failed runs in their status colours. Hover a cell for its iterations and status.")
+                + "; failed runs in their status colours." + continuum + " Hover a cell for its iterations and status.")
     more = sel.caption().replace("held at the best cell (not reduced)", "held at their first value")
     if more:
         cap_text += " " + esc(more[0].upper() + more[1:]) + "."
-    return {"data": data, "layout": layout}, cap_text + capped_note(sel, s), cells
+    return {"data": data, "layout": layout}, cap_text + capped_note(sel, s, star=False), cells

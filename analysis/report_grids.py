@@ -97,15 +97,20 @@ class Selection:
         return int(math.ceil(math.sqrt(total / cap))) if self.y is not None else int(math.ceil(total / cap))
 
 
-def capped_note(sel, s):
+def ordinal(n):
+    return f"{n}{'th' if 10 <= n % 100 <= 20 else {1: 'st', 2: 'nd', 3: 'rd'}.get(n % 10, 'th')}"
+
+
+def capped_note(sel, s, star=True):
     if s == 1:
         return ""
     ls = sel.ls
     nx = len(ls.axes[sel.x].values)
     ny = len(ls.axes[sel.y].values) if sel.y is not None else 1
     shown = len(range(0, nx, s)) * (len(range(0, ny, s)) if sel.y is not None else 1)
-    return (f' <span class="capped">Capped: every {s}-th value of each plotted axis is drawn ({shown} of {nx * ny} '
-            "cells per panel); the marked best cell is the full grid's.</span>")
+    return (f' <span class="capped">Capped: every {ordinal(s)} value of each plotted axis is drawn ({shown} of '
+            f"{nx * ny} cells per panel){'; the marked best cell is the full grid' + chr(39) + 's' if star else ''}."
+            "</span>")
 
 
 def arrange(frames, sel, xa, ya, height=480):

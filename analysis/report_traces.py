@@ -3,6 +3,7 @@ time; IK: ‖F‖ against iteration) and the optimisation traces (objective agai
 stage, best so far). Plain plotly dicts. Run with /usr/bin/python3."""
 import numpy as np
 
+from report_grids import ordinal
 from report_page import esc, fmt, table
 from report_tables import varying_parameters
 
@@ -55,7 +56,7 @@ def history_figure(view, row):
     if step > 1:
         keep = np.unique(np.r_[np.arange(0, len(x), step), len(x) - 1])
         x, y = x[keep], y[keep]
-        capped = (f' <span class="capped">Capped: every {step}-th of {len(h[list(h)[0]])} samples drawn.</span>')
+        capped = (f' <span class="capped">Capped: every {ordinal(step)} of {len(h[list(h)[0]])} samples drawn.</span>')
     data = []
     for j in range(y.shape[1]):
         yy = y[:, j].astype(float)
@@ -143,7 +144,7 @@ def optimization_figure(res, name):
                f"{n} evaluations; best {fmt(b['objective'], 8)} at {esc(bx_text)} (stage {esc(b['stage'])}, "
                f"status {esc(b['status'])})." + (f" References: {esc(refs)}." if refs else ""))
     if step > 1:
-        caption += (f' <span class="capped">Capped: every {step}-th evaluation drawn ({len(keep)} of {n}, the best '
+        caption += (f' <span class="capped">Capped: every {ordinal(step)} evaluation drawn ({len(keep)} of {n}, the best '
                     "included); the best-so-far line uses all of them.</span>")
     stg = o.stages
     cols = [c for c in ("name", "algorithm", "result", "evaluations", "best_objective", "best_status", "wall_time")

@@ -328,7 +328,7 @@ class ReportTest(unittest.TestCase):
         path = self.report(self.h5["basins"], "--max-cells", "100")
         with open(path, encoding="utf-8") as f:
             text = f.read()
-        self.assertIn("Capped: every", text)
+        self.assertIn("Capped: every 2nd value", text)
         p = Page(text)
         spec = json.loads(p.islands["basins-0-data"])
         cells = sum(len(t["z"]) * len(t["z"][0]) for t in spec["data"] if t["type"] == "heatmap")
