@@ -1,0 +1,287 @@
+"""Gridded figures of analysis/report.py: which landscape axes go on x and y, which of the other dims
+become facets or a dropdown (and which are held at the best cell, said in the caption), subsampling
+of big grids, and the landscape heatmaps (metric colour, failed cells in their status colours, hover
+with the cell's parameters and metrics). Plain plotly dicts. Run with /usr/bin/python3."""
+import math
+
+import numpy as np
+
+from report_page import esc, fmt
+
+MAX_FRAMES = 24      # facets / dropdown entries per figure; further dims are held at the best cell
+MAX_FACETS = 4       # up to this many frames side by side, more in a dropdown
+STATUS_COLOURS = {"unreachable_start": "#b0b0b0", "singular": "#7b3294", "diverged": "#202020",
+                  "stalled": "#e08214", "max_iter": "#d7191c", "cycle": "#f4a582", "unsupported": "#6a6a6a",
+                  "no_solution": "#8f8f8f", "out_of_limits": "#fdae61"}
+METRIC_LABELS = {"E": "E (mean ‖τ‖)", "iterations": "iterations to converge", "tau_inf": "‖τ‖∞"}
+
+
+def axis_title(a):
+    return f"{a.name} [{a.unit}]" if a.unit else a.name
+
+
+def axis_values(a, idx):
+    return [a.labels[int(i)] for i in idx] if a.categorical else [float(a.values[i]) for i in idx]
+
+
+def value_text(a, i):
+    v = a.labels[int(i)] if a.categorical else fmt(a.values[i], 5)
+    return f"{a.name} = {v}" + (f" {a.unit}" if a.unit and not a.categorical else "")
+
+
+class Selection:
+    """x, y (None for a 1-D landscape), the frames over the other dims and the dims held fixed.
+    frames: list of (label, {dim: index}); fixed: {dim: index} (same in every frame)."""
+
+    def __init__(self, ls, best_index):
+        n = len(ls.axes)
+        longer = [i for i, a in enumerate(ls.axes) if len(a.values) > 1]
+        numeric = [i for i in longer if not ls.axes[i].categorical]
+        if ls.kind == "ik":  # IK grids: the initial guesses on x and y when two of them are swept
+            guesses = [i for i in numeric if ls.axes[i].name.startswith("q0_")]
+            numeric = (guesses + [i for i in numeric if i not in guesses]) if len(guesses) >= 2 else numeric
+        order = numeric + [i for i in longer if i not in numeric] + [i for i in range(n) if i not in longer]
+        self.x = order[0]
+        self.y = order[1] if len(order) > 1 and len(ls.axes[order[1]].values) > 1 else None
+        rest = [i for i in range(n) if i not in (self.x, self.y)]
+        self.fixed, self.held = {}, []
+        framed, count = [], 1
+        for d in rest:
+            size = len(ls.axes[d].values)
+            if size == 1:
+                self.fixed[d] = 0
+            elif count * size <= MAX_FRAMES:
+                framed.append(d)
+                count *= size
+            else:
+                self.fixed[d] = int(best_index[d]) if best_index is not None else 0
+                self.held.append(d)
+        self.frames = []
+        for combo in np.ndindex(*[len(ls.axes[d].values) for d in framed]) if framed else [()]:
+            idx = dict(zip(framed, combo))
+            label = ", ".join(value_text(ls.axes[d], i) for d, i in idx.items())
+            self.frames.append((label, idx))
+        self.framed = framed
+        self.ls = ls
+
+    def slice(self, grid, frame_index):
+        """The frame's 2-D slice, rows = y, columns = x (1-D: a 1 x nx array)."""
+        idx = [0] * grid.ndim
+        for d, i in {**self.fixed, **frame_index}.items():
+            idx[d] = i
+        idx[self.x] = slice(None)
+        if self.y is not None:
+            idx[self.y] = slice(None)
+        g = grid[tuple(idx)]
+        if self.y is None:
+            return g[None, :]
+        return g.T if self.x < self.y else g
+
+    def caption(self):
+        ls, parts = self.ls, []
+        if self.framed:
+            parts.append(f"one {'panel' if len(self.frames) <= MAX_FACETS else 'dropdown entry'} per value of "
+                         + " × ".join(ls.axes[d].name for d in self.framed))
+        if self.held:
+            parts.append("held at the best cell (not reduced): "
+                         + ", ".join(value_text(ls.axes[d], self.fixed[d]) for d in self.held))
+        return "; ".join(parts)
+
+    def stride(self, cap):
+        """Every s-th value of x and y so that the figure holds at most `cap` cells over its frames."""
+        nx = len(self.ls.axes[self.x].values)
+        ny = len(self.ls.axes[self.y].values) if self.y is not None else 1
+        total = nx * ny * len(self.frames)
+        if total <= cap:
+            return 1
+        return int(math.ceil(math.sqrt(total / cap))) if self.y is not None else int(math.ceil(total / cap))
+
+
+def ordinal(n):
+    return f"{n}{'th' if 10 <= n % 100 <= 20 else {1: 'st', 2: 'nd', 3: 'rd'}.get(n % 10, 'th')}"
+
+
+def capped_note(sel, s, star=True):
+    if s == 1:
+        return ""
+    ls = sel.ls
+    nx = len(ls.axes[sel.x].values)
+    ny = len(ls.axes[sel.y].values) if sel.y is not None else 1
+    shown = len(range(0, nx, s)) * (len(range(0, ny, s)) if sel.y is not None else 1)
+    return (f' <span class="capped">Capped: every {ordinal(s)} value of each plotted axis is drawn ({shown} of '
+            f"{nx * ny} cells per panel){'; the marked best cell is the full grid' + chr(39) + 's' if star else ''}."
+            "</span>")
+
+
+def arrange(frames, sel, xa, ya, height=480):
+    """Lay out the frames' traces: side by side (facets) or one at a time with a dropdown.
+    frames: list of (label, [trace dicts]). Returns (data, layout)."""
+    data, layout = [], {"height": height, "margin": {"l": 70, "r": 30, "t": 60, "b": 60},
+                        "legend": {"orientation": "h", "y": -0.18, "x": 0}, "plot_bgcolor": "#ffffff"}
+    ytitle = axis_title(ya) if ya is not None else ""
+    n = len(frames)
+    if n <= MAX_FACETS:
+        gap = 0.05 if n > 1 else 0.0
+        notes = []
+        for i, (label, traces) in enumerate(frames):
+            s = "" if i == 0 else str(i + 1)
+            for t in traces:
+                t["xaxis"], t["yaxis"] = "x" + s, "y" + s
+                data.append(t)
+            dom = [i / n + (gap / 2 if i else 0), (i + 1) / n - (gap / 2 if i < n - 1 else 0)]
+            layout["xaxis" + s] = {"domain": dom, "title": {"text": axis_title(xa)}, "anchor": "y" + s}
+            layout["yaxis" + s] = {"anchor": "x" + s, "title": {"text": ytitle if i == 0 else ""}}
+            if i:
+                layout["yaxis" + s]["matches"] = "y"
+                layout["yaxis" + s]["showticklabels"] = False
+            if label:
+                notes.append({"text": esc(label), "x": (dom[0] + dom[1]) / 2, "y": 1.0, "xref": "paper",
+                              "yref": "paper", "xanchor": "center", "yanchor": "bottom", "showarrow": False, "font": {"size": 13}})
+        layout["annotations"] = notes
+        return data, layout
+    counts = [len(t) for _, t in frames]
+    buttons = []
+    for i, (label, traces) in enumerate(frames):
+        for t in traces:
+            t["visible"] = i == 0
+            data.append(t)
+        vis = [j == i for j, c in enumerate(counts) for _ in range(c)]
+        buttons.append({"label": label, "method": "restyle", "args": [{"visible": vis}, list(range(len(vis)))]})
+    layout["updatemenus"] = [{"buttons": buttons, "x": 0, "y": 1.02, "xanchor": "left", "yanchor": "bottom",
+                              "direction": "down", "showactive": True, "active": 0}]
+    layout["margin"]["t"] = 80
+    layout["xaxis"] = {"title": {"text": axis_title(xa)}}
+    layout["yaxis"] = {"title": {"text": ytitle}}
+    return data, layout
+
+
+def legend_square(name, colour, group=None):
+    """A legend entry with no data (heatmap cells have none of their own)."""
+    return {"type": "scatter", "x": [None], "y": [None], "mode": "markers", "name": name, "showlegend": True,
+            "marker": {"symbol": "square", "size": 12, "color": colour, "line": {"color": "#555", "width": 1}},
+            "hoverinfo": "skip", "legendgroup": group or name}
+
+
+def colour_scale(values):
+    """Linear or (for a positive range over more than two decades) log10 colour scale: returns
+    (transform, zmin, zmax, colorbar ticks or None)."""
+    finite = values[np.isfinite(values)]
+    if not finite.size:
+        return (lambda v: v), 0.0, 1.0, None
+    lo, hi = float(finite.min()), float(finite.max())
+    if lo > 0 and hi / lo > 100:
+        vals = [m * 10.0 ** e for e in range(int(math.floor(math.log10(lo))), int(math.ceil(math.log10(hi))) + 1)
+                for m in (1, 2, 5) if lo <= m * 10.0 ** e <= hi]
+        ticks = {"tickvals": [math.log10(v) for v in vals], "ticktext": [f"{v:g}" for v in vals]}
+        return np.log10, math.log10(lo), math.log10(hi), ticks
+    return (lambda v: v), lo, hi if hi > lo else lo + 1.0, None
+
+
+def landscape_figure(ls, cap):
+    """The block's default metric (E; IK: iterations of converged runs) over the selected axes.
+    Returns (figure dict, caption html, cells drawn)."""
+    if not ls.axes:
+        return None
+    metric = "iterations" if ls.kind == "ik" else "E"
+    if metric not in ls.metrics:
+        metric = [m for m in ls.metrics if m not in ("ok", "converged", "status_code")][0]
+    status = ls.metrics["status_code"]
+    good = status == 0
+    val = np.where(good, ls.metrics[metric], np.nan)
+    best = np.unravel_index(np.nanargmin(val), val.shape) if np.isfinite(val).any() else None
+    sel = Selection(ls, best)
+    xa, ya = ls.axes[sel.x], (ls.axes[sel.y] if sel.y is not None else None)
+    s = sel.stride(cap)
+    xi = np.arange(0, len(xa.values), s)
+    yi = np.arange(0, len(ya.values), s) if ya is not None else np.array([0])
+    hover_metrics = [m for m in ls.metrics if m not in ("ok", "converged", "status_code")
+                     and np.isfinite(np.where(good, ls.metrics[m], np.nan)).any()]
+    frames_val = [sel.slice(val, f) for _, f in sel.frames]
+    transform, zmin, zmax, ticks = colour_scale(np.concatenate([v.ravel() for v in frames_val]))
+    statuses = ls.statuses
+    unit = ls.units.get(metric, "")
+    label = METRIC_LABELS.get(metric, metric) + (f" [{unit}]" if unit else "")
+    xs, ys = axis_values(xa, xi), (axis_values(ya, yi) if ya is not None else [""])
+    pos = "%{x}" + (f" {xa.unit}" if xa.unit else "")
+    head = f"{xa.name} = {pos}" + (f"<br>{ya.name} = %{{y}}" + (f" {ya.unit}" if ya.unit else "") if ya else "")
+    frames, failed_seen, cells = [], {}, 0
+    fail_all = np.isfinite(status) & (status != 0)
+    dropdown = len(sel.frames) > MAX_FACETS  # then every frame carries its colour bar and legend entry
+    for (flabel, f), v in zip(sel.frames, frames_val):
+        ctx = (f"<br>{esc(flabel)}" if flabel else "") + "".join(
+            f"<br>{esc(value_text(ls.axes[d], sel.fixed[d]))}" for d in sel.held)
+        st = sel.slice(status, f)[np.ix_(yi, xi)]
+        z = v[np.ix_(yi, xi)]
+        custom = np.stack([sel.slice(ls.metrics[m], f)[np.ix_(yi, xi)] for m in hover_metrics], axis=-1)
+        tmpl = head + ctx + "".join(f"<br>{m} = %{{customdata[{k}]:.5g}}" + (f" {ls.units[m]}" if ls.units[m] else "")
+                                    for k, m in enumerate(hover_metrics)) + f"<br>status {statuses[0]}<extra></extra>"
+        with np.errstate(all="ignore"):
+            zt = transform(z)
+        cb = {"title": {"text": label, "side": "right"}, **(ticks or {})}
+        traces = [{"type": "heatmap", "x": xs, "y": ys, "z": zt, "customdata": custom, "hovertemplate": tmpl,
+                   "colorscale": "Viridis", "zmin": zmin, "zmax": zmax, "colorbar": cb, "hoverongaps": False,
+                   "showscale": dropdown or not frames, "name": metric}]
+        fail = np.where(np.isfinite(st) & (st != 0), st, np.nan)
+        codes = sorted({int(c) for c in fail[np.isfinite(fail)].ravel()})
+        if codes:
+            for c in codes:
+                failed_seen[c] = failed_seen.get(c, 0) + int(np.sum(sel.slice(status, f) == c))
+            names = np.array([statuses[int(c)] if np.isfinite(c) else "" for c in fail.ravel()],
+                             dtype=object).reshape(fail.shape)
+            # the failed runs' metrics that have values (an IK failure's iterations and final error)
+            fm = [m for m in ls.metrics if m not in ("ok", "converged", "status_code")
+                  and np.isfinite(np.where(fail_all, ls.metrics[m], np.nan)).any()]
+            fcustom = np.stack([names] + [sel.slice(ls.metrics[m], f)[np.ix_(yi, xi)].astype(object) for m in fm],
+                               axis=-1)
+            ftmpl = head + ctx + "<br>status %{customdata[0]}" + "".join(
+                f"<br>{m} = %{{customdata[{k + 1}]:.5g}}" + (f" {ls.units[m]}" if ls.units[m] else "")
+                for k, m in enumerate(fm)) + "<extra></extra>"
+            traces.append({"type": "heatmap", "x": xs, "y": ys, "z": fail, "customdata": fcustom,
+                           "zmin": 0, "zmax": max(1, len(statuses) - 1), "colorscale": _steps(statuses),
+                           "showscale": False, "hoverongaps": False, "name": "failed", "hovertemplate": ftmpl})
+        if np.isfinite(v).any():
+            i, j = np.unravel_index(np.nanargmin(v), v.shape)
+            bx = axis_values(xa, [j])[0]
+            by = axis_values(ya, [i])[0] if ya is not None else ""
+            traces.append({"type": "scatter", "x": [bx], "y": [by], "mode": "markers", "name": "best cell",
+                           "showlegend": dropdown or not frames, "legendgroup": "best",
+                           "marker": {"symbol": "star", "size": 16, "color": "#ff3030",
+                                      "line": {"color": "white", "width": 1.5}},
+                           "hovertemplate": f"best cell: {metric} = {fmt(v[i, j], 6)} {unit}<extra></extra>"})
+        cells += z.size
+        frames.append((flabel, traces))
+    if ya is None:  # a 1-D landscape: a one-row strip
+        for _, traces in frames:
+            for t in traces:
+                if t["type"] == "heatmap":
+                    t["y"] = [metric]
+                elif t["type"] == "scatter":
+                    t["y"] = [metric]
+    data, layout = arrange(frames, sel, xa, ya, height=300 if ya is None else 500)
+    data += [legend_square(f"{statuses[c]}", STATUS_COLOURS.get(statuses[c], "#999999")) for c in sorted(failed_seen)]
+    fig = {"data": data, "layout": layout}
+    good_name = statuses[0]
+    parts = [f"{esc(label[0].upper() + label[1:])} of the {good_name} runs over {esc(xa.name)}"
+             + (f" × {esc(ya.name)}" if ya is not None else "")
+             + (" (log colour scale)" if ticks else "") + "; the colour scale is shared by all panels."]
+    if failed_seen:
+        parts.append("Failed cells in their status colours: "
+                     + ", ".join(f"{statuses[c]} {n}" for c, n in sorted(failed_seen.items())) + ".")
+    if np.isnan(status).any():
+        parts.append("White cells: no run.")
+    more = sel.caption()
+    if more:
+        parts.append(esc(more[0].upper() + more[1:]) + ".")
+    parts.append("The star marks the smallest value of each panel; hover a cell for its parameters and metrics.")
+    return fig, " ".join(parts) + capped_note(sel, s), cells
+
+
+def _steps(statuses):
+    """A discrete colour scale: status code c (0..n-1, zmin 0, zmax n-1) in its status colour."""
+    n = len(statuses)
+    out = []
+    for c, name in enumerate(statuses):
+        col = STATUS_COLOURS.get(name, "#999999")
+        lo, hi = max(0.0, (c - 0.5) / (n - 1)), min(1.0, (c + 0.5) / (n - 1))
+        out += [[lo, col], [hi, col]]
+    return out

@@ -1,0 +1,162 @@
+"""The HTML of analysis/report.py: the page skeleton (style, table of contents, the script that draws
+the figures and records JavaScript errors), tables and figure placeholders. Plotly's JavaScript is
+embedded from Debian's python3-plotly, so the page works offline. Run with /usr/bin/python3."""
+import html
+import json
+import math
+
+import numpy as np
+
+STYLE = """
+body { font-family: system-ui, 'DejaVu Sans', sans-serif; margin: 0 auto; max-width: 1400px; padding: 0 16px 40px;
+       color: #1d2330; background: #ffffff; }
+h1 { font-size: 1.5em; margin: 18px 0 4px; } h2 { font-size: 1.25em; margin: 0 0 8px; border-bottom: 2px solid #3b6fb6;
+       padding-bottom: 3px; } h3 { font-size: 1.05em; margin: 16px 0 4px; }
+section { margin: 22px 0; }
+nav ul { margin: 4px 0; padding-left: 20px; columns: 2; } nav a { color: #2b5c9e; }
+.sub { color: #555c6b; margin: 0 0 10px; }
+.caption { color: #3a4150; font-size: 0.9em; margin: 4px 0 12px; max-width: 1100px; }
+.capped { color: #9a4b00; font-weight: 600; }
+.scroll { overflow-x: auto; max-width: 100%; }
+table { border-collapse: collapse; font-size: 0.86em; margin: 4px 0 8px; }
+th, td { border: 1px solid #c9cfda; padding: 3px 7px; text-align: right; white-space: nowrap; }
+th { background: #e8eef8; position: sticky; top: 0; } td.s, th.s { text-align: left; }
+tr:nth-child(even) td { background: #f6f8fc; }
+pre.study { background: #f4f6fa; border: 1px solid #d5dbe6; padding: 8px 10px; font-size: 0.82em; max-height: 420px;
+            overflow: auto; }
+.plot { width: 100%; min-height: 200px; }
+#ks-status { display: none; }
+body.only > header, body.only > nav { display: none; }
+"""
+
+# Runs first (before plotly's script): records errors and console.error calls, for the reader of a
+# broken page and for the tests (written into #ks-status once the figures are drawn).
+ERROR_COLLECTOR = """
+window.ksErrors = [];
+window.addEventListener('error', function (e) { window.ksErrors.push(String(e.message || e)); });
+window.addEventListener('unhandledrejection', function (e) { window.ksErrors.push('rejection: ' + String(e.reason)); });
+(function () { var ce = console.error; console.error = function () {
+  window.ksErrors.push(Array.prototype.map.call(arguments, String).join(' ')); return ce.apply(console, arguments); }; })();
+"""
+
+# Shows only the section named by '#only=ID' (for screenshots of one section), then draws every
+# figure from its JSON data island and writes the outcome into #ks-status (data-ready="1").
+LOADER = """
+(function () {
+  var m = /^#only=([\\w-]+)$/.exec(window.location.hash);
+  if (m) {
+    document.body.classList.add('only');
+    document.querySelectorAll('body > section').forEach(function (s) { s.style.display = s.id === m[1] ? '' : 'none'; });
+  }
+  var done = [];
+  var drawn = 0;
+  document.querySelectorAll('div.plot').forEach(function (div) {
+    var sec = div.closest('section');
+    if (sec && sec.style.display === 'none') return;
+    try {
+      var spec = JSON.parse(document.getElementById(div.id + '-data').textContent);
+      spec.config = Object.assign({displaylogo: false, responsive: true,
+                                   modeBarButtonsToRemove: ['sendDataToCloud']}, spec.config || {});
+      done.push(Plotly.newPlot(div, spec.data, spec.layout, spec.config).then(function () { drawn += 1; }));
+    } catch (e) { window.ksErrors.push('figure ' + div.id + ': ' + e); }
+  });
+  function report() {
+    var st = document.getElementById('ks-status');
+    st.textContent = JSON.stringify({plots: drawn, errors: window.ksErrors});
+    st.setAttribute('data-ready', '1');
+  }
+  Promise.all(done).then(report, function (e) { window.ksErrors.push('plot: ' + e); report(); });
+})();
+"""
+
+
+def esc(s):
+    return html.escape(str(s), quote=True)
+
+
+def fmt(v, digits=6):
+    """A table cell's text: NaN as an en dash, integers as such, floats to `digits` significant digits."""
+    if v is None:
+        return "–"
+    if isinstance(v, (str, bytes)):
+        return v.decode() if isinstance(v, bytes) else v
+    if isinstance(v, (bool, np.bool_)):
+        return "yes" if v else "no"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    v = float(v)
+    if not math.isfinite(v):
+        return "–"
+    return f"{v:.{digits}g}"
+
+
+def exact(v):
+    """The cell's value at full precision, for the data-v attribute (readers and tests compare it)."""
+    if isinstance(v, (str, bytes)):
+        return v.decode() if isinstance(v, bytes) else v
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    return repr(float(v))
+
+
+def header(name, unit):
+    return f"{name} [{unit}]" if unit else name
+
+
+def table(columns, rows, css_id=None, text_columns=()):
+    """An HTML table: columns = [(name, unit)], rows = lists of values. Every cell carries its exact
+    value in data-v; text columns (names) are left-aligned."""
+    out = [f'<div class="scroll"><table{f" id={chr(34)}{esc(css_id)}{chr(34)}" if css_id else ""}>', "<thead><tr>"]
+    for name, unit in columns:
+        cls = ' class="s"' if name in text_columns else ""
+        out.append(f'<th{cls} data-col="{esc(name)}">{esc(header(name, unit))}</th>')
+    out.append("</tr></thead><tbody>")
+    for row in rows:
+        out.append("<tr>")
+        for (name, _), v in zip(columns, row):
+            cls = ' class="s"' if name in text_columns else ""
+            out.append(f'<td{cls} data-v="{esc(exact(v))}">{esc(fmt(v))}</td>')
+        out.append("</tr>")
+    out.append("</tbody></table></div>")
+    return "".join(out)
+
+
+def _clean(o):
+    if isinstance(o, dict):
+        return {str(k): _clean(v) for k, v in o.items()}
+    if isinstance(o, np.ndarray):
+        return _clean(o.tolist())
+    if isinstance(o, (list, tuple)):
+        return [_clean(v) for v in o]
+    if isinstance(o, (float, np.floating)):
+        o = float(o)
+        return float(f"{o:.7g}") if math.isfinite(o) else None
+    if isinstance(o, (np.integer,)):
+        return int(o)
+    if isinstance(o, np.bool_):
+        return bool(o)
+    return o
+
+
+def figure(fid, fig, caption, title=None):
+    """A figure placeholder, its JSON data island (data, layout: plain plotly dicts; NaN -> null) and
+    its caption. Floats are kept to 7 significant digits."""
+    text = json.dumps(_clean(fig), allow_nan=False, separators=(",", ":")).replace("</", "<\\/")
+    h = f"<h3>{esc(title)}</h3>" if title else ""
+    return (f'{h}<div class="plot" id="{esc(fid)}"></div>'
+            f'<script type="application/json" id="{esc(fid)}-data">{text}</script>'
+            f'<p class="caption">{caption}</p>')
+
+
+def page(title, subtitle, sections, plotly_js):
+    """The whole page: sections = [(id, heading, body html)], in order; the table of contents lists them."""
+    toc = "".join(f'<li><a href="#{esc(sid)}">{esc(head)}</a></li>' for sid, head, _ in sections)
+    body = "".join(f'<section id="{esc(sid)}"><h2>{esc(head)}</h2>{html_}</section>' for sid, head, html_ in sections)
+    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            f"<title>{esc(title)}</title><style>{STYLE}</style>"
+            f"<script>{ERROR_COLLECTOR}</script>"
+            f"<script>{plotly_js}</script></head><body>"
+            f"<header><h1>{esc(title)}</h1><p class=\"sub\">{subtitle}</p></header>"
+            f"<nav><strong>Contents</strong><ul>{toc}</ul></nav>{body}"
+            "<pre id=\"ks-status\" data-ready=\"0\"></pre>"
+            f"<script>{LOADER}</script></body></html>\n")
