@@ -8,14 +8,17 @@ histories (plot_histories), IK histories (plot_convergence), preset rows (plot_c
 block (file order), log-scaled axes, faceting, round contour levels, joint units, one colour per run.
 
 usage: /usr/bin/python3 test_plot_studies.py KINESWEEP_BINARY REPO_ROOT
+(KS_KEEP_PLOTS=1 keeps the pictures and names their directory)
 """
 import glob
 import json
 import math
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
+import types
 import unittest
 
 import h5py
@@ -89,6 +92,9 @@ q0_2 = { from = -180, to = 180, count = 15 }
 """
 
 
+DEFAULT_PLOTS = ("plot_landscape.py", "plot_basins.py", "plot_histories.py", "plot_convergence.py", "plot_cases.py")
+
+
 def h5str(v):
     return v.decode() if isinstance(v, bytes) else str(v)
 
@@ -116,7 +122,7 @@ def ordered_landscapes(f):
 class PlotStudiesTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.tmp = tempfile.TemporaryDirectory()
+        cls.tmp = types.SimpleNamespace(name=tempfile.mkdtemp(prefix="ks_plot_studies_"))
         cls.files = {}
         studies = sorted(glob.glob(os.path.join(ROOT, "studies", "*.toml")))
         for name, text in (("random_axes", RANDOM), ("lhs_axes", LHS), ("planar3r_basins", PLANAR3R)):
@@ -133,22 +139,39 @@ class PlotStudiesTest(unittest.TestCase):
             r = subprocess.run(cmd, capture_output=True, text=True)
             assert r.returncode == 0, f"{name}: {r.stderr}"
             cls.files[name] = out
+        # Every script's default picture of every file, two at a time (the checks read these results).
+        cls.cache = {}
+        jobs = [(s, h5, (), None if s == "plot_basins.py" else (800, 600)) for h5 in cls.files.values()
+                for s in DEFAULT_PLOTS]
+        from concurrent.futures import ThreadPoolExecutor
+        with ThreadPoolExecutor(max_workers=int(THREADS)) as pool:
+            for key, r in zip(jobs, pool.map(lambda j: cls.run_plot(*j), jobs)):
+                cls.cache[key] = r
 
     @classmethod
     def tearDownClass(cls):
-        cls.tmp.cleanup()
+        if os.environ.get("KS_KEEP_PLOTS"):  # keep the pictures to look at
+            print(f"pictures kept in {cls.tmp.name}/png", file=sys.stderr)
+        else:
+            shutil.rmtree(cls.tmp.name, ignore_errors=True)
 
     def script(self, script, *args):
         return subprocess.run([sys.executable, os.path.join(ROOT, "analysis", script), *args],
                               capture_output=True, text=True)
 
-    def plot(self, script, h5, *extra, size=(800, 600), expect_ok=True):
-        """Run a script with --print-data; when it succeeds check the picture; returns (rc, data, stderr)."""
-        png = os.path.join(self.tmp.name, "png", f"{os.path.basename(h5)}_{script}_{abs(hash(extra))}.png")
+    @classmethod
+    def run_plot(cls, script, h5, extra, size):
+        png = os.path.join(cls.tmp.name, "png", f"{os.path.basename(h5)}_{script}_{abs(hash(extra))}.png")
         args = [h5, "-o", png, "--print-data", *extra]
         if size:
             args += ["--size", f"{size[0]}x{size[1]}"]
-        r = self.script(script, *args)
+        return png, subprocess.run([sys.executable, os.path.join(ROOT, "analysis", script), *args],
+                                   capture_output=True, text=True)
+
+    def plot(self, script, h5, *extra, size=(800, 600), expect_ok=True):
+        """Run a script with --print-data; when it succeeds check the picture; returns (rc, data, stderr)."""
+        key = (script, h5, extra, size)
+        png, r = self.cache[key] if key in self.cache else self.run_plot(*key)
         self.assertNotIn("Traceback", r.stderr, f"{script} {h5} {extra}")
         if expect_ok:
             self.assertEqual(r.returncode, 0, f"{script} {h5} {extra}: {r.stderr}")
