@@ -81,6 +81,8 @@ def print_json(obj):
 def axis_label(name, unit):
     pretty = {"alpha1A": "α1A", "q0_1": "θ1 initial guess (q0_1)", "q0_2": "θ2 initial guess (q0_2)",
               "k": "k (gravity weight)", "lambda": "λ"}.get(name, name)
+    if name.startswith("q0_") and name[3:].isdigit() and unit:  # an initial guess, named by its joint's unit
+        pretty = f"{joint_symbol(name, unit)} initial guess ({name})"
     return f"{pretty} [{unit}]" if unit else pretty
 
 

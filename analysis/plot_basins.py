@@ -30,9 +30,9 @@ FAIL_COLOURS = {"stalled": "#8c510a", "singular": "#7b3294", "max_iter": "#d7191
 def parse_args(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ksplot.add_output_args(p, default_size=DEFAULT_SIZE)
-    p.add_argument("--block", help="IK landscape (block) name (default: the first in file order with the --x, --y axes)")
-    p.add_argument("--x", default="q0_1", help="initial-guess axis on x (default %(default)s)")
-    p.add_argument("--y", default="q0_2", help="initial-guess axis on y (default %(default)s)")
+    p.add_argument("--block", help="IK landscape (block) name (default: the first in file order with two swept initial-guess axes)")
+    p.add_argument("--x", help="initial-guess axis on x (default: the block's first swept q0_ axis, e.g. q0_1)")
+    p.add_argument("--y", help="initial-guess axis on y (default: its next swept q0_ axis, e.g. q0_2)")
     p.add_argument("--panels", help="axis giving one column of panels per value (default: the first remaining axis, "
                    f"e.g. method); a second remaining axis (up to {MAX_ROWS} values, e.g. lambda) gives the rows")
     p.add_argument("--fix", action="append", default=[], metavar="AXIS=VALUE",
@@ -80,12 +80,23 @@ def joint_units(res, runs, qcols, sel):
     return units
 
 
+def xy_axes(ls, args):
+    """--x and --y, else the landscape's first two swept initial-guess axes (q0_1, q0_2)."""
+    starts = [a.name for a in ls.axes if a.name.startswith("q0_") and not a.categorical and len(a.values) > 1]
+    x = args.x or next((n for n in starts if n != args.y), None)
+    y = args.y or next((n for n in starts if n != x), None)
+    return x, y
+
+
 def plottable(ls, args):
     """Why the landscape can't be drawn as basins ("" when it can)."""
     names = [a.name for a in ls.axes]
     if ls.kind != "ik":
         return f"landscape {ls.block} is not an IK block"
-    missing = [n for n in (args.x, args.y) if n not in names]
+    x, y = xy_axes(ls, args)
+    if x is None or y is None:
+        return f"landscape {ls.block} has not two swept initial-guess axes (axes: {', '.join(names) or 'none'})"
+    missing = [n for n in (x, y) if n not in names]
     if missing:
         return f"landscape {ls.block} has no axis {', '.join(missing)} (axes: {', '.join(names) or 'none'})"
     return ""
@@ -107,7 +118,7 @@ def choose_block(res, args):
         if not why:
             return b
         reasons.append(why)
-    raise SystemExit(f"plot_basins: {args.file}: no IK landscape over ({args.x}, {args.y}) to plot (a study with "
+    raise SystemExit(f"plot_basins: {args.file}: no IK landscape over two initial-guess axes to plot (a study with "
                      f"an ik block and a grid of initial guesses){': ' + '; '.join(reasons) if reasons else ''}")
 
 
@@ -115,6 +126,7 @@ def main(argv=None):
     args = parse_args(argv)
     res = ksread.open_results(args.file)
     ls = res.landscape(choose_block(res, args), degrees=True)
+    args.x, args.y = xy_axes(ls, args)
     names = [a.name for a in ls.axes]
     fixed = {}
     for f in args.fix:

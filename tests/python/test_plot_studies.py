@@ -229,10 +229,12 @@ class PlotStudiesTest(unittest.TestCase):
             drawn.append("plot_landscape.py")
         # plot_basins: the first IK landscape in file order over (q0_1, q0_2).
         basins = [b for b in lands if "converged" in f["landscapes"][b]
-                  and {"q0_1", "q0_2"} <= {n for n, _, _ in axes[b]}]
+                  and len([n for n in numeric(axes[b]) if n.startswith("q0_")]) >= 2]
         rc, d, err = self.plot("plot_basins.py", h5, size=None, expect_ok=bool(basins))
         if basins:
             self.assertEqual(d["block"], basins[0])
+            self.assertEqual([d["x"]["name"], d["y"]["name"]],
+                             [n for n in numeric(axes[basins[0]]) if n.startswith("q0_")][:2])
             drawn.append("plot_basins.py")
         else:
             self.assertNotEqual(rc, 0)
