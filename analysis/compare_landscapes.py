@@ -27,7 +27,8 @@ def parse_args(argv=None):
     p.add_argument("--dpi", type=float, default=100.0, help="dots per inch (default %(default)s)")
     p.add_argument("--title", help="replace the figure title")
     p.add_argument("--print-data", action="store_true", help="also print the minima as JSON on stdout")
-    p.add_argument("--block", help="landscape (block) name (default: each file's first)")
+    p.add_argument("--block", help="landscape (block) name (default: each file's first in file order with "
+                   "the --x and --y axes)")
     p.add_argument("--metric", default="E", help="landscape metric (default %(default)s)")
     p.add_argument("--x", default="alpha1A", help="axis on x (default %(default)s)")
     p.add_argument("--y", default="k", help="axis on y (default %(default)s)")
@@ -73,7 +74,12 @@ def main(argv=None):
     panels = []
     for path in args.files:
         with ksread.open_results(path) as res:
-            land = res.landscape(args.block, degrees=True)
+            block = args.block or next((b for b in res.landscapes() if {args.x, args.y} <=
+                                        {a.name for a in res.landscape(b).axes}), None)
+            if block is None:
+                raise SystemExit(f"{path}: no landscape over ({args.x}, {args.y}); landscapes: "
+                                 f"{', '.join(res.landscapes()) or 'none'}")
+            land = res.landscape(block, degrees=True)
             x, y, z = panel(land, args, fixed)
             label = res.f.attrs.get("study_name", os.path.basename(path))
             label = label.decode() if isinstance(label, bytes) else str(label)

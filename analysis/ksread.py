@@ -397,8 +397,20 @@ class Results:
             h.units[a] = unit
         return h
 
+    def blocks(self):
+        """The block names in file order: order of first appearance in the /runs `block` column."""
+        if "block" not in self.f["runs"]:
+            return []
+        names = [_s(x) for x in self.f["runs"]["block"][()]]
+        return [b for b in dict.fromkeys(names) if b]
+
     def landscapes(self):
-        return list(self.f["landscapes"]) if "landscapes" in self.f else []
+        """The /landscapes groups in block order (blocks()), any other after them."""
+        if "landscapes" not in self.f:
+            return []
+        have = list(self.f["landscapes"])
+        order = [b for b in self.blocks() if b in have]
+        return order + [b for b in have if b not in order]
 
     def landscape(self, block=None, degrees=False):
         names = self.landscapes()

@@ -33,8 +33,14 @@ def main(argv=None):
     args = parse_args(argv)
     res = ksread.open_results(args.file)
     if "preset" not in res.columns():
-        raise SystemExit(f"{args.file}: no preset column (run a study with presets, e.g. studies/thesis_table4.toml)")
+        raise SystemExit(f"{args.file}: no Table 4 preset rows (no preset column); "
+                         "studies/thesis_table4.toml runs them all")
+    if args.metric not in res.columns():
+        raise SystemExit(f"{args.file}: no column {args.metric} (plot_cases reads trajectory runs)")
     runs = res.runs(columns=["run_id", "preset", "status", args.metric])
+    if not any(runs["preset"]):
+        raise SystemExit(f"{args.file}: no Table 4 preset rows (no done run has a preset); "
+                         "studies/thesis_table4.toml runs them all")
     cases = [c.strip() for c in args.cases.split(",")] if args.cases else \
         [c for c in dict.fromkeys(runs["preset"]) if c]
     ours, thesis, ids = [], [], []

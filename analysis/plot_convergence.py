@@ -3,7 +3,8 @@
 
 By default one line per (method, lambda) present among the IK runs with a history: the first such
 run (lowest id); --start Q1,Q2 picks the runs whose initial guess (degrees) is nearest instead, and
---runs lists run ids explicitly.
+--runs lists run ids explicitly. Each line's label names its run, method, λ and start; runs that share
+a method and λ get a colour each.
 
     /usr/bin/python3 analysis/plot_convergence.py results/ik_scara.h5 --start 60,45
 """
@@ -71,24 +72,40 @@ def main(argv=None):
     other_colour = {}
     data = {}
     floor = None
-    for r in ids:
+    missing = [r for r in ids if r not in rid]
+    if missing:
+        raise SystemExit(f"--runs: no done run {', '.join(map(str, missing))} in {args.file}")
+    # One line per (method, lambda) gets that pair's colour and style; when two plotted runs share the
+    # pair (runs from other starts), each run gets its own colour instead.
+    keys = [(runs["method"][rid[r]], float(runs["lambda"][rid[r]]) if runs["method"][rid[r]] in LAMBDA_METHODS
+             else None) for r in ids]
+    per_run = len(set(keys)) < len(keys)
+    run_colours = matplotlib.colormaps["tab10"]
+    for n, r in enumerate(ids):
         i = rid[r]
+        if not res.has_history(r):
+            raise SystemExit(f"run {r} has no history in {args.file} (run the study with histories)")
         h = res.history(r)
+        if "norm_F" not in h:
+            raise SystemExit(f"run {r} is not an IK run (no norm_F history)")
         k, nf = h["k"][:, 0], h["norm_F"][:, 0]
         m = runs["method"][i]
         if m in LAMBDA_METHODS:
             lam = float(runs["lambda"][i])
             c = cmap(0.05 + 0.85 * (lams.index(lam) / max(1, len(lams) - 1)))
-            lab = f"{m}, λ = {lam:g}"
             ls = styles[m]
         else:
             c = other_colour.setdefault(m, next(other, "#444444"))
-            lab, ls = m, "-"
-        lab += f" ({runs['status'][i]}, {int(runs['iterations'][i])} it.)"
+            ls = "-"
+        if per_run:
+            c, ls = run_colours(n % 10), "-"
+        lab = (f"run {r}: {m}" + (f", λ = {float(runs['lambda'][i]):g}" if m in LAMBDA_METHODS else "")
+               + f", q0 = ({runs['q0_1'][i]:.4g}°, {runs['q0_2'][i]:.4g}°)"
+               + f" ({runs['status'][i]}, {int(runs['iterations'][i])} it.)")
         pos = nf > 0
         ax.semilogy(k[pos], nf[pos], ls, color=c, lw=1.4, marker="o" if len(k) < 40 else None, ms=3, label=lab)
         floor = nf[pos].min() if floor is None or not pos.any() else min(floor, nf[pos].min())
-        data[r] = {"label": lab, "k": k, "norm_F": nf, "method": m,
+        data[r] = {"label": lab, "colour": matplotlib.colors.to_hex(c), "style": ls, "k": k, "norm_F": nf, "method": m,
                    "lambda": float(runs["lambda"][i]) if m in LAMBDA_METHODS else None}
     ax.set_xlabel("iteration k")
     ax.set_ylabel("‖F_k‖ [problem units: mm for the SCARA]")
@@ -98,7 +115,8 @@ def main(argv=None):
         ax.set_xlabel("iteration k (linear to 10, then log)")
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
     q = f" from q0 = ({args.start}) deg" if args.start else ""
-    ax.set_title(args.title or f"Convergence ‖F_k‖ per method and λ{q}\n{os.path.basename(args.file)}", fontsize=10)
+    what = f"runs {', '.join(map(str, ids))}" if args.runs else f"per method and λ{q}"
+    ax.set_title(args.title or f"Convergence ‖F_k‖, {what}\n{os.path.basename(args.file)}", fontsize=10)
     return ksplot.finish(fig, args, "convergence", {"file": args.file, "runs": data})
 
 

@@ -46,7 +46,11 @@ def main(argv=None):
                                  f"{', '.join(sorted(set(runs['preset']) - {''}))}")
             ids.append(int(runs["run_id"][m[0]]))
     if not ids:
-        ids = [int(r) for r in runs["run_id"] if res.has_history(int(r))][:3]
+        # the first three trajectory runs with a history (an IK run's history has no time array)
+        ids = [int(r) for r in runs["run_id"] if res.has_history(int(r)) and "t" in res.f["histories"][
+            ksread.history_group_name(int(r), res.n_runs)]][:3]
+        if not ids:
+            raise SystemExit(f"{args.file}: no trajectory run with a history (run the study with histories)")
     whats = [w.strip() for w in args.what.split(",") if w.strip()]
     hist = {}
     for r in ids:

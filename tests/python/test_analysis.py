@@ -136,7 +136,7 @@ class AnalysisTest(unittest.TestCase):
 
     def test_landscape_reduced_min_and_log(self):
         d = self.plot("plot_landscape.py", self.files["landscape"], "--metric", "tau_inf", "--log",
-                      "--x", "k", "--y", "alpha1A")
+                      "--x", "k", "--y", "alpha1A", "--reduce", "min")
         self.assertEqual(d["reduce"], "min")
         with h5py.File(self.files["landscape"], "r") as f:
             g = f["landscapes"]["local"]
