@@ -225,7 +225,7 @@ def view_scatter(plt, size, ctx):
         cb.set_label(metric.label() + " (ok runs)")
     what = f"{metric.name} over ({x.name}, {y.name})" if two else f"{metric.name} against {x.name}"
     data = {"axes": {"x": x.describe(), "y": yc.describe(), "colour": metric.describe() if two else None},
-            "panels": panels}
+            "colour_range": [norm.vmin, norm.vmax] if two else None, "panels": panels}
     return fig, what, data
 
 
@@ -348,7 +348,8 @@ def view_parcoords(plt, size, ctx):
     cb = fig.colorbar(lc, cax=cax)
     cb.set_label(metric.label() + " (ok runs)")
     data = {"axes": [c.describe() for c in cols], "run_ids": ctx["run_ids"][rows], "status": ctx["status"][rows],
-            "values": {c.name: c.values[rows] for c in cols}, "colour": metric.values[rows]}
+            "values": {c.name: c.values[rows] for c in cols}, "colour": metric.values[rows],
+            "colour_range": [norm.vmin, norm.vmax]}
     return fig, f"parallel coordinates of {len(cols) - 1} parameters and {metric.name}", data
 
 
