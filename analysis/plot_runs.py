@@ -55,6 +55,11 @@ def parse_args(argv=None):
                    "`kinesweep query --where`: COL OP VALUE, COL=A,B, COL=LO..HI, LO<COL<=HI, angles "
                    "in degrees; alternatives separated by ' | ' (any holds)")
     p.add_argument("--log", action="store_true", help="the metric on a log scale (axis or colour)")
+    # An expression may start with '-' (-10<alpha1A<10): take the word after -w / --where as its value.
+    argv = list(sys.argv[1:] if argv is None else argv)
+    for i in range(len(argv) - 1, 0, -1):
+        if argv[i - 1] in ("-w", "--where"):
+            argv[i - 1:i + 1] = ["--where=" + argv[i]]
     return p.parse_args(argv)
 
 
@@ -131,7 +136,10 @@ def draw_failed(ax, x, y, status, fail_order, y_is_metric):
         none = m & ~np.isfinite(y) if y_is_metric else np.zeros_like(m)
         if none.any():
             tr = mtrans.blended_transform_factory(ax.transData, ax.transAxes)
-            ax.scatter(x[none], np.full(int(none.sum()), 0.025), transform=tr, clip_on=False, **kw)
+            ax.scatter(x[none], np.full(int(none.sum()), 0.025), transform=tr, **kw)
+            # the x limits must take these points in too (autoscaling skips a blended transform)
+            ax.update_datalim(np.column_stack([x[none], np.ones(int(none.sum()))]), updatey=False)
+            ax.autoscale_view()
 
 
 def failure_handles(ctx, y_is_metric=True):
