@@ -91,20 +91,22 @@ def fmt_num(v):
 
 
 def is_log_spaced(values) -> bool:
-    """True when the values are all positive, spread over at least 2 decades, and closer to evenly
-    spaced in log than linearly (the spread of the sorted gaps relative to their mean is smaller for
-    log10 of the values than for the values)."""
-    v = np.unique(np.asarray(values, dtype=float).ravel())
-    if v.size < 2 or not np.all(np.isfinite(v)) or v[0] <= 0 or v[-1] / v[0] < 100.0:
+    """True when `values` read better on a log axis: all finite values positive, spread over at least
+    2 decades, and their distinct values closer to evenly spaced in log10 than linearly (mean distance
+    of the sorted, min-max scaled values from an even sequence). E.g. λ = 1e-3 .. 100 by decades: True;
+    uniform draws in [1e-3, 100] or a linear grid: False. Fewer than 2 distinct values: False."""
+    v = np.asarray(values, dtype=float).ravel()
+    v = np.unique(v[np.isfinite(v)])
+    if len(v) < 2 or v[0] <= 0 or np.log10(v[-1] / v[0]) < 2:
         return False
-    if v.size == 2:
+    if len(v) == 2:
         return True
+    even = np.linspace(0.0, 1.0, len(v))
 
-    def unevenness(x):
-        d = np.diff(x)
-        return float(np.std(d) / np.mean(d))
+    def unevenness(u):
+        return float(np.mean(np.abs((u - u[0]) / (u[-1] - u[0]) - even)))
 
-    return unevenness(np.log10(v)) <= unevenness(v)
+    return unevenness(np.log10(v)) < unevenness(v)
 
 
 def cell_edges(values, log=False):
