@@ -5,7 +5,8 @@
 
 Runs the small studies studies/examples_*.toml and studies/thesis_table4.toml (seconds), and the small
 optimisation study below (OPTIMIZATION_STUDY, written to the work directory), then every plot script at
-800x600 (basins 1200x500), dpi 100.
+800x600 (basins 1200x500), dpi 100. results/examples/report.png (a screenshot of analysis/report.py's
+page, taken with headless Chromium) is not regenerated here: analysis/README.md says how it was taken.
 """
 import argparse
 import os
@@ -60,7 +61,7 @@ def main():
     os.makedirs(a.work, exist_ok=True)
     os.makedirs(a.out, exist_ok=True)
     h5 = {}
-    for s in ("thesis_table4", "examples_landscape", "examples_basins", "examples_convergence"):
+    for s in ("thesis_table4", "examples_landscape", "examples_basins", "examples_convergence", "examples_lhs"):
         h5[s] = os.path.join(a.work, s + ".h5")
         subprocess.run([a.kinesweep, "run", os.path.join(ROOT, "studies", s + ".toml"), "-o", h5[s],
                         "--overwrite", "-q"], check=True, stdout=subprocess.DEVNULL)
@@ -84,6 +85,11 @@ def main():
         ("plot_convergence.py", h5["examples_convergence"], "convergence.png", []),
         ("plot_landscape.py", h5["examples_optimization"], "landscape_optimization.png",
          ["--optimization", "1h", "--log"]),
+        ("plot_runs.py", h5["examples_lhs"], "runs_scatter_lhs.png",
+         ["--view", "scatter", "--x", "alpha1A", "--y", "k", "--facet", "method", "--size", "1100x500"]),
+        ("plot_runs.py", h5["examples_lhs"], "runs_slice_lambda.png",
+         ["--view", "slice", "--block", "lm_lambda", "--size", "1100x450"]),
+        ("plot_runs.py", h5["examples_lhs"], "runs_parcoords.png", ["--view", "parcoords"]),
     ]
     for script, f, out, extra in jobs:
         subprocess.run([py, os.path.join(HERE, script), f, "-o", os.path.join(a.out, out), *extra], check=True)

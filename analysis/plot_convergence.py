@@ -70,7 +70,7 @@ def main(argv=None):
     styles = {"lm": "-", "lm_adaptive": "--"}
     other = iter(["#000000", "#1b9e77", "#7570b3", "#e7298a", "#66a61e"])
     other_colour = {}
-    data = {}
+    data, starts = {}, set()
     floor = None
     missing = [r for r in ids if r not in rid]
     if missing:
@@ -99,9 +99,10 @@ def main(argv=None):
             ls = "-"
         if per_run:
             c, ls = run_colours(n % 10), "-"
+        start = f"({runs['q0_1'][i]:.4g}°, {runs['q0_2'][i]:.4g}°)"
+        starts.add(start)
         lab = (f"run {r}: {m}" + (f", λ = {float(runs['lambda'][i]):g}" if m in LAMBDA_METHODS else "")
-               + f", q0 = ({runs['q0_1'][i]:.4g}°, {runs['q0_2'][i]:.4g}°)"
-               + f" ({runs['status'][i]}, {int(runs['iterations'][i])} it.)")
+               + f", q0 = {start}" + f" ({runs['status'][i]}, {int(runs['iterations'][i])} it.)")
         pos = nf > 0
         ax.semilogy(k[pos], nf[pos], ls, color=c, lw=1.4, marker="o" if len(k) < 40 else None, ms=3, label=lab)
         floor = nf[pos].min() if floor is None or not pos.any() else min(floor, nf[pos].min())
@@ -113,8 +114,11 @@ def main(argv=None):
     if max(len(d["k"]) for d in data.values()) > 200:
         ax.set_xscale("symlog", linthresh=10)
         ax.set_xlabel("iteration k (linear to 10, then log)")
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
-    q = f" from q0 = ({args.start}) deg" if args.start else ""
+    handles, labels = ax.get_legend_handles_labels()
+    if len(starts) == 1:  # one start for all: said once, in the title
+        labels = [lab.replace(f", q0 = {next(iter(starts))}", "") for lab in labels]
+    ax.legend(handles, labels, fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
+    q = f" from q0 = {next(iter(starts))}" if len(starts) == 1 else ""
     what = f"runs {', '.join(map(str, ids))}" if args.runs else f"per method and λ{q}"
     ax.set_title(args.title or f"Convergence ‖F_k‖, {what}\n{os.path.basename(args.file)}", fontsize=10)
     return ksplot.finish(fig, args, "convergence", {"file": args.file, "runs": data})
