@@ -16,6 +16,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <ostream>
 #include <thread>
 
@@ -40,7 +42,8 @@ struct Sample {
 struct BlockEstimate {
   std::uint64_t runs = 0;
   std::size_t sampled = 0;
-  double compute_s = 0;  ///< per run
+  double compute_s = 0;      ///< per run
+  double history_bytes = 0;  ///< per run, encoded
 };
 
 /// Run-index sequence over [0, n): the golden-ratio (Weyl) sequence, distinct indices, any prefix spread.
@@ -57,31 +60,60 @@ std::vector<std::uint64_t> spread_indices(std::uint64_t n, std::size_t max) {
   return out;
 }
 
-/// Size in bytes of a results file of `samples` (run ids 0..n-1) with `columns`, and the writer's time.
-std::pair<double, double> write_samples(const std::string& path, const Study& study, const StudySchema& schema,
-                                        const std::vector<Sample>& samples) {
+/// Seconds since this process started (Linux: /proc; 0 elsewhere): what a run spends before its sweep
+/// (loading, MPI probing, parsing the study), which the dry run spent too.
+double seconds_since_process_start() {
+  std::ifstream stat("/proc/self/stat"), uptime("/proc/uptime");
+  std::string text;
+  double up = 0;
+  if (!std::getline(stat, text) || !(uptime >> up)) return 0;
+  std::istringstream fields(text.substr(text.rfind(')') + 2));  // after "pid (comm) "
+  std::string f;
+  for (int i = 3; i <= 22 && fields >> f; ++i) {
+    if (i == 22) return std::max(0.0, up - std::stod(f) / static_cast<double>(sysconf(_SC_CLK_TCK)));
+  }
+  return 0;
+}
+
+double history_bytes(const store::EncodedHistory& h) {
+  double b = 0;
+  for (const auto& a : h.arrays) b += static_cast<double>(a.bytes.size());
+  return b;
+}
+
+/// Size in bytes of a results file of `rows` runs (run ids 0..rows-1) whose rows and histories cycle
+/// through `samples`, the writer's time, and the history bytes written.
+struct Written {
+  double bytes = 0, seconds = 0, history_bytes = 0;
+};
+Written write_samples(const std::string& path, const Study& study, const StudySchema& schema,
+                      const std::vector<Sample>& samples, std::size_t rows) {
+  Written out;
   const auto t0 = Clock::now();
   {
     auto w = store::ResultsWriter::create(path, store_meta(study), schema.columns,
-                                          static_cast<std::int64_t>(std::max<std::size_t>(samples.size(), 1)),
+                                          static_cast<std::int64_t>(std::max<std::size_t>(rows, 1)),
                                           {.overwrite = true});
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-      Record row = samples[i].row;
+    for (std::size_t i = 0; i < rows && !samples.empty(); ++i) {
+      const Sample& sample = samples[i % samples.size()];
+      Record row = sample.row;
       row.cells[schema.run_id] = static_cast<std::int64_t>(i);
-      w->write_run(static_cast<std::int64_t>(i), row, samples[i].history);
+      w->write_run(static_cast<std::int64_t>(i), row, sample.history);
+      out.history_bytes += history_bytes(sample.history);
     }
     w->close();
   }
-  const double s = std::chrono::duration<double>(Clock::now() - t0).count();
-  const double bytes = static_cast<double>(fs::file_size(path));
+  out.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  out.bytes = static_cast<double>(fs::file_size(path));
   fs::remove(path);
-  return {bytes, s};
+  return out;
 }
 
 }  // namespace
 
 int dry_run(const Study& study, const StudySchema& schema, const DryRunOptions& opt, std::ostream& out,
             std::ostream& err) {
+  const double startup = seconds_since_process_start();
   out << "study " << study.name << " (" << study.file << "), sha256 " << study.sha256 << '\n';
   out << "output " << opt.output << (fs::exists(opt.output) ? " (exists: --resume completes it, --overwrite replaces it)" : "")
       << '\n';
@@ -111,17 +143,32 @@ int dry_run(const Study& study, const StudySchema& schema, const DryRunOptions& 
       if (!o.history.arrays.empty()) hist = store::encode_history(o.history, opt.compression);
       const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
       compute += wall;
+      est[b].history_bytes += history_bytes(hist);
       samples.push_back({b, local, schema.row(study.first_run(b) + local, b, block, run, o, wall), std::move(hist)});
       ++est[b].sampled;
     }
     est[b].compute_s = est[b].sampled ? compute / static_cast<double>(est[b].sampled) : 0;
+    if (est[b].sampled) est[b].history_bytes /= static_cast<double>(est[b].sampled);
   }
-  // Bytes and writer time per run, from the sample file beyond a file of one empty row.
+  // Bytes and writer time per run, from sample files beyond a file of one empty row. The samples are
+  // written repeatedly, up to 4096 rows or 64 MiB of histories, so that the store's per-commit costs
+  // are spread over as many runs as in a sweep.
+  double total_runs = 0, compute_total = 0, sample_history = 0;
+  for (const BlockEstimate& e : est) {
+    total_runs += static_cast<double>(e.runs);
+    compute_total += static_cast<double>(e.runs) * e.compute_s;
+  }
+  for (const Sample& smp : samples) sample_history += history_bytes(smp.history);
+  const double mean_history = samples.empty() ? 0 : sample_history / static_cast<double>(samples.size());
+  std::size_t rows = std::min<std::size_t>(static_cast<std::size_t>(total_runs), 4096);
+  if (mean_history > 0) rows = std::min<std::size_t>(rows, static_cast<std::size_t>(64.0 * (1 << 20) / mean_history));
+  rows = std::max(rows, samples.size());
   const fs::path tmp = fs::temp_directory_path() / ("kinesweep-dry-run-" + std::to_string(getpid()) + ".h5");
-  double file_bytes = 0, empty_bytes = 0, write_s = 0, empty_s = 0;
+  Written empty, half, full;
   try {
-    std::tie(empty_bytes, empty_s) = write_samples(tmp.string(), study, schema, {});
-    std::tie(file_bytes, write_s) = write_samples(tmp.string(), study, schema, samples);
+    empty = write_samples(tmp.string(), study, schema, {}, 0);
+    half = write_samples(tmp.string(), study, schema, samples, rows / 2);
+    full = write_samples(tmp.string(), study, schema, samples, rows);
   } catch (const std::exception& e) {
     std::error_code ec;
     fs::remove(tmp, ec);
@@ -129,20 +176,21 @@ int dry_run(const Study& study, const StudySchema& schema, const DryRunOptions& 
         << e.what() << '\n';
     return 1;
   }
-  const double n_sampled = static_cast<double>(std::max<std::size_t>(samples.size(), 1));
-  const double bytes_per_run = std::max(0.0, file_bytes - empty_bytes) / n_sampled;
-  const double write_per_run = std::max(0.0, write_s - empty_s) / n_sampled;
-  double total_runs = 0, compute_total = 0;
-  for (const BlockEstimate& e : est) {
-    total_runs += static_cast<double>(e.runs);
-    compute_total += static_cast<double>(e.runs) * e.compute_s;
-  }
+  // Per run: its block's history bytes, plus what every run costs beyond its history (row, index, objects).
+  const double n_rows = static_cast<double>(std::max<std::size_t>(rows, 1));
+  const double overhead_per_run = std::max(0.0, full.bytes - empty.bytes - full.history_bytes) / n_rows;
+  double bytes = empty.bytes;
+  for (std::size_t b = 0; b < est.size(); ++b) bytes += static_cast<double>(est[b].runs) * (est[b].history_bytes + overhead_per_run);
+  // The writer's time per run: the slope between the half and the full file (a new file's first
+  // rows cost more: its index and chunks are being allocated).
+  const double write_per_run = rows >= 2 ? std::max(0.0, full.seconds - half.seconds) / (n_rows - rows / 2)
+                                         : std::max(0.0, full.seconds - empty.seconds) / n_rows;
   const int n = opt.threads > 0 ? opt.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const double write_total = total_runs * write_per_run;
-  const double seconds = std::max((compute_total + write_total) / n, write_total) + empty_s;
+  const double seconds = startup + std::max((compute_total + write_total) / n, write_total) + 2 * empty.seconds;
   out << "  total: " << static_cast<std::uint64_t>(total_runs) << " runs; histories " << h.str()
-      << "\n  estimated size: " << human_bytes(empty_bytes + total_runs * bytes_per_run) << " ("
-      << human_bytes(bytes_per_run) << " per run); estimated time: " << human_time(seconds) << " on " << n
+      << "\n  estimated size: " << human_bytes(bytes) << " (" << human_bytes((bytes - empty.bytes) / std::max(total_runs, 1.0))
+      << " per run); estimated time: " << human_time(seconds) << " on " << n
       << " thread" << (n == 1 ? "" : "s") << " (from " << samples.size() << " sample runs executed and written here)\n";
   for (const OptimizeBlock& ob : study.optimizations) {  // run after the sweep; not part of the estimates
     out << "  optimization " << ob.name << ": minimise " << ob.objective_text << " over";

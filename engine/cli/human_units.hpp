@@ -1,5 +1,5 @@
 #pragma once
-// Sizes and durations for people: "1.5 MiB", "12.0 s", "3.2 min", "1.1 h".
+// Sizes and durations for people: "1.5 MiB", "0.25 s", "12.0 s", "3.2 min", "1.1 h".
 #include <cstdio>
 #include <string>
 
@@ -16,7 +16,8 @@ inline std::string human_bytes(double b) {
 
 inline std::string human_time(double s) {
   char buf[32];
-  if (s < 120) std::snprintf(buf, sizeof buf, "%.1f s", s);
+  if (s < 10) std::snprintf(buf, sizeof buf, "%.2f s", s);
+  else if (s < 120) std::snprintf(buf, sizeof buf, "%.1f s", s);
   else if (s < 7200) std::snprintf(buf, sizeof buf, "%.1f min", s / 60);
   else std::snprintf(buf, sizeof buf, "%.1f h", s / 3600);
   return buf;
