@@ -77,10 +77,9 @@ std::vector<std::string> read_strings(hid_t attr) {
   if (n <= 0) return out;
   if (H5Tis_variable_str(ftype) > 0) {
     Hid mtype(utf8_vlen_type());
-    std::vector<char*> ptrs(static_cast<std::size_t>(n), nullptr);
-    if (H5Aread(attr, mtype, ptrs.data()) < 0) return out;
-    for (char* p : ptrs) out.emplace_back(p ? p : "");
-    H5Dvlen_reclaim(mtype, space, H5P_DEFAULT, ptrs.data());
+    VlenStrings strs(mtype, space, static_cast<std::size_t>(n));
+    if (H5Aread(attr, mtype, strs.data()) < 0) return out;
+    for (char* p : strs.ptrs) out.emplace_back(p ? p : "");
   } else {
     std::size_t sz = H5Tget_size(ftype);
     Hid mtype(H5Tcopy(H5T_C_S1));

@@ -56,6 +56,27 @@ struct QuietHdf5 {
   ~QuietHdf5() { H5Eset_auto2(H5E_DEFAULT, func, data); }
 };
 
+/// Owns the strings HDF5 allocates when it reads variable-length strings into `ptrs` (memory type
+/// `type`, `space` the memory dataspace of the read): frees them (H5Dvlen_reclaim) when it goes out
+/// of scope, also when the read or the copy into std::string throws. Null pointers are skipped by
+/// HDF5, so a read that failed half-way is reclaimed too.
+class VlenStrings {
+ public:
+  VlenStrings(hid_t type, hid_t space, std::size_t n) : type_(type), space_(space), ptrs(n, nullptr) {}
+  ~VlenStrings() {
+    if (!ptrs.empty()) H5Dvlen_reclaim(type_, space_, H5P_DEFAULT, ptrs.data());
+  }
+  VlenStrings(const VlenStrings&) = delete;
+  VlenStrings& operator=(const VlenStrings&) = delete;
+  void* data() { return ptrs.data(); }
+
+ private:
+  hid_t type_, space_;
+
+ public:
+  std::vector<char*> ptrs;
+};
+
 /// The current HDF5 error stack as one line (and clears it).
 std::string h5_error_text();
 /// Throws StoreError(path, what + HDF5 error text) when id < 0 / rc < 0.

@@ -47,12 +47,11 @@ struct In {
     Hid d(check(H5Dopen2(g, name.c_str(), H5P_DEFAULT), path, "open " + where + "/" + name));
     Hid s(H5Dget_space(d));
     Hid t(utf8_vlen_type());
-    std::vector<char*> p(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)), nullptr);
+    VlenStrings p(t, s, static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
     std::vector<std::string> v;
-    if (p.empty()) return v;
+    if (p.ptrs.empty()) return v;
     check(H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, p.data()), path, "read " + where + "/" + name);
-    for (char* c : p) v.emplace_back(c ? c : "");
-    H5Dvlen_reclaim(t, s, H5P_DEFAULT, p.data());
+    for (char* c : p.ptrs) v.emplace_back(c ? c : "");
     return v;
   }
 };

@@ -18,11 +18,9 @@ std::string read_text_dataset(hid_t group, const char* name, const std::string& 
   Hid d(check(H5Dopen2(group, name, H5P_DEFAULT), path, "open " + what));
   Hid t(utf8_vlen_type());
   Hid s(H5Dget_space(d));
-  char* p = nullptr;
-  check(H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, &p), path, "read " + what);
-  std::string text = p ? p : "";
-  H5Dvlen_reclaim(t, s, H5P_DEFAULT, &p);
-  return text;
+  VlenStrings p(t, s, 1);
+  check(H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, p.data()), path, "read " + what);
+  return p.ptrs[0] ? p.ptrs[0] : "";
 }
 }  // namespace
 
@@ -92,11 +90,10 @@ struct ResultsReader::Impl {
     H5Sselect_hyperslab(fs, H5S_SELECT_SET, &first, nullptr, &count, nullptr);
     Hid ms(H5Screate_simple(1, &count, nullptr));
     Hid t(utf8_vlen_type());
-    std::vector<char*> ptrs(count, nullptr);
-    check(H5Dread(d, t, ms, fs, H5P_DEFAULT, ptrs.data()), path, "read /runs/" + name);
+    VlenStrings strs(t, ms, count);
+    check(H5Dread(d, t, ms, fs, H5P_DEFAULT, strs.data()), path, "read /runs/" + name);
     out.reserve(count);
-    for (char* p : ptrs) out.emplace_back(p ? p : "");
-    H5Dvlen_reclaim(t, ms, H5P_DEFAULT, ptrs.data());
+    for (char* p : strs.ptrs) out.emplace_back(p ? p : "");
     return out;
   }
 };
