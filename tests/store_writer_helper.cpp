@@ -1,10 +1,12 @@
 // Test helper: writes the deterministic test study (store_testgen.cpp) into a results file, slowly
 // if asked, so that tests can kill it (SIGKILL) or read the file while it is being written.
 //   store_writer_helper PATH N [--delay-us D] [--flush-every K] [--flush-seconds S] [--no-shuffle] [--landscape]
+//                       [--stop-after-runs K1,K2,...]   (flush, then stop itself with SIGSTOP, after K runs)
 // Creates PATH, or resumes it when it exists. Prints "resumed <k>" / "created", then "finished".
 #include <unistd.h>
 
 #include <algorithm>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
@@ -25,6 +27,7 @@ int main(int argc, char** argv) {
   const std::int64_t n = std::atoll(argv[2]);
   long delay_us = 0;
   bool shuffle = true, landscape = false;
+  std::vector<std::int64_t> stop_after;  // after writing this many runs: flush, then SIGSTOP itself
   store::StoreOptions opt;
   opt.flush_every_seconds = 0.05;
   for (int i = 3; i < argc; ++i) {
@@ -34,6 +37,9 @@ int main(int argc, char** argv) {
     else if (a == "--flush-seconds" && i + 1 < argc) opt.flush_every_seconds = std::atof(argv[++i]);
     else if (a == "--no-shuffle") shuffle = false;
     else if (a == "--landscape") landscape = true;
+    else if (a == "--stop-after-runs" && i + 1 < argc) {
+      for (char* t = std::strtok(argv[++i], ","); t; t = std::strtok(nullptr, ",")) stop_after.push_back(std::atoll(t));
+    }
   }
   try {
     std::unique_ptr<store::ResultsWriter> w;
@@ -54,9 +60,14 @@ int main(int argc, char** argv) {
       for (std::size_t i = 0; i + 1 < order.size(); i += 2)
         if (rng() % 2) std::swap(order[i], order[i + 1]);
     }
+    std::int64_t written = 0;
     for (auto id : order) {
       if (done[static_cast<std::size_t>(id)]) continue;
       w->write_run(id, store_test::test_record(id), store::encode_history(store_test::test_history(id), 4));
+      if (std::find(stop_after.begin(), stop_after.end(), ++written) != stop_after.end()) {
+        w->flush();
+        raise(SIGSTOP);  // a test reads the committed state, then lets the writer go on (SIGCONT)
+      }
       if (delay_us > 0) usleep(static_cast<useconds_t>(delay_us));
     }
     w->flush();

@@ -1,5 +1,5 @@
-// The ksjournal redo journal on disk: its records, recovery after a crash, and the consistency stamp
-// readers use (see journal_format.hpp, journal_vfd.hpp, FORMAT.md "Crash safety"). The HDF5 driver
+// The ksjournal redo journal on disk: its records, the check that it belongs to the file, recovery
+// after a crash, and what readers use (how to open the file, the consistency stamp) (see journal_format.hpp, journal_vfd.hpp, FORMAT.md "Crash safety"). The HDF5 driver
 // that writes it is journal_vfd.cpp.
 #include "store/journal_format.hpp"
 
@@ -9,6 +9,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -56,36 +57,70 @@ bool read_all(int fd, void* buf, std::size_t n, std::uint64_t off) {
 void put64(unsigned char* p, std::uint64_t v) { std::memcpy(p, &v, 8); }
 std::uint64_t get64(const unsigned char* p) { std::uint64_t v; std::memcpy(&v, p, 8); return v; }
 
-std::vector<unsigned char> make_header(std::uint64_t dev, std::uint64_t ino, std::uint64_t committed,
-                                       std::uint64_t seq, std::uint64_t session) {
-  std::vector<unsigned char> h(kHeadSize);
-  std::memcpy(h.data(), kHeadMagic, 8);
-  put64(h.data() + 8, dev); put64(h.data() + 16, ino); put64(h.data() + 24, committed);
-  put64(h.data() + 32, seq); put64(h.data() + 40, session);
-  return h;
+std::pair<std::uint64_t, std::uint64_t> first_page_range(std::uint64_t size) {
+  return {0, std::min<std::uint64_t>(kPage, size)};
 }
 
-bool reset_journal(int jfd, std::uint64_t dev, std::uint64_t ino, std::uint64_t committed, std::uint64_t seq,
-                   std::uint64_t session) {
+std::pair<std::uint64_t, std::uint64_t> last_page_range(std::uint64_t size) {
+  if (size == 0) return {0, 0};
+  const std::uint64_t at = (size - 1) / kPage * kPage;
+  return {at, size - at};
+}
+
+namespace {
+std::uint32_t crc_of(const unsigned char* p, std::size_t n) {
+  return static_cast<std::uint32_t>(crc32(crc32(0L, Z_NULL, 0), p, static_cast<uInt>(n)));
+}
+bool crc_range(int fd, std::pair<std::uint64_t, std::uint64_t> r, std::uint32_t* out) {
+  std::vector<unsigned char> b(static_cast<std::size_t>(r.second));
+  if (!read_all(fd, b.data(), b.size(), r.first)) return false;
+  *out = crc_of(b.data(), b.size());
+  return true;
+}
+}  // namespace
+
+bool fingerprint(int fd, std::uint64_t size, Fingerprint* out) {
+  out->size = size;
+  return crc_range(fd, first_page_range(size), &out->crc_first) && crc_range(fd, last_page_range(size), &out->crc_last);
+}
+
+bool reset_journal(int jfd, int fd, std::uint64_t dev, std::uint64_t ino, std::uint64_t committed,
+                   std::uint64_t seq, std::uint64_t session) {
+  Fingerprint fp;
+  if (!fingerprint(fd, committed, &fp)) return false;
+  unsigned char h[kHeadSize] = {};
+  std::memcpy(h, kHeadMagic, 8);
+  put64(h + 8, dev); put64(h + 16, ino); put64(h + 24, committed);
+  put64(h + 32, seq); put64(h + 40, session);
+  std::memcpy(h + 48, &fp.crc_first, 4);
+  std::memcpy(h + 52, &fp.crc_last, 4);
   // Header first, then drop the old records: a kill in between leaves a header whose (old,
   // still valid) commit is replayed again, which is harmless.
-  auto h = make_header(dev, ino, committed, seq, session);
-  if (!write_all(jfd, h.data(), h.size(), 0)) return false;
+  if (!write_all(jfd, h, kHeadSize, 0)) return false;
   return ::ftruncate(jfd, static_cast<off_t>(kHeadSize)) == 0;
 }
 
-Parsed parse_journal(int jfd, std::uint64_t dev, std::uint64_t ino) {
+Parsed parse_journal(int jfd) {
   Parsed out;
   struct stat st{};
-  if (::fstat(jfd, &st) != 0 || static_cast<std::size_t>(st.st_size) < kHeadSize) return out;
+  if (::fstat(jfd, &st) != 0 || static_cast<std::size_t>(st.st_size) < kHeadSizeV1) return out;
   std::vector<unsigned char> buf(static_cast<std::size_t>(st.st_size));
   if (!read_all(jfd, buf.data(), buf.size(), 0)) return out;
-  if (std::memcmp(buf.data(), kHeadMagic, 8) != 0 || get64(buf.data() + 8) != dev ||
-      get64(buf.data() + 16) != ino)
+  std::size_t pos = 0;
+  if (std::memcmp(buf.data(), kHeadMagic, 8) == 0 && buf.size() >= kHeadSize) {
+    out.version = 2;
+    std::memcpy(&out.crc_first, buf.data() + 48, 4);
+    std::memcpy(&out.crc_last, buf.data() + 52, 4);
+    pos = kHeadSize;
+  } else if (std::memcmp(buf.data(), kHeadMagicV1, 8) == 0) {
+    out.version = 1;
+    pos = kHeadSizeV1;
+  } else {
     return out;
-  out.header_ok = true;
+  }
+  out.dev = get64(buf.data() + 8);
+  out.ino = get64(buf.data() + 16);
   out.committed = get64(buf.data() + 24);
-  std::size_t pos = kHeadSize;
   uLong crc = crc32(0L, Z_NULL, 0);
   std::uint64_t n = 0;
   while (pos + 16 <= buf.size()) {
@@ -112,18 +147,51 @@ Parsed parse_journal(int jfd, std::uint64_t dev, std::uint64_t ino) {
   return out;
 }
 
-bool recover_locked(int fd, int jfd, std::uint64_t dev, std::uint64_t ino, bool* replayed) {
-  *replayed = false;
-  Parsed p = parse_journal(jfd, dev, ino);
-  if (!p.header_ok) return true;  // no journal content, or a stale journal of another file
+std::string mismatch(const Parsed& p, int fd) {
+  struct stat st{};
+  if (::fstat(fd, &st) != 0) return std::string("cannot stat the file: ") + std::strerror(errno);
+  const std::uint64_t size = static_cast<std::uint64_t>(st.st_size);
+  if (p.commit_ok && size != p.new_size)
+    return "the file has " + std::to_string(size) + " bytes, the commit in the journal makes it " +
+           std::to_string(p.new_size);
+  if (!p.commit_ok && size < p.committed)
+    return "the file has " + std::to_string(size) + " bytes, fewer than the " + std::to_string(p.committed) +
+           " the journal committed";
+  if (p.version < 2) return {};
+  const std::pair<std::pair<std::uint64_t, std::uint64_t>, std::uint32_t> pages[2] = {
+      {first_page_range(p.committed), p.crc_first}, {last_page_range(p.committed), p.crc_last}};
+  for (auto& [range, expected] : pages) {
+    std::uint32_t now = 0;
+    if (!crc_range(fd, range, &now)) return std::string("cannot read the file: ") + std::strerror(errno);
+    if (now == expected) continue;
+    bool as_committed = false;  // or as the pending commit writes it
+    if (p.commit_ok)
+      for (auto& [addr, bytes] : p.records)
+        if (addr == range.first && bytes.size() == range.second) as_committed = crc_of(bytes.data(), bytes.size()) == now;
+    if (!as_committed)
+      return "the bytes at offset " + std::to_string(range.first) + " differ from the state the journal was written for";
+  }
+  return {};
+}
+
+bool recover_locked(int fd, int jfd, std::uint64_t dev, std::uint64_t ino, std::string* why) {
+  why->clear();
+  Parsed p = parse_journal(jfd);
+  if (p.version == 0) return true;  // empty, or no journal at all: nothing to recover
+  if (p.dev != dev || p.ino != ino) {
+    if (!p.commit_ok) return true;  // another file's journal with nothing committed: nothing of this file
+    *why = "the journal holds a commit for another file (device/inode differ: the file was replaced after its "
+           "writer stopped)";
+    return false;
+  }
+  *why = mismatch(p, fd);
+  if (!why->empty()) return false;
   struct stat st{};
   if (::fstat(fd, &st) != 0) return false;
-  std::uint64_t size = static_cast<std::uint64_t>(st.st_size);
+  const std::uint64_t size = static_cast<std::uint64_t>(st.st_size);
   if (p.commit_ok) {
     for (auto& [addr, bytes] : p.records)
       if (!write_all(fd, bytes.data(), bytes.size(), addr)) return false;
-    if (size > p.new_size && ::ftruncate(fd, static_cast<off_t>(p.new_size)) != 0) return false;
-    *replayed = true;
   } else if (size > p.committed) {
     // bytes appended after the last commit: nothing committed points at them
     if (::ftruncate(fd, static_cast<off_t>(p.committed)) != 0) return false;
@@ -139,27 +207,26 @@ std::string journal_path(const std::string& results_path) { return results_path 
 
 std::string journal_last_error() { return g_last_error; }
 
-RecoverOutcome recover(const std::string& results_path) {
+ReadView read_view(const std::string& results_path) {
   const std::string jp = journal_path(results_path);
-  int jfd = ::open(jp.c_str(), O_RDWR | O_CLOEXEC);
-  if (jfd < 0) return errno == ENOENT ? RecoverOutcome::no_journal : RecoverOutcome::not_permitted;
-  if (::flock(jfd, LOCK_EX | LOCK_NB) != 0) { ::close(jfd); return RecoverOutcome::writer_alive; }
-  int fd = ::open(results_path.c_str(), O_RDWR | O_CLOEXEC);
-  if (fd < 0) {
-    ::close(jfd);
-    if (errno == ENOENT) { ::unlink(jp.c_str()); return RecoverOutcome::clean; }  // orphan journal
-    return RecoverOutcome::not_permitted;
-  }
-  struct stat st{};
-  ::fstat(fd, &st);
-  bool replayed = false;
-  bool ok = recover_locked(fd, jfd, static_cast<std::uint64_t>(st.st_dev), static_cast<std::uint64_t>(st.st_ino),
-                           &replayed);
-  if (ok) ::unlink(jp.c_str());
-  ::close(fd);
+  int jfd = ::open(jp.c_str(), O_RDONLY | O_CLOEXEC);
+  if (jfd < 0) return {};
+  ReadView v;
+  Parsed p = parse_journal(jfd);
   ::close(jfd);
-  if (!ok) return RecoverOutcome::not_permitted;
-  return replayed ? RecoverOutcome::replayed : RecoverOutcome::clean;
+  int fd = ::open(results_path.c_str(), O_RDONLY | O_CLOEXEC);
+  struct stat st{};
+  if (fd < 0 || ::fstat(fd, &st) != 0) {
+    if (fd >= 0) ::close(fd);
+    return {};  // the open that follows reports it
+  }
+  if (p.version != 0 && p.commit_ok && p.dev == static_cast<std::uint64_t>(st.st_dev) &&
+      p.ino == static_cast<std::uint64_t>(st.st_ino)) {
+    v.why = mismatch(p, fd);
+    v.kind = v.why.empty() ? ReadView::overlay : ReadView::refuse;
+  }
+  ::close(fd);
+  return v;
 }
 
 std::string consistency_stamp(const std::string& results_path) {
@@ -170,28 +237,23 @@ std::string consistency_stamp(const std::string& results_path) {
     return "static:" + std::to_string(st.st_size) + ":" + std::to_string(st.st_mtim.tv_sec) + "." +
            std::to_string(st.st_mtim.tv_nsec);
   }
-  std::string out;
+  // The header (commit sequence, session, committed size) and, past it, the journal's size and its
+  // last bytes: records being written or a commit being applied change the stamp.
+  std::string out = "journal:";
   struct stat st{};
-  if (::fstat(jfd, &st) == 0 && static_cast<std::size_t>(st.st_size) == kHeadSize) {
-    std::vector<unsigned char> h(kHeadSize);
-    if (read_all(jfd, h.data(), kHeadSize, 0) && std::memcmp(h.data(), kHeadMagic, 8) == 0)
-      out = "journal:" + std::string(h.begin(), h.end());
+  if (::fstat(jfd, &st) == 0) {
+    const std::uint64_t size = static_cast<std::uint64_t>(st.st_size);
+    std::vector<unsigned char> h(std::min<std::uint64_t>(size, kHeadSize));
+    std::vector<unsigned char> t(size > kHeadSize ? std::min<std::uint64_t>(size - kHeadSize, kTailSize) : 0);
+    if (read_all(jfd, h.data(), h.size(), 0) && read_all(jfd, t.data(), t.size(), size - t.size()))
+      out += std::string(h.begin(), h.end()) + ":" + std::to_string(size) + ":" + std::string(t.begin(), t.end());
   }
   ::close(jfd);
-  return out;  // empty: a commit is in progress
+  return out;
 }
 
 bool journal_has_pending_commit(const std::string& results_path) {
-  int jfd = ::open(journal_path(results_path).c_str(), O_RDONLY | O_CLOEXEC);
-  if (jfd < 0) return false;
-  struct stat st{};
-  bool pending = false;
-  if (::stat(results_path.c_str(), &st) == 0) {
-    Parsed p = parse_journal(jfd, static_cast<std::uint64_t>(st.st_dev), static_cast<std::uint64_t>(st.st_ino));
-    pending = p.commit_ok;
-  }
-  ::close(jfd);
-  return pending;
+  return read_view(results_path).kind != ReadView::plain;
 }
 
 }  // namespace ks::store::detail

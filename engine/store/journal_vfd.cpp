@@ -7,8 +7,9 @@
 // of every H5Fflush/H5Fclose) writes the overlay pages plus a checksummed trailer to the journal,
 // then applies them to the file, then resets the journal. A kill before the trailer is complete
 // leaves the file untouched below `committed` (recovery just truncates the appended bytes); a kill
-// after it is replayed by recover() (idempotent). The journal's layout, recovery and the readers'
-// consistency stamp: journal_format.cpp.
+// after it is replayed by the next writer's open (idempotent) once it has checked that the journal
+// belongs to the file as it is. The journal's layout, recovery and the readers' consistency stamp:
+// journal_format.cpp; the writer lock: journal_lock.cpp.
 #include "store/journal_vfd.hpp"
 
 #include <fcntl.h>
@@ -44,6 +45,7 @@ struct JFile {
   std::uint64_t seq = 0, session = 0;  // commits in this session; random id of this writer session
   bool durable = false;
   bool poisoned = false;        // an I/O error happened: never commit again (the journal stays)
+  bool readonly = false;        // a reader's overlay of an unapplied commit (open_overlay): no journal
   std::string path;
   std::map<std::uint64_t, std::vector<unsigned char>> pages;  // page number -> kPage bytes
   // Test hook (crash-safety tests only): KS_STORE_TEST_CRASH="<n>:<phase>" makes the process
@@ -58,6 +60,7 @@ void maybe_crash(JFile* f, const char* phase) {
 
 struct JFapl {
   int durable;
+  int readonly;  // open_overlay()
 };
 
 std::vector<unsigned char>* page_for(JFile* f, std::uint64_t pno) {
@@ -72,6 +75,7 @@ void* j_fapl_get(H5FD_t* file) {
   auto* f = reinterpret_cast<JFile*>(file);
   auto* fa = static_cast<JFapl*>(std::malloc(sizeof(JFapl)));
   fa->durable = f->durable ? 1 : 0;
+  fa->readonly = f->readonly ? 1 : 0;
   return fa;
 }
 void* j_fapl_copy(const void* old) {
@@ -81,17 +85,57 @@ void* j_fapl_copy(const void* old) {
 }
 herr_t j_fapl_free(void* fa) { std::free(fa); return 0; }
 
-H5FD_t* j_open(const char* name, unsigned flags, hid_t fapl, haddr_t /*maxaddr*/) {
-  if (!(flags & H5F_ACC_RDWR) || (flags & (H5F_ACC_TRUNC | H5F_ACC_CREAT))) {
-    set_error("ksjournal driver opens existing files for writing only", 0);
+/// Read-only open of a file whose stopped writer left a complete, unapplied commit in the journal:
+/// the commit's pages become the overlay, the commit's new size the committed size. Nothing is
+/// written; the journal is read once and closed.
+H5FD_t* open_overlay(JFile* f) {
+  f->readonly = true;
+  f->fd = ::open(f->path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (f->fd < 0) { set_error("cannot open " + f->path, errno); return nullptr; }
+  const std::string jp = journal_path(f->path);
+  int jfd = ::open(jp.c_str(), O_RDONLY | O_CLOEXEC);
+  if (jfd < 0) { set_error("cannot open journal " + jp, errno); return nullptr; }
+  Parsed p = parse_journal(jfd);
+  ::close(jfd);
+  struct stat st{};
+  ::fstat(f->fd, &st);
+  f->dev = static_cast<std::uint64_t>(st.st_dev);
+  f->ino = static_cast<std::uint64_t>(st.st_ino);
+  if (!p.commit_ok || p.dev != f->dev || p.ino != f->ino) {
+    set_error("the journal " + jp + " holds no commit for this file any more", 0);
     return nullptr;
   }
-  bool durable = false;
-  if (const void* info = H5Pget_driver_info(fapl)) durable = static_cast<const JFapl*>(info)->durable != 0;
+  const std::string why = mismatch(p, f->fd);
+  if (!why.empty()) { set_error("the journal " + jp + " does not match the file: " + why, 0); return nullptr; }
+  f->eof = f->committed = p.new_size;
+  for (auto& [addr, bytes] : p.records) {
+    auto* pg = page_for(f, addr / kPage);
+    if (!pg || addr % kPage != 0) { set_error("cannot read " + f->path, errno); return nullptr; }
+    std::memcpy(pg->data(), bytes.data(), bytes.size());
+  }
+  return &f->pub;
+}
+
+H5FD_t* j_open(const char* name, unsigned flags, hid_t fapl, haddr_t /*maxaddr*/) {
+  bool durable = false, overlay = false;
+  if (const void* info = H5Pget_driver_info(fapl)) {
+    durable = static_cast<const JFapl*>(info)->durable != 0;
+    overlay = static_cast<const JFapl*>(info)->readonly != 0;
+  }
+  if ((flags & (H5F_ACC_TRUNC | H5F_ACC_CREAT)) || overlay == ((flags & H5F_ACC_RDWR) != 0)) {
+    set_error("ksjournal driver: writers open existing files read-write, readers read-only", 0);
+    return nullptr;
+  }
   auto* f = new JFile();
   std::memset(&f->pub, 0, sizeof(H5FD_t));
   f->path = name;
   f->durable = durable;
+  if (overlay) {
+    if (H5FD_t* h = open_overlay(f)) return h;
+    if (f->fd >= 0) ::close(f->fd);
+    delete f;
+    return nullptr;
+  }
   if (const char* c = std::getenv("KS_STORE_TEST_CRASH")) {
     std::string spec(c);
     auto colon = spec.find(':');
@@ -102,36 +146,39 @@ H5FD_t* j_open(const char* name, unsigned flags, hid_t fapl, haddr_t /*maxaddr*/
   }
   f->fd = ::open(name, O_RDWR | O_CLOEXEC);
   if (f->fd < 0) { set_error("cannot open " + f->path + " for writing", errno); delete f; return nullptr; }
-  const std::string jp = journal_path(name);
-  f->jfd = ::open(jp.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (f->jfd < 0) {
-    set_error("cannot create journal " + jp, errno);
-    ::close(f->fd); delete f; return nullptr;
-  }
-  int tries = 0;  // a reader may hold the lock for a moment while it checks the journal
-  while (::flock(f->jfd, LOCK_EX | LOCK_NB) != 0 && ++tries < 20) ::usleep(50000);
-  if (tries >= 20) {
-    set_error("results file is being written by another process (journal " + jp + " is locked)", 0);
-    ::close(f->jfd); ::close(f->fd); delete f; return nullptr;
-  }
   struct stat st{};
   ::fstat(f->fd, &st);
   f->dev = static_cast<std::uint64_t>(st.st_dev);
   f->ino = static_cast<std::uint64_t>(st.st_ino);
-  bool replayed = false;
-  if (!recover_locked(f->fd, f->jfd, f->dev, f->ino, &replayed)) {
-    set_error("cannot recover " + f->path + " from its journal", errno);
-    ::close(f->jfd); ::close(f->fd); delete f; return nullptr;
-  }
-  ::fstat(f->fd, &st);
-  f->eof = f->committed = static_cast<std::uint64_t>(st.st_size);
   f->session = (static_cast<std::uint64_t>(std::random_device{}()) << 32) ^ std::random_device{}() ^
                static_cast<std::uint64_t>(::getpid());
-  if ((durable && ::fsync(f->fd) != 0) || !reset_journal(f->jfd, f->dev, f->ino, f->committed, 0, f->session) ||
+  pause_point("data_opened");
+  const std::string jp = journal_path(name);
+  // The lock first: a new journal becomes visible already locked, with a header describing the
+  // file as it is (no journal: the file is at a committed state).
+  f->jfd = acquire_lock(jp, [&](int jfd) {
+    struct stat now{};
+    return ::fstat(f->fd, &now) == 0 &&
+           reset_journal(jfd, f->fd, f->dev, f->ino, static_cast<std::uint64_t>(now.st_size), 0, f->session);
+  });
+  if (f->jfd < 0) { ::close(f->fd); delete f; return nullptr; }
+  std::string why;
+  if (!recover_locked(f->fd, f->jfd, f->dev, f->ino, &why)) {
+    if (why.empty()) set_error("cannot recover " + f->path + " from its journal", errno);
+    else set_error(f->path + " does not match its journal " + jp + " (" + why + "): the file was changed after "
+                   "its writer stopped; nothing was written (delete the journal to use the file as it is)", 0);
+    ::close(f->jfd); ::close(f->fd); delete f; return nullptr;
+  }
+  pause_point("recovered");
+  ::fstat(f->fd, &st);
+  f->eof = f->committed = static_cast<std::uint64_t>(st.st_size);
+  if ((durable && ::fsync(f->fd) != 0) ||
+      !reset_journal(f->jfd, f->fd, f->dev, f->ino, f->committed, 0, f->session) ||
       (durable && ::fsync(f->jfd) != 0)) {
     set_error("cannot write journal " + jp, errno);
     ::close(f->jfd); ::close(f->fd); delete f; return nullptr;
   }
+  pause_point("ready");
   return &f->pub;
 }
 
@@ -182,7 +229,7 @@ bool commit_impl(JFile* f) {
     if (!write_all(f->fd, pg.data(), len, addr)) return false;
   }
   if (f->durable && ::fdatasync(f->fd) != 0) return false;
-  if (!reset_journal(f->jfd, f->dev, f->ino, new_size, f->seq + 1, f->session)) return false;
+  if (!reset_journal(f->jfd, f->fd, f->dev, f->ino, new_size, f->seq + 1, f->session)) return false;
   ++f->seq;
   f->committed = new_size;
   f->eof = new_size;
@@ -199,8 +246,13 @@ bool commit(JFile* f) {
 herr_t j_close(H5FD_t* file) {
   auto* f = reinterpret_cast<JFile*>(file);
   herr_t rc = 0;
+  if (f->readonly) {
+    ::close(f->fd);
+    delete f;
+    return 0;
+  }
   if (!commit(f)) { set_error("commit failed on close of " + f->path, errno); rc = -1; }
-  if (rc == 0) ::unlink(journal_path(f->path).c_str());  // clean close: nothing to recover
+  if (rc == 0) ::unlink(journal_path(f->path).c_str());  // clean close, still locked: nothing to recover
   ::close(f->fd);
   ::close(f->jfd);  // releases the lock
   delete f;
@@ -247,6 +299,7 @@ herr_t j_read(H5FD_t* file, H5FD_mem_t, hid_t, haddr_t addr, size_t size, void* 
 
 herr_t j_write(H5FD_t* file, H5FD_mem_t, hid_t, haddr_t addr, size_t size, const void* buffer) {
   auto* f = reinterpret_cast<JFile*>(file);
+  if (f->readonly) { set_error("write to " + f->path + " opened read-only", 0); return -1; }
   auto* in = static_cast<const unsigned char*>(buffer);
   std::uint64_t a = addr;
   while (size > 0) {
@@ -271,12 +324,14 @@ herr_t j_write(H5FD_t* file, H5FD_mem_t, hid_t, haddr_t addr, size_t size, const
 
 herr_t j_flush(H5FD_t* file, hid_t, hbool_t) {
   auto* f = reinterpret_cast<JFile*>(file);
+  if (f->readonly) return 0;
   if (!commit(f)) { set_error("commit of " + f->path + " failed", errno); return -1; }
   return 0;
 }
 
 herr_t j_truncate(H5FD_t* file, hid_t, hbool_t) {
   auto* f = reinterpret_cast<JFile*>(file);
+  if (f->readonly) return 0;
   // Grow to the EOA when needed; never shrink below the committed size (committed readers need it).
   const std::uint64_t want = std::max<std::uint64_t>(f->eoa, f->committed);
   if (want > f->eof) {
@@ -335,7 +390,14 @@ hid_t journal_driver_id() {
 
 hid_t make_journal_fapl(bool durable) {
   hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
-  JFapl fa{durable ? 1 : 0};
+  JFapl fa{durable ? 1 : 0, 0};
+  H5Pset_driver(fapl, journal_driver_id(), &fa);
+  return fapl;
+}
+
+hid_t make_journal_read_fapl() {
+  hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+  JFapl fa{0, 1};
   H5Pset_driver(fapl, journal_driver_id(), &fa);
   return fapl;
 }

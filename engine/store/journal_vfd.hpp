@@ -1,7 +1,9 @@
 #pragma once
 // Internal to the store: an HDF5 virtual file driver ("ksjournal") that makes every H5Fflush an
 // atomic commit of the file, so that a kill -9 at any moment leaves the last committed state.
-// See FORMAT.md, "Crash safety". Only the writer thread uses it; only store/*.cpp include it.
+// See FORMAT.md, "Crash safety". Writers open with make_journal_fapl() (and recover a crashed
+// writer's file first); readers use make_journal_read_fapl() only for a commit left unapplied.
+// Only store/*.cpp include it.
 #include <hdf5.h>
 
 #include <cstdint>
@@ -9,7 +11,7 @@
 
 namespace ks::store::detail {
 
-/// The driver id (registered on first use). Files opened with it must already exist (H5Fopen RDWR).
+/// The driver id (registered on first use). Files opened with it must already exist.
 hid_t journal_driver_id();
 /// A file-access property list using the driver; `durable` adds fsync()s around each commit
 /// (needed only against power loss, not against a killed process).
@@ -18,26 +20,32 @@ hid_t make_journal_fapl(bool durable);
 /// Path of the journal file that belongs to `results_path`.
 std::string journal_path(const std::string& results_path);
 
-enum class RecoverOutcome {
-  no_journal,        ///< nothing to do
-  writer_alive,      ///< another process holds the journal lock: a live writer; nothing touched
-  clean,             ///< journal present but had nothing to replay (stale or uncommitted epoch discarded)
-  replayed,          ///< a committed-but-unapplied journal was replayed into the file
-  not_permitted,     ///< the data file or journal could not be opened for writing
-};
-/// Bring a results file to its last committed state after a crash (kill -9 of a writer):
-/// replays a committed journal, or drops bytes appended after the last commit. Safe to call at any
-/// time; it does nothing while a writer is alive. Removes the journal when done.
-RecoverOutcome recover(const std::string& results_path);
+/// A file-access property list for reading the committed state of a file whose stopped writer left
+/// a complete commit in the journal, not yet applied (see read_view()): the driver serves the
+/// journal's pages over the file's bytes, in memory. It opens read-only and writes nothing, neither
+/// to the file nor to the journal.
+hid_t make_journal_read_fapl();
 
-/// True when the journal holds a complete, not-yet-applied commit (the only state in which the
-/// results file itself must not be read without recover() first). Test/diagnostic helper.
+/// How a reader opens a results file. Readers never lock, replay, truncate or delete anything.
+struct ReadView {
+  enum Kind {
+    plain,    ///< no journal, or no commit waiting in it: the file's own bytes are its committed state
+    overlay,  ///< a complete commit waits in the journal and belongs to this file: make_journal_read_fapl()
+    refuse,   ///< a complete commit waits in a journal that does not match the file as it is now (why)
+  } kind = plain;
+  std::string why;
+};
+ReadView read_view(const std::string& results_path);
+
+/// True when the journal holds a complete commit for this file, not yet applied (read_view() is not
+/// plain): the file must then not be read as it is on disk.
 bool journal_has_pending_commit(const std::string& results_path);
 
-/// A token that changes whenever the committed state of the file may have changed: the journal
-/// header (which carries a commit sequence number and a writer-session id) while a writer lives,
-/// else the file's size and mtime. Empty while a commit is being applied. Two equal, non-empty
-/// stamps taken before and after a read mean the read saw one committed state.
+/// A token that changes whenever the committed state of the file may have changed: while a journal
+/// exists, its header (commit sequence, writer-session id), its size and its last bytes (records
+/// being written or applied change them); else the file's size and mtime. Empty when the file does
+/// not exist. Two equal, non-empty stamps taken before and after a read mean the read saw one
+/// committed state.
 std::string consistency_stamp(const std::string& results_path);
 
 /// Last error text from the driver (open failures), for StoreError messages.

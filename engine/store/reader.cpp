@@ -111,17 +111,27 @@ void ResultsReader::refresh() {
   if (::access(path.c_str(), F_OK) != 0) throw StoreError(path, "no such file");
   if (H5Fis_hdf5(path.c_str()) == 0)  // a readable file that is no HDF5 file at all (a study file, ...)
     throw StoreError(path, "not an HDF5 file (expected a kinesweep results file, as written by kinesweep run)");
-  // After a crashed writer, bring the file to its last committed state (no-op while a writer lives).
-  recover(path);
+  // Never writes: no lock, no replay, no truncation, no deletion (FORMAT.md, "Crash safety").
   // Open between two commits of a live writer: the same consistency stamp before and after.
   std::string last;
   for (int attempt = 0; attempt < 100; ++attempt) {
     if (attempt) ::usleep(attempt < 10 ? 2000 : 20000);
     const std::string before = consistency_stamp(path);
-    if (before.empty() && attempt < 99) continue;  // a commit is being applied
-    Hid fapl(H5Pcreate(H5P_FILE_ACCESS));
+    if (before.empty()) { last = "no such file"; continue; }
+    const ReadView view = read_view(path);
+    if (view.kind == ReadView::refuse) {
+      last = "its journal " + journal_path(path) + " holds a commit that does not match the file (" + view.why +
+             "): the file was changed after its writer stopped; delete the journal to read the file as it is";
+      if (consistency_stamp(path) == before) throw StoreError(path, "not read: " + last);
+      continue;  // a live writer moved on meanwhile
+    }
+    Hid fapl(view.kind == ReadView::overlay ? make_journal_read_fapl() : H5Pcreate(H5P_FILE_ACCESS));
     hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl);
-    if (f < 0) { last = h5_error_text(); continue; }
+    if (f < 0) {
+      last = h5_error_text();
+      if (view.kind == ReadView::overlay && !journal_last_error().empty()) last = journal_last_error();
+      continue;
+    }
     impl_->file = Hid(f);
     try {
       impl_->columns.clear();
@@ -136,6 +146,7 @@ void ResultsReader::refresh() {
       continue;
     }
     impl_->stamp = before;
+    // On the last try the open is kept anyway: unchanged_since_open() then tells the caller.
     if (consistency_stamp(path) == before || attempt == 99) return;
     impl_->file.reset();  // a commit happened meanwhile: open again
   }

@@ -153,7 +153,8 @@ class ResultsWriter {
                                                const StoreOptions& options = {});
 
   struct Resumed;
-  /// Reopen an existing file to fill its missing runs (recovering it first after a crash). Refuses
+  /// Reopen an existing file to fill its missing runs (recovering it first after a crash, when its
+  /// journal matches the file as it is; otherwise refusing with the file untouched). Refuses
   /// with StoreError when the file's study_sha256 differs from `expected_sha256`, or when its
   /// format_version is not kFormatVersion (checked read-only: a refused file is left untouched).
   static Resumed open_for_resume(const std::string& path, const std::string& expected_sha256,
@@ -196,7 +197,9 @@ struct ResultsWriter::Resumed {
 // ------------------------------------------------------------------------------------------------
 /// Read access (kinesweep info/query, tests). Works on a file that is being written: it sees the
 /// last committed state at open time (re-open to see newer runs; read the done mask before the
-/// columns). Opening a crashed file first recovers it (when the directory is writable).
+/// columns). A reader never modifies the file or its journal: after a crash it reads the last
+/// committed state as the writer left it (a commit the writer had not finished applying is read
+/// from the journal), and refuses, saying why, a journal that does not match the file (FORMAT.md).
 class ResultsReader {
  public:
   /// Fills `role` and `kinds` of the /runs columns of a format_version 1 file, which stores neither.

@@ -16,6 +16,7 @@
 #include <set>
 
 #include "store/h5util.hpp"
+#include "store/journal_format.hpp"
 #include "store/journal_vfd.hpp"
 #include "store/store.hpp"
 #include "store/writer_impl.hpp"
@@ -76,14 +77,6 @@ hid_t file_type_of(CellType t) {
     case CellType::i64: return H5Tcopy(H5T_STD_I64LE);
     default: return utf8_vlen_type();
   }
-}
-
-bool journal_locked_by_other(const std::string& jp) {
-  int fd = ::open(jp.c_str(), O_RDWR | O_CLOEXEC);
-  if (fd < 0) return false;
-  bool locked = ::flock(fd, LOCK_EX | LOCK_NB) != 0;
-  ::close(fd);
-  return locked;
 }
 
 void fsync_path(const std::string& p, bool dir) {
@@ -218,9 +211,18 @@ std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, co
     }
     if (H5Fclose(f.release()) < 0) throw StoreError(path, "cannot write " + tmp + ": " + h5_error_text());
     if (options.durable) fsync_path(tmp, false);  // against power loss only: a killed process loses nothing
+    if (!options.overwrite && ::stat(path.c_str(), &st) == 0)
+      throw StoreError(path, "file exists (pass overwrite to replace it)");
+    // The writer lock, held while the new file is put into place: the journal of a file we replace
+    // (or an orphan) must never touch the new file, and only the lock's holder deletes a journal.
     const std::string jp = journal_path(path);
-    if (journal_locked_by_other(jp)) throw StoreError(path, "results file is being written by another process");
-    ::unlink(jp.c_str());  // a journal of a file we replace (or an orphan) must never touch the new file
+    const int lock = journal::acquire_lock(jp, [](int) { return true; });
+    if (lock < 0) throw StoreError(path, journal_last_error());
+    struct Unlock {
+      int fd;
+      ~Unlock() { ::close(fd); }
+    } unlock{lock};
+    ::unlink(jp.c_str());
     if (options.overwrite) {
       if (::rename(tmp.c_str(), path.c_str()) != 0)
         throw StoreError(path, std::string("cannot rename temporary file into place: ") + std::strerror(errno));
