@@ -34,10 +34,10 @@ void put64(unsigned char* p, std::uint64_t v);
 std::uint64_t get64(const unsigned char* p);
 
 /// What identifies a committed state of the results file: its size and the CRC-32 of its first
-/// page [0, min(4096, size)) and of its last page [4096*floor((size-1)/4096), size). Every commit
-/// rewrites the superblock (page 0: end-of-file address, root object) and every change of size
-/// moves the last page, so a file changed by another program after its writer stopped (appended to,
-/// rewritten in place, a copy put over it) no longer matches.
+/// page [0, min(4096, size)) and of its last page [4096*floor((size-1)/4096), size). Page 0 holds
+/// the superblock (its end-of-file address changes whenever the file grows) and the root group's
+/// object header, and a change of size moves the last page, so a file changed by another program
+/// after its writer stopped (appended to, a copy put over it, page 0 rewritten) no longer matches.
 struct Fingerprint {
   std::uint64_t size = 0;
   std::uint32_t crc_first = 0, crc_last = 0;

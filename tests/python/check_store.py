@@ -170,7 +170,7 @@ def stamp(path):
     except FileNotFoundError:
         st = os.stat(path)
         return ("static", st.st_size, st.st_mtime_ns)
-    if len(head) != 48 or head[:8] != b"KSJRNL01":
+    if (head[:8], len(head)) not in ((b"KSJRNL02", 56), (b"KSJRNL01", 48)):
         return None
     return ("journal", head)
 
@@ -243,8 +243,8 @@ def killed_writer_file(helper, work, iterations=8):
                 j = fh.read()
         except FileNotFoundError:
             j = b""
-        if len(j) > 48 and j[-32:-24] == b"KSJCMT01":
-            pending += 1  # died between journal commit and apply: readers run recovery first (FORMAT.md)
+        if len(j) > 56 and j[-32:-24] == b"KSJCMT01":
+            pending += 1  # died between journal commit and apply: a writer (--resume) applies it first (FORMAT.md)
             continue
         with h5py.File(path, "r") as f:
             done = check_table(f, 600, False)
