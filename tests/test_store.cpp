@@ -493,6 +493,12 @@ TEST(StoreCrash, SigkillAtRandomMomentsThenResume) {
     pid_t pid = spawn_helper({path, std::to_string(n), "--delay-us", std::to_string(delay_us), "--flush-every",
                               std::to_string(flush_every), "--landscape"});
     const int max_us = it % 6 == 0 ? 6000 : 150000;  // right after a fresh start: aim at the creation
+    if (it % 6 != 0)  // otherwise aim at a writer that has its file (wait on its progress, however slow)
+      while (!fs::exists(path)) {
+        siginfo_t si{};  // (WNOWAIT: an exited writer stays to be reaped below)
+        if (waitid(P_PID, static_cast<id_t>(pid), &si, WEXITED | WNOHANG | WNOWAIT) != 0 || si.si_pid != 0) break;
+        std::this_thread::yield();
+      }
     std::this_thread::sleep_for(std::chrono::microseconds(std::uniform_int_distribution<int>(500, max_us)(rng)));
     kill(pid, SIGKILL);
     int st = 0;

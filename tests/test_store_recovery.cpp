@@ -153,9 +153,8 @@ TEST(StoreLock, AReaderAndASecondWriterAtEveryStepOfAWritersOpen) {
     for (auto& s : c.a_holds) steps.emplace_back(s, true);
     for (auto& s : c.b_wins) steps.emplace_back(s, false);
     for (auto& [step, a_holds] : steps) {
-      const std::string tag = (c.crash.empty() ? std::string("clean") : c.crash.substr(2)) + "/" + step;
-      const std::string path = td.file(c.crash.substr(0, 1) + c.crash.substr(2) + step + ".h5"),
-                        jp = path + ".journal";
+      const std::string how = c.crash.empty() ? std::string("clean") : c.crash.substr(2), tag = how + "/" + step;
+      const std::string path = td.file(how + "_" + step + ".h5"), jp = path + ".journal";
       make_file(path, c.crash);
       const std::int64_t done_before = done_runs_checked(path);
       Helper a(path, path + ".a.err", {{"KS_STORE_TEST_PAUSE", step}});
@@ -303,7 +302,9 @@ TEST(StoreRecovery, ReadersChangeNoByteOfACrashedFile) {
   // was not applied yet); the next writer then applies it and finishes.
   TempDir td;
   int checked = 0;
+  std::int64_t most = 0;
   for (int commit : {2, 5, 9}) {
+    std::int64_t done_half = -1;
     for (const std::string phase : {"journal_half", "journal_done", "apply_half"}) {
       const std::string path = td.file(phase + std::to_string(commit) + ".h5"), jp = path + ".journal";
       make_file(path, std::to_string(commit) + ":" + phase);
@@ -311,7 +312,9 @@ TEST(StoreRecovery, ReadersChangeNoByteOfACrashedFile) {
       const std::int64_t done = done_runs_checked(path);
       EXPECT_EQ(snap(path), file0) << phase << commit;
       EXPECT_EQ(snap(jp), journal0) << phase << commit;
-      EXPECT_GT(done, 0) << phase << commit;
+      if (phase == "journal_half") done_half = done;
+      else EXPECT_GE(done, done_half) << phase << commit << ": a commit complete in the journal is seen";
+      most = std::max(most, done);
       Helper w(path, path + ".w.err", {});
       int code = 0;
       ASSERT_FALSE(w.wait_stop_or_exit(&code));
@@ -321,7 +324,9 @@ TEST(StoreRecovery, ReadersChangeNoByteOfACrashedFile) {
       ++checked;
     }
   }
-  std::cout << "[ read-only ] " << checked << " crashed files read with no byte changed" << std::endl;
+  EXPECT_GT(most, 0);
+  std::cout << "[ read-only ] " << checked << " crashed files read with no byte changed (up to " << most
+            << " done runs)" << std::endl;
 }
 
 }  // namespace
