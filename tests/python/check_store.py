@@ -233,9 +233,7 @@ def killed_writer_file(helper, work, iterations=8):
         path = os.path.join(work, f"killed{it}.h5")
         proc = subprocess.Popen([helper, path, "600", "--delay-us", "200", "--flush-every", str(rng.choice([1, 4, 16]))],
                                 stdout=subprocess.DEVNULL)
-        while not os.path.exists(path) and proc.poll() is None:  # progress first: the file exists
-            time.sleep(0.005)
-        time.sleep(rng.uniform(0.0, 0.2))
+        time.sleep(rng.uniform(0.03, 0.2))
         proc.send_signal(signal.SIGKILL)
         proc.wait()
         if not os.path.exists(path):
