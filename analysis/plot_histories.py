@@ -32,7 +32,7 @@ def parse_args(argv=None):
 def main(argv=None):
     args = parse_args(argv)
     res = ksread.open_results(args.file)
-    runs = res.runs(columns=["run_id", "block", "status"] + (["preset"] if "preset" in res.columns() else []))
+    runs = res.runs(degrees=True)
     ids = []
     if args.runs:
         ids += [int(x) for x in args.runs.split(",") if x.strip()]
@@ -64,10 +64,18 @@ def main(argv=None):
             raise SystemExit(f"run {r} is not a trajectory run (no time array)")
     label = {}
     rid = list(runs["run_id"])
+    rows = [rid.index(r) for r in ids if r in rid]
+    # The parameters that tell the plotted runs apart (angles in degrees, as read).
+    differ = [c for c in res.parameters("trajectory") if c in runs and c != "preset"
+              and len({str(runs[c][i]) for i in rows}) > 1]
     for r in ids:
         i = rid.index(r) if r in rid else None
         pre = runs["preset"][i] if (i is not None and "preset" in runs and runs["preset"][i]) else ""
-        label[r] = f"run {r}" + (f" (case {pre})" if pre else f" ({runs['block'][i]})" if i is not None else "")
+        what = [f"case {pre}"] if pre else [runs["block"][i]] if i is not None else []
+        if i is not None and not pre:
+            what += [f"{c} = {ksplot.fmt_num(runs[c][i]) if isinstance(runs[c][i], float) else runs[c][i]}"
+                     f"{'°' if runs.units.get(c) == 'deg' else ''}" for c in differ]
+        label[r] = f"run {r}" + (f" ({', '.join(what)})" if what else "")
 
     plt, size = ksplot.figure(args)
     ncols = max(hist[ids[0]][w].shape[1] for w in whats)
@@ -92,7 +100,8 @@ def main(argv=None):
         ax.set_xlabel("t [s]")
     axes[0][0].legend(fontsize=7)
     title = args.title or (f"{', '.join(NAMES.get(w, w) for w in whats)} against time, "
-                           f"{'; '.join(label[r] for r in ids)}\n{os.path.basename(args.file)}")
+                           f"{'runs ' + ', '.join(map(str, ids)) if differ else '; '.join(label[r] for r in ids)}"
+                           f"\n{os.path.basename(args.file)}")
     fig.suptitle(title, fontsize=10)
     return ksplot.finish(fig, args, "histories", {"file": args.file, "runs": data})
 

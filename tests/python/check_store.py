@@ -233,7 +233,12 @@ def killed_writer_file(helper, work, iterations=8):
         path = os.path.join(work, f"killed{it}.h5")
         proc = subprocess.Popen([helper, path, "600", "--delay-us", "200", "--flush-every", str(rng.choice([1, 4, 16]))],
                                 stdout=subprocess.DEVNULL)
-        time.sleep(rng.uniform(0.03, 0.2))
+        # The random moment counts from the file's appearance (its creation is renamed into place), so a
+        # loaded machine that starts the writer late still kills it while it writes.
+        deadline = time.monotonic() + 30
+        while not os.path.exists(path) and proc.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.002)
+        time.sleep(rng.uniform(0.0, 0.17))
         proc.send_signal(signal.SIGKILL)
         proc.wait()
         if not os.path.exists(path):

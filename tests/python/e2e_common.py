@@ -1,6 +1,7 @@
 """What the end-to-end tests share: the small studies they run and how they compare results files.
 Run with Debian's /usr/bin/python3 (h5py, numpy)."""
 import os
+import subprocess
 import shutil
 import tempfile
 import unittest
@@ -88,6 +89,18 @@ def make_v1(src, dst):
             for a in ("role", "kinds"):
                 del f["runs"][k].attrs[a]
         f.attrs.modify("format_version", np.int64(1))
+
+
+def run_study_text(ks, directory, name, text, *args):
+    """Write `text` as DIRECTORY/NAME.toml, run it into DIRECTORY/NAME.h5 (extra `args` to `kinesweep
+    run`) and return the results file's path; AssertionError with kinesweep's stderr when it fails."""
+    study = os.path.join(directory, name + ".toml")
+    with open(study, "w") as f:
+        f.write(text)
+    out = os.path.join(directory, name + ".h5")
+    r = subprocess.run([ks, "run", study, "-o", out, "--overwrite", "-q", *args], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    return out
 
 
 class TempDirTest(unittest.TestCase):

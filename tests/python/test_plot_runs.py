@@ -18,6 +18,8 @@ import unittest
 import h5py
 import numpy as np
 
+from e2e_common import run_study_text
+
 KS = None
 ROOT = None
 D = 180.0 / math.pi
@@ -214,13 +216,7 @@ class PlotRunsTest(unittest.TestCase):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.files = {}
         for name, text in (("random", RANDOM), ("lhs", LHS), ("ik", IK)):
-            study = os.path.join(cls.tmp.name, name + ".toml")
-            with open(study, "w") as f:
-                f.write(text)
-            out = os.path.join(cls.tmp.name, name + ".h5")
-            r = subprocess.run([KS, "run", study, "-o", out, "--overwrite", "-q"], capture_output=True, text=True)
-            assert r.returncode == 0, r.stderr
-            cls.files[name] = out
+            cls.files[name] = run_study_text(KS, cls.tmp.name, name, text)
         # An interrupted sweep: every third row of block zeta not done (FORMAT.md: done = 0 rows are not
         # results, whatever they hold).
         cls.files["partial"] = os.path.join(cls.tmp.name, "partial.h5")

@@ -7,7 +7,6 @@ usage: /usr/bin/python3 test_query_group.py KINESWEEP_BINARY REPO_ROOT
 import csv
 import io
 import math
-import os
 import subprocess
 import sys
 import tempfile
@@ -16,7 +15,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import OPTIMIZE as OPTIMIZE_COMMON
+from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, run_study_text
 
 KS = None
 D = 180.0 / math.pi
@@ -64,12 +63,7 @@ class GroupAndOr(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
-        study = os.path.join(cls.tmp.name, "g.toml")
-        with open(study, "w") as f:
-            f.write(STUDY)
-        cls.h5 = os.path.join(cls.tmp.name, "g.h5")
-        r = ks("run", study, "-o", cls.h5, "-q")
-        assert r.returncode == 0, r.stderr
+        cls.h5 = run_study_text(KS, cls.tmp.name, "g", STUDY)
         with h5py.File(cls.h5, "r") as f:
             g = f["runs"]
             cls.t = {k: (np.array([s(x) for x in g[k][()]], dtype=object) if g[k].dtype.kind == "O" else g[k][()])
@@ -160,12 +154,7 @@ class OptimizationWhere(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
-        study = os.path.join(cls.tmp.name, "o.toml")
-        with open(study, "w") as f:
-            f.write(OPTIMIZE)
-        cls.h5 = os.path.join(cls.tmp.name, "o.h5")
-        r = ks("run", study, "-o", cls.h5, "-q")
-        assert r.returncode == 0, r.stderr
+        cls.h5 = run_study_text(KS, cls.tmp.name, "o", OPTIMIZE)
         with h5py.File(cls.h5, "r") as f:
             e = f["optimizations"]["h1"]["evaluations"]
             cls.x, cls.obj = e["x"][()], e["objective"][()]

@@ -20,7 +20,7 @@ from html.parser import HTMLParser
 import h5py
 import numpy as np
 
-from e2e_common import OPTIMIZE
+from e2e_common import OPTIMIZE, run_study_text
 
 KS = None
 ROOT = None
@@ -163,13 +163,7 @@ class ReportTest(unittest.TestCase):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.h5, cls.html, cls.pages = {}, {}, {}
         for name, text in (("trajectory", TRAJECTORY), ("basins", BASINS), ("optimize", OPTIMIZE)):
-            study = os.path.join(cls.tmp.name, name + ".toml")
-            with open(study, "w") as f:
-                f.write(text)
-            out = os.path.join(cls.tmp.name, name + ".h5")
-            r = subprocess.run([KS, "run", study, "-o", out, "--overwrite", "-q"], capture_output=True, text=True)
-            assert r.returncode == 0, r.stderr
-            cls.h5[name] = out
+            out = cls.h5[name] = run_study_text(KS, cls.tmp.name, name, text)
             cls.html[name] = cls.report(out)
             with open(cls.html[name], encoding="utf-8") as f:
                 cls.pages[name] = Page(f.read())
