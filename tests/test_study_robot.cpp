@@ -212,3 +212,15 @@ TEST(StudyRobot, SpatialTaskNeedsThreeCoordinatesAndHoldsOrientation) {
                    kTraj,
                8, 15, "expected \"hold\"");
 }
+
+// Found by the study parser's fuzz target: a Table 4 preset optimised on a robot without the seed
+// arm's alpha1A (a URDF chain) read the block's column table out of range; it is a located error.
+TEST(StudyRobot, SeedPresetOptimisationNeedsTheSeedArmsParameters) {
+  const std::string text = "[robot]\nurdf = \"robots/arm7.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\n"
+                           "[task]\nvertices = [[0.5, 0, 0.6], [0.5, 0.2, 0.6], [0.5, 0.2, 0.8], [0.5, 0, 0.6]]\ndurations = [1, 1, 1]\n"
+                           "[[optimize]]\npreset = \"1h\"\n[optimize.local]\nalgorithm = \"LN_BOBYQA\"\nmax_evals = 10\n";
+  const StudyDiagnostic d = first_error(text, KS_SOURCE_DIR "/studies/found.toml");
+  EXPECT_EQ(d.line, 8) << d.str();
+  EXPECT_NE(d.message.find("preset '1h' optimises alpha1A"), std::string::npos) << d.str();
+  EXPECT_NE(d.message.find("expected variables"), std::string::npos) << d.str();
+}

@@ -343,7 +343,8 @@ int run_info(const InfoArgs& args) {
   } else {
     os << with << " of " << n_done << " done runs (run ids " << first << " .. " << last
        << "); kinesweep query FILE --run ID --history NAME\n";
-    for (auto& [kind, r] : example) {
+    for (auto& [kind, run] : example) {
+      const std::int64_t r = run;  // a plain variable: a lambda cannot capture a structured binding (C++17/20)
       const RunHistory h = consistent_read(reader, [&] { return reader.read_history(r); });
       os << "            " << kind << ": ";
       for (std::size_t i = 0; i < h.arrays.size(); ++i) {

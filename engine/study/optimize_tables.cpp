@@ -118,11 +118,20 @@ void Parser::parse_optimizations(const toml::table& root, Study& s) {
     if (!vn && seed_row && kind == BlockKind::trajectory) {
       // A seed row's own design variables (Table 4): k and/or alpha1A, or the five vertex alphas.
       const std::string_view p = ob.preset;
+      bool robot_lacks = false;  // a variable of the seed arm's row that the study's robot has no column for
       auto add = [&](const std::string& nm, double lo, double hi) {
         if (axis_names.count(nm)) return;
+        const std::size_t col = block->column_index(nm);
+        if (col == Block::npos) {
+          if (!robot_lacks)
+            error(bpos, label + ": preset '" + ob.preset + "' optimises " + nm + ", which the study's robot has no " +
+                            "parameter for (it is the seed's planar 3R's); expected variables = { ... }");
+          robot_lacks = true;
+          return;
+        }
         OptimizeVariable v;
         v.name = nm;
-        v.unit = block->columns()[block->column_index(nm)].unit;
+        v.unit = block->columns()[col].unit;
         v.lower = v.unit == "rad" ? lo * kDeg : lo;
         v.upper = v.unit == "rad" ? hi * kDeg : hi;
         ob.variables.push_back(std::move(v));
@@ -136,7 +145,7 @@ void Parser::parse_optimizations(const toml::table& root, Study& s) {
       } else if (p.size() == 2 && (p[1] == 'b' || p[1] == 'd' || p[1] == 'f')) {
         add("k", 0, 1);
       }
-      if (ob.variables.empty())
+      if (ob.variables.empty() && !robot_lacks)
         error(bpos, label + ": preset '" + ob.preset + "' is not an optimised row of Table 4; expected variables = { ... }");
     } else if (!vn) error(bpos, label + " has no variables; expected variables = { alpha1A = [-40, 40], k = [0, 1] } (or an optimised preset: 1b, 1d, 1f, 1g, 1h, 2b, 2d, 2f, 2g, 2h, 3, 4)");
     else if (!vt || vt->empty())
