@@ -70,6 +70,13 @@ OpenedResults open_results(const Study& study, const StudySchema& schema, const 
 
 namespace {
 
+/// A message on one line (HDF5's descriptions may hold line breaks).
+std::string one_line(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  return s;
+}
+
 class LocalBackend final : public SweepBackend {
  public:
   bool leader() const override { return true; }
@@ -79,6 +86,10 @@ class LocalBackend final : public SweepBackend {
     if (r.options.stop && r.options.stop->load()) {  // a signal during validation: nothing created
       err << "kinesweep run: interrupted before " << out << " was opened; nothing written\n";
       return 130;
+    }
+    if (fs::is_directory(out)) {
+      err << "kinesweep run: " << out << " is a directory; expected a results file path (NAME.h5)\n";
+      return 1;
     }
     const bool exists = fs::exists(out);
     if (const std::string why = refuse_existing(out, exists, "exists", r); !why.empty()) {
@@ -172,14 +183,8 @@ int run_study(const Study& study, const RunRequest& request, std::ostream& out, 
       SweepResult res = backend->sweep(study, schema, request, out, err);
       code = backend->leader() ? conclude(study, request, *backend, res, out) : res.code;
     }
-  } catch (const store::StoreError& e) {
-    err << "kinesweep run: " << e.what() << '\n';
-    code = 1;
-  } catch (const fs::filesystem_error& e) {
-    err << "kinesweep run: " << e.what() << '\n';
-    code = 1;
-  } catch (const std::exception& e) {  // anything else still ends every rank through finish()
-    err << "kinesweep run: " << e.what() << '\n';
+  } catch (const std::exception& e) {  // store, file system or anything else: every rank ends through finish()
+    err << "kinesweep run: " << one_line(e.what()) << '\n';
     code = 1;
   }
   return backend->finish(code);

@@ -221,6 +221,16 @@ class Paths(TempDirTest):
         self.assertEqual(r.returncode, 2, r.stderr)
         self.assertIn("is a directory; expected a study file (TOML), e.g. ", r.stderr)
 
+    def test_a_directory_as_the_output_is_refused_in_one_line(self):
+        study = self.write("s.toml", TRAJ)
+        os.mkdir(os.path.join(self.dir, "d.h5"))
+        for extra in ([], ["--resume"], ["--overwrite"]):
+            with self.subTest(extra=extra):
+                r = run("run", study, "-o", os.path.join(self.dir, "d.h5"), "-q", *extra)
+                self.assertEqual(r.returncode, 1, r.stderr)
+                self.assertEqual(len(r.stderr.strip().splitlines()), 1, r.stderr)
+                self.assertIn("is a directory", r.stderr)
+
     def test_control_characters_in_the_output_path_are_refused(self):
         study = self.write("s.toml", TRAJ)
         r = run("run", study, "-o", os.path.join(self.dir, "a\nb.h5"))
