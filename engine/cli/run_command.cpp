@@ -4,10 +4,10 @@
 
 #include <CLI/CLI.hpp>
 #include <atomic>
-#include <cstdlib>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <thread>
