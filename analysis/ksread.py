@@ -62,7 +62,7 @@ THESIS_OPTIMA = {
     "local_unweighted": {"global": "2h", "partial": ["2d", "2f", "2g"]},
 }
 
-TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged"]
+TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged", "undersampled"]
 IK_STATUSES = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution",
                "out_of_limits"]
 

@@ -42,7 +42,7 @@ std::pair<std::string, double> inside(const ParamDef& p, const Family& f) {
     return {"\"" + p.choices.back() + "\"", 0};
   }
   switch (p.domain.rule) {
-    case Domain::Rule::positive: return {"0.125", 0.125};
+    case Domain::Rule::positive: return {"0.03125", 0.03125};  // a dt that samples each 0.5 s segment 16 times
     case Domain::Rule::nonnegative: return {"0.25", 0.25};
     case Domain::Rule::at_least:
     case Domain::Rule::within: return {"7", 7.0};

@@ -8,6 +8,7 @@
 #include "cli/schema_command.hpp"
 #include "cli/table4.hpp"
 #include "common/shell_word.hpp"
+#include "store/store.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"kinesweep: parameter-sweep studies of redundant manipulators"};
@@ -25,6 +26,7 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
   }
+  ks::store::print_hdf5_error_stack(false);  // every command says a file's problem in one line (run: unless --verbose)
   if (table4->parsed()) {
     ks::print_table4(std::cout);
     return 0;

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <thread>
@@ -23,6 +24,37 @@ namespace ks::cli {
 namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void on_sigint(int) { g_stop.store(true); }
+
+/// SIGINT and SIGTERM set g_stop from here to the end of the command: the command then ends at its
+/// next stopping point (before the results file is created, between runs, between evaluations).
+struct StopOnSignals {
+  StopOnSignals() {
+    std::signal(SIGINT, on_sigint);
+    std::signal(SIGTERM, on_sigint);
+  }
+  ~StopOnSignals() {
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+  }
+};
+
+/// For tests of signal handling: with KINESWEEP_TEST_PAUSE_BEFORE_SWEEP set, announce "paused" on
+/// stderr and wait (up to 60 s) for g_stop once the study is validated, before anything is written.
+void test_pause_before_sweep() {
+  if (!std::getenv("KINESWEEP_TEST_PAUSE_BEFORE_SWEEP")) return;
+  std::cerr << "paused before the sweep (KINESWEEP_TEST_PAUSE_BEFORE_SWEEP)" << std::endl;
+  for (int i = 0; i < 6000 && !g_stop.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+}
+
+/// Why `path` cannot name a file ("" when it can): a NUL would cut it short, control characters
+/// are almost always a slip of a script.
+std::string path_chars_problem(const std::string& path) {
+  for (unsigned char c : path)
+    if (c < 0x20 || c == 0x7f)
+      return c == 0 ? "contains a NUL character; expected a path without control characters"
+                    : "contains a control character; expected a path without control characters";
+  return "";
+}
 
 /// "full", "none", "every=N" -> policy; false when malformed.
 bool parse_histories(const std::string& s, HistoryPolicy& p) {
@@ -104,14 +136,19 @@ RunArgs& add_run_command(CLI::App& app) {
   c->add_option("--histories", a.histories, "full | every=N | none (default: the study's)");
   c->add_option("--compression", a.compression, "deflate level of the histories, after HDF5's shuffle (default 1; 0: raw chunks, no filter)")
       ->check(CLI::Range(0, 9));
+  c->add_option("--max-runs", a.max_runs, "the most runs a study may ask for (default 50000000; a study's max_runs may only lower it)")
+      ->check(CLI::PositiveNumber);
   c->add_flag("-q,--quiet", a.quiet, "no progress display");
+  c->add_flag("--verbose", a.verbose, "with a results-file error, HDF5's own error stack too");
   return a;
 }
 
 int run_command(const RunArgs& a) {
+  const StopOnSignals signals;  // before anything is read or created
+  store::print_hdf5_error_stack(a.verbose);
   Study study;
   try {
-    study = load_study(a.study);
+    study = load_study(a.study, StudyOptions{a.max_runs});
   } catch (const StudyError& e) {
     std::cerr << e.what() << '\n';
     return 2;
@@ -126,13 +163,19 @@ int run_command(const RunArgs& a) {
     return 2;
   }
   const std::string output = a.output.empty() ? study.output : a.output;
-  if (const std::string why = output_name_problem(output); !why.empty()) {
+  std::string why = path_chars_problem(output);
+  if (why.empty()) why = output_name_problem(output);
+  if (!why.empty()) {
     std::cerr << "kinesweep run: " << (a.output.empty() ? "the study's output " : "-o ") << shell_word(output) << ": "
               << why << '\n';
     return 2;
   }
-  if (a.dry_run)
-    return dry_run(study, make_schema(study), {histories, a.threads, a.compression, output}, std::cout, std::cerr);
+  if (a.dry_run) {  // a few seconds at most; its temporary file is removed before it returns
+    const int code = dry_run(study, make_schema(study), {histories, a.threads, a.compression, output}, std::cout, std::cerr);
+    if (!g_stop.load()) return code;
+    std::cerr << "kinesweep run: --dry-run interrupted; nothing written\n";
+    return 130;
+  }
 
   RunRequest r;
   r.study_arg = a.study;
@@ -147,11 +190,16 @@ int run_command(const RunArgs& a) {
   r.options.stop = &g_stop;
   ProgressDisplay progress(a.quiet);
   r.options.on_progress = [&](const SweepProgress& p) { progress(p); };
-  std::signal(SIGINT, on_sigint);
-  std::signal(SIGTERM, on_sigint);
+  test_pause_before_sweep();
   const int code = run_study(study, r, std::cout, std::cerr);
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
+  if (code == 1) {
+    // A results-file failure (e.g. a full disk) can leave HDF5 1.10 holding a file whose close
+    // failed, and its at-exit shutdown then crashes closing it again. End here instead: the file is
+    // left as a killed process leaves it, and its journal restores the last commit at --resume.
+    std::cout.flush();
+    std::cerr.flush();
+    std::_Exit(1);
+  }
   return code;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // `kinesweep run STUDY.toml [-o FILE] [--threads N] [--resume] [--overwrite] [--dry-run]
-//  [--histories full|every=N|none] [--compression 0..9] [-q]`
+//  [--histories full|every=N|none] [--compression 0..9] [--max-runs N] [-q] [--verbose]`
+#include <cstdint>
 #include <string>
 
 namespace CLI {
@@ -17,6 +18,8 @@ struct RunArgs {
   std::string histories;   ///< empty: the study's policy
   bool quiet = false;      ///< no progress display
   int compression = 1;     ///< history deflate level (0: raw chunks, no filter)
+  std::uint64_t max_runs = 50'000'000;  ///< the run-count limit (a study's max_runs may only lower it)
+  bool verbose = false;    ///< HDF5's own error stack with a results-file error
   std::string program = "kinesweep";  ///< how the user invoked kinesweep (argv[0]), for printed commands
 };
 

@@ -12,10 +12,11 @@ constexpr NameTable<TrajectoryMethod, 3> kMethods{{{TrajectoryMethod::local_weig
                                                {TrajectoryMethod::vertex_alpha, "vertex_alpha"}}};
 constexpr NameTable<Integrator, 2> kIntegrators{
     {{Integrator::semi_implicit_euler, "semi_implicit_euler"}, {Integrator::rk4, "rk4"}}};
-constexpr NameTable<RunStatus, 4> kStatuses{{{RunStatus::ok, "ok"},
+constexpr NameTable<RunStatus, 5> kStatuses{{{RunStatus::ok, "ok"},
                                          {RunStatus::unreachable_start, "unreachable_start"},
                                          {RunStatus::singular, "singular"},
-                                         {RunStatus::diverged, "diverged"}}};
+                                         {RunStatus::diverged, "diverged"},
+                                         {RunStatus::undersampled, "undersampled"}}};
 
 }  // namespace
 

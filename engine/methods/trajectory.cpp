@@ -15,6 +15,22 @@
 
 namespace ks {
 
+bool samples_path(const std::vector<double>& durations, double dt) {
+  for (double d : durations)
+    if (!(d / dt >= kMinSamplesPerSegment * (1 - 1e-12))) return false;
+  return true;
+}
+
+TrajectoryMetrics not_simulated(RunStatus status, int joints) {
+  TrajectoryMetrics out;
+  out.status = status;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  out.E = out.E_M = out.min_manipulability = out.torque_sq_integral = out.power_sq_integral = nan;
+  out.max_tracking_error = out.final_alpha = nan;
+  out.tau_inf.setConstant(joints, nan);
+  return out;
+}
+
 void TrajectoryHistory::prepare(std::size_t samples) {
   const Eigen::Index n = static_cast<Eigen::Index>((samples + stride - 1) / stride + 1);
   if (t.size() < n) {

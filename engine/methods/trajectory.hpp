@@ -33,7 +33,9 @@ enum class RunStatus {
   unreachable_start,  ///< no real analytic IK at the first vertex for alpha1A: nothing simulated
   singular,           ///< the Jacobian became singular (see TrajectoryOptions::singular_tolerance)
   diverged,           ///< a non-finite value, or a torque above TrajectoryOptions::torque_bound
+  undersampled,       ///< dt leaves fewer than kMinSamplesPerSegment samples on a segment: nothing simulated
 };
+
 
 std::string_view to_string(TrajectoryMethod m);
 std::string_view to_string(Integrator i);
@@ -82,6 +84,15 @@ struct TrajectoryMetrics {
   double final_alpha = 0.0;           ///< alpha at the last sample [rad]
   double stop_time = 0.0;             ///< time of the last sample computed [s]
 };
+
+/// The fewest samples per path segment (segment duration / dt) a run needs to follow its path: with
+/// fewer, the quintic segments are sampled too coarsely to track them (and a dt above a segment's
+/// duration skips it), and the metrics would describe another motion.
+constexpr double kMinSamplesPerSegment = 10;
+/// True when dt samples every segment of `durations` [s] at least kMinSamplesPerSegment times.
+bool samples_path(const std::vector<double>& durations, double dt);
+/// The metrics of a run that was not simulated: `status`, every figure NaN (`joints` torque bounds).
+TrajectoryMetrics not_simulated(RunStatus status, int joints);
 
 /// Per-sample history, written in place by simulate() (no copy per sample). One column per stored
 /// sample; every `stride`-th sample is stored, and the last one computed always is.

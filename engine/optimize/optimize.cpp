@@ -49,6 +49,7 @@ struct Runner {
   std::string stage;
   int start = -1;
   double fd_step = 1e-6;
+  const std::atomic<bool>* stop = nullptr;
   std::vector<EvalRecord> records;
 
   double eval(const double* x, std::size_t n) {
@@ -82,6 +83,7 @@ struct Runner {
 
 double objective_cb(unsigned n, const double* x, double* grad, void* data) {
   auto* r = static_cast<Runner*>(data);
+  if (r->stop && r->stop->load()) throw nlopt::forced_stop();  // NLopt's wrapper ends optimize() with it
   const double f0 = r->eval(x, n);
   if (grad) r->gradient(x, n, f0, grad, [&](const double* xp) { return r->eval(xp, n); });
   return f0;
@@ -121,9 +123,11 @@ struct StageRun {
 
 /// One NLopt run of `s` from x0. `local_for_mlsl`: the local algorithm MLSL uses.
 StageRun run_stage(const Problem& p, const StageOptions& s, const std::vector<double>& x0, const std::string& stage,
-                   int start, ConstraintMode mode, const StageOptions* local_for_mlsl) {
+                   int start, ConstraintMode mode, const StageOptions* local_for_mlsl,
+                   const std::atomic<bool>* stop) {
   const std::size_t n = p.variables.size();
   Runner r;
+  r.stop = stop;
   r.problem = &p;
   r.stage = stage;
   r.start = start;
@@ -282,7 +286,7 @@ Summary optimize(const Problem& p, const PipelineOptions& o) {
     std::vector<StageRun> runs(static_cast<std::size_t>(islands));
     auto island = [&](std::size_t i) {
       nlopt::srand(static_cast<unsigned long>(o.seed + i));  // NLopt's generator is thread-local
-      runs[i] = run_stage(p, *o.global, x_default, "global", -1, o.constraint, o.local ? &*o.local : nullptr);
+      runs[i] = run_stage(p, *o.global, x_default, "global", -1, o.constraint, o.local ? &*o.local : nullptr, o.stop);
     };
     if (islands == 1) {
       island(0);
@@ -321,11 +325,12 @@ Summary optimize(const Problem& p, const PipelineOptions& o) {
   if (local_starts.empty()) local_starts.push_back(x_default);
 
   // Local stage: one polish per start, concurrently; merged in start order.
-  if (o.local) {
+  const auto stopped = [&] { return o.stop && o.stop->load(); };
+  if (o.local && !stopped()) {
     const auto t0 = Clock::now();
     std::vector<StageRun> runs(local_starts.size());
     auto body = [&](std::size_t i) {
-      runs[i] = run_stage(p, *o.local, local_starts[i], "local", static_cast<int>(i), o.constraint, nullptr);
+      runs[i] = run_stage(p, *o.local, local_starts[i], "local", static_cast<int>(i), o.constraint, nullptr, o.stop);
     };
     tbb::task_arena arena(o.threads > 0 ? o.threads : tbb::task_arena::automatic);
     arena.execute([&] {
@@ -353,6 +358,7 @@ Summary optimize(const Problem& p, const PipelineOptions& o) {
       out.best_stage = e.stage;
     }
   out.wall_time_s = seconds_since(t_all);
+  out.stopped = stopped();
   return out;
 }
 

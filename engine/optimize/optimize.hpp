@@ -7,6 +7,7 @@
 // Determinism: the global stage runs in the calling thread after nlopt::srand(seed); the local
 // polishes are deterministic algorithms, run concurrently (TBB, `threads`) and merged in start order.
 // So a Summary (except wall times) does not depend on the thread count.
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
@@ -111,6 +112,9 @@ struct PipelineOptions {
   int threads = 0;                 ///< local polishes in parallel (0: all cores)
   std::uint64_t seed = 42;         ///< nlopt::srand before the global stage
   ConstraintMode constraint = ConstraintMode::automatic;
+  /// When set (e.g. by SIGINT), every running stage ends before its next evaluation (FORCED_STOP)
+  /// and no later stage starts; the evaluations made so far are kept.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 /// One objective evaluation.
@@ -146,6 +150,7 @@ struct Summary {
   std::string best_status;
   std::string best_stage;
   double wall_time_s = 0.0;
+  bool stopped = false;  ///< PipelineOptions::stop ended it early
   /// Human-readable: stages (algorithm, evaluations, time, best), the best point.
   void print(std::ostream& os) const;
 };

@@ -137,6 +137,11 @@ RunOutcome run_chain_trajectory(const Scenario& sc, const TrajectoryRun& run, in
 }
 
 RunOutcome run_trajectory(const Scenario& sc, const TrajectoryRun& run, int stride, RunWorkspace::Impl& ws) {
+  if (!samples_path(sc.task->durations, run.options.dt)) {  // a swept dt too coarse for the path
+    RunOutcome out;
+    out.result = not_simulated(RunStatus::undersampled, sc.chain ? sc.chain->dof() : 3);
+    return out;
+  }
   if (sc.chain) return run_chain_trajectory(sc, run, stride, ws);
   PlanarArm3 arm = *sc.robot;
   arm.inertia_form = run.inertia;

@@ -291,6 +291,7 @@ OptimizeResult run_optimization(const Study& study, std::size_t index, const Opt
   po.threads = options.threads;
   po.seed = ob.seed;
   po.constraint = ob.constraint;
+  po.stop = options.stop;
   po.starts = best_cells(study, index, options);
 
   OptimizeResult res;
@@ -420,13 +421,16 @@ std::vector<OptimizeResult> run_optimizations(const Study& study, store::Results
                                               const OptimizeRunOptions& options, std::ostream* os) {
   std::vector<OptimizeResult> out;
   for (std::size_t i = 0; i < study.optimizations.size(); ++i) {
+    if (options.stop && options.stop->load()) break;
     OptimizeResult r = run_optimization(study, i, options);
-    if (writer) writer->write_optimization(r.record);
-    if (os) {
+    const bool empty = r.summary.evaluations.empty();
+    if (writer && !empty) writer->write_optimization(r.record);
+    if (os && !empty) {
       if (i == 0) *os << '\n';
       print_optimization(*os, study, i, r);
     }
     out.push_back(std::move(r));
+    if (out.back().summary.stopped) break;
   }
   return out;
 }

@@ -3,6 +3,7 @@
 // evaluation = the block's runs with the variables' columns set to x; the weighted objective averaged
 // over them; failed runs get a deterministic penalty; the start's reach margin as the constraint) ->
 // opt::optimize -> a store::OptimizationRecord (/optimizations/<name>).
+#include <atomic>
 #include <iosfwd>
 #include <string>
 #include <vector>
@@ -18,6 +19,9 @@ struct OptimizeRunOptions {
   /// polish_from: read the landscape block's cells from this results file (when all its runs are done);
   /// null (or not done): evaluate the cells here.
   const store::ResultsReader* cells = nullptr;
+  /// When set (e.g. by SIGINT): the running block ends before its next evaluation and stores what it
+  /// has; the later blocks do not start.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 /// Reach margin of the start [-]: |cos theta2| - 1 of the analytic IK at point p for orientation alpha
@@ -45,7 +49,8 @@ OptimizeResult run_optimization(const Study& study, std::size_t index, const Opt
 void print_optimization(std::ostream& os, const Study& study, std::size_t index, const OptimizeResult& r);
 
 /// Run every optimisation block of the study in file order, write each to `writer` (when given) and
-/// print it to `os` (when given). Returns the results.
+/// print it to `os` (when given). Returns the results (fewer than the blocks when options.stop ended
+/// them: the last one's summary is then `stopped`; a block stopped before any evaluation is not written).
 std::vector<OptimizeResult> run_optimizations(const Study& study, store::ResultsWriter* writer,
                                               const OptimizeRunOptions& options, std::ostream* os);
 

@@ -29,6 +29,30 @@ std::string refuse_existing(const std::string& out, bool exists, const std::stri
   return out + " " + what + "; use --resume to complete it or --overwrite to replace it";
 }
 
+namespace {
+/// The bytes a new results file takes before any run: every /runs row is allocated at creation (8
+/// bytes per number, 16 per string reference, 1 for the done flag), plus 1 MiB for the rest.
+std::uint64_t skeleton_bytes(const StudySchema& schema, std::uint64_t runs) {
+  std::uint64_t row = 1;
+  for (const auto& c : schema.columns) row += c.type == CellType::str ? 16 : 8;
+  return runs * row + (1u << 20);
+}
+
+/// Refuses (StoreError) a new file whose skeleton would not fit in its directory's free space.
+void check_free_space(const std::string& out, const StudySchema& schema, std::uint64_t runs) {
+  const fs::path dir = fs::path(out).parent_path().empty() ? fs::path(".") : fs::path(out).parent_path();
+  std::error_code ec;
+  const fs::space_info sp = fs::space(dir, ec);
+  if (ec) return;  // unknown: the writer reports a full disk as it happens
+  const std::uint64_t need = skeleton_bytes(schema, runs);
+  if (need > sp.available)
+    throw store::StoreError(out, "the file needs " + std::to_string(need) + " bytes for its " + std::to_string(runs) +
+                                     " run rows before any run, but " + dir.string() + " has " +
+                                     std::to_string(sp.available) + " bytes free; expected more free space "
+                                     "(or fewer runs)");
+}
+}  // namespace
+
 OpenedResults open_results(const Study& study, const StudySchema& schema, const std::string& out, bool resume,
                            const store::StoreOptions& so) {
   OpenedResults r;
@@ -38,6 +62,7 @@ OpenedResults open_results(const Study& study, const StudySchema& schema, const 
     return r;
   }
   if (!fs::path(out).parent_path().empty()) fs::create_directories(fs::path(out).parent_path());
+  check_free_space(out, schema, study.run_count());
   r.writer = store::ResultsWriter::create(out, store_meta(study), schema.columns,
                                          static_cast<std::int64_t>(study.run_count()), so);
   return r;
@@ -45,12 +70,27 @@ OpenedResults open_results(const Study& study, const StudySchema& schema, const 
 
 namespace {
 
+/// A message on one line (HDF5's descriptions may hold line breaks).
+std::string one_line(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r') c = ' ';
+  return s;
+}
+
 class LocalBackend final : public SweepBackend {
  public:
   bool leader() const override { return true; }
 
   int open(const Study& study, const StudySchema& schema, const RunRequest& r, std::ostream& err) override {
     const std::string& out = r.output;
+    if (r.options.stop && r.options.stop->load()) {  // a signal during validation: nothing created
+      err << "kinesweep run: interrupted before " << out << " was opened; nothing written\n";
+      return 130;
+    }
+    if (fs::is_directory(out)) {
+      err << "kinesweep run: " << out << " is a directory; expected a results file path (NAME.h5)\n";
+      return 1;
+    }
     const bool exists = fs::exists(out);
     if (const std::string why = refuse_existing(out, exists, "exists", r); !why.empty()) {
       err << "kinesweep run: " << why << '\n';
@@ -108,7 +148,17 @@ int conclude(const Study& study, const RunRequest& r, SweepBackend& backend, Swe
     OptimizeRunOptions oo;
     oo.threads = backend.threads(r);
     oo.cells = cells ? &*cells : nullptr;
-    run_optimizations(study, res.writer.get(), oo, &out);
+    oo.stop = r.options.stop;
+    const auto done = run_optimizations(study, res.writer.get(), oo, &out);
+    const bool partial = !done.empty() && done.back().summary.stopped;
+    if (partial || done.size() < study.optimizations.size()) {
+      res.writer->close();
+      const std::size_t complete = done.size() - (partial ? 1 : 0);
+      out << "interrupted: the sweep's " << report.total << " runs, " << complete << " of "
+          << study.optimizations.size() << " optimisation blocks" << (partial ? " and the evaluations of the next" : "")
+          << " are kept in " << backend.kept_in(r) << "\nresume with: " << backend.resume_command(r) << '\n';
+      return 130;
+    }
   }
   res.writer->close();
   out << "results: " << r.output << '\n' << std::flush;
@@ -133,14 +183,8 @@ int run_study(const Study& study, const RunRequest& request, std::ostream& out, 
       SweepResult res = backend->sweep(study, schema, request, out, err);
       code = backend->leader() ? conclude(study, request, *backend, res, out) : res.code;
     }
-  } catch (const store::StoreError& e) {
-    err << "kinesweep run: " << e.what() << '\n';
-    code = 1;
-  } catch (const fs::filesystem_error& e) {
-    err << "kinesweep run: " << e.what() << '\n';
-    code = 1;
-  } catch (const std::exception& e) {  // anything else still ends every rank through finish()
-    err << "kinesweep run: " << e.what() << '\n';
+  } catch (const std::exception& e) {  // store, file system or anything else: every rank ends through finish()
+    err << "kinesweep run: " << one_line(e.what()) << '\n';
     code = 1;
   }
   return backend->finish(code);

@@ -1,6 +1,16 @@
 #include "store/h5util.hpp"
 
+#include <cstdio>
 #include <cstring>
+
+namespace ks::store {
+
+void print_hdf5_error_stack(bool print) {
+  if (print) H5Eset_auto2(H5E_DEFAULT, reinterpret_cast<H5E_auto2_t>(H5Eprint2), stderr);
+  else H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+}
+
+}  // namespace ks::store
 
 namespace ks::store::detail {
 

@@ -32,6 +32,10 @@ class StoreError : public std::runtime_error {
   std::string path_, cause_;
 };
 
+/// Whether HDF5 prints its own (multi-line) error stack to stderr when a call fails (its default:
+/// yes). The store's errors say the cause in one line either way.
+void print_hdf5_error_stack(bool print);
+
 inline constexpr const char* kFormatName = "kinesweep-results";
 /// The format this kinesweep writes (2: /runs columns carry `role` and `kinds` attributes).
 inline constexpr std::int64_t kFormatVersion = 2;

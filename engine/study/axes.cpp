@@ -16,6 +16,37 @@ std::string Parser::domain_problem(const ParamDef& info, double v) {
   return "";
 }
 
+std::string Parser::sampling_problem(const std::vector<double>& durations, double dt) const {
+  if (durations.empty() || samples_path(durations, dt)) return "";
+  const double shortest = *std::min_element(durations.begin(), durations.end());
+  return "dt = " + fmt(dt) + " s samples the shortest segment (" + fmt(shortest) + " s) " + fmt(shortest / dt) +
+         " times; expected at least " + fmt(kMinSamplesPerSegment) + " samples per segment (dt <= " +
+         fmt(shortest / kMinSamplesPerSegment) + " s; a dt axis may go beyond: those runs end undersampled)";
+}
+
+void Parser::check_block_dt(const BlockDraft& d, const Study& s) {
+  if (d.kind != BlockKind::trajectory || d.axis_names.count("dt")) return;
+  if (d.optimize)  // dt an optimisation variable: its evaluations beyond the bound end undersampled
+    if (const toml::node* v = d.table.get("variables"); v && v->as_table() && v->as_table()->get("dt")) return;
+  for (const auto& [name, v] : d.spec.fixed)
+    if (name == "dt") {
+      if (auto p = sampling_problem(s.task.durations, std::get<double>(v)); !p.empty()) error(*d.table.get("dt"), p);
+      return;
+    }
+  if (task_dt_reported_ || s.task.durations.empty()) return;
+  const double dt = s.task.dt;
+  std::string p = sampling_problem(s.task.durations, dt);
+  if (p.empty() && !task_dt_pos_) {  // the default dt: the path's length bounds it too
+    p = domain_problem(*find_param(block_params(BlockKind::trajectory), "dt"), dt);
+    if (!p.empty()) p = "the default " + p + " (set [task] dt)";
+  } else if (!p.empty() && !task_dt_pos_) {
+    p = "the default " + p;
+  }
+  if (p.empty()) return;
+  task_dt_reported_ = true;
+  error(task_dt_pos_ ? *task_dt_pos_ : path_pos_, p);
+}
+
 std::optional<Cell> Parser::param_value(const ParamDef& info, const toml::node& n) {
   if (info.type == CellType::str) {
     const auto* s = n.as_string();
@@ -61,8 +92,8 @@ bool Parser::count_and_interval_ok(const std::string& what, std::int64_t count, 
     return false;
   }
   if (std::uint64_t(count) > max_runs_) {
-    error(count_node, what + " count = " + std::to_string(count) + "; expected at most max_runs = " +
-                          std::to_string(max_runs_));
+    error(count_node, what + " count = " + std::to_string(count) + "; expected at most " +
+                          std::to_string(max_runs_) + " runs" + limit_hint());
     return false;
   }
   return true;
@@ -111,22 +142,7 @@ std::optional<AxisDraft> Parser::parse_axis(const ParamDef& info_ref, const toml
       return std::nullopt;
     }
     const bool is_int = info->type == CellType::i64;
-    auto gen_check = [&](const std::vector<double>& vals, const toml::node& at) {
-      for (double v : vals) {
-        if (is_int && std::abs(v - std::round(v)) > 1e-9 * std::max(1.0, std::abs(v))) {
-          error(at, what + " yields " + fmt(v) + "; expected integer values for " + key);
-          return false;
-        }
-        if (auto p = domain_problem(*info, v); !p.empty()) {
-          error(at, what + " yields " + p);
-          return false;
-        }
-      }
-      return true;
-    };
-    auto fill = [&](const std::vector<double>& vals) {
-      for (double v : vals) d.axis.values.push_back(info->from_file(v));
-    };
+    d.node = n;
     if (const toml::node* rn = t->get("random")) {
       check_keys(*t, {"random"}, what + " (random)");
       d.axis.form = "random";
@@ -153,9 +169,11 @@ std::optional<AxisDraft> Parser::parse_axis(const ParamDef& info_ref, const toml
         error(*rt->get("seed"), what + " seed = " + std::to_string(*seed) + "; expected seed >= 0");
         return std::nullopt;
       }
-      const auto vals = uniform_draws(std::uint64_t(*seed), std::uint64_t(*count), *from, *to);
-      if (!gen_check(vals, *rn)) return std::nullopt;
-      fill(vals);
+      d.count = std::uint64_t(*count);
+      d.node = rn;
+      d.generate = [seed = std::uint64_t(*seed), count = d.count, from = *from, to = *to] {
+        return uniform_draws(seed, count, from, to);
+      };
     } else if (const toml::node* ln = t->get("lhs")) {
       check_keys(*t, {"lhs"}, what + " (lhs)");
       d.axis.form = "lhs";
@@ -177,7 +195,11 @@ std::optional<AxisDraft> Parser::parse_axis(const ParamDef& info_ref, const toml
         error(*ln, what + " has from = " + fmt(*from) + " > to = " + fmt(*to) + "; expected from <= to");
         return std::nullopt;
       }
-      if (!gen_check({*from, *to}, *ln)) return std::nullopt;
+      for (double v : {*from, *to})
+        if (auto p = value_problem(*info, what, v); !p.empty()) {
+          error(*ln, p);
+          return std::nullopt;
+        }
       if (!lhs_node) {
         error(*ln, what + " uses lhs but the block has no lhs settings; expected lhs = { count = N, seed = S } in the block");
         return std::nullopt;
@@ -197,7 +219,6 @@ std::optional<AxisDraft> Parser::parse_axis(const ParamDef& info_ref, const toml
       }
       auto from = get_number(*t, "from", "from"), to = get_number(*t, "to", "to");
       if (!from || !to) return std::nullopt;
-      std::vector<double> vals;
       if (is_range) {
         auto step = get_number(*t, "step", "step");
         if (!step) return std::nullopt;
@@ -213,11 +234,12 @@ std::optional<AxisDraft> Parser::parse_axis(const ParamDef& info_ref, const toml
           return std::nullopt;
         }
         if (cnt > max_runs_) {
-          error(*n, what + " has " + std::to_string(cnt) + " values; expected at most max_runs = " +
-                        std::to_string(max_runs_));
+          error(*n, what + " has " + std::to_string(cnt) + " values; expected at most " + std::to_string(max_runs_) +
+                        " runs" + limit_hint());
           return std::nullopt;
         }
-        vals = range_values(*from, *to, *step);
+        d.count = cnt;
+        d.generate = [from = *from, to = *to, step = *step] { return range_values(from, to, step); };
       } else {
         if (is_int) {
           error(*t->get("count"), what + ": linspace gives non-integers in general; expected a list or { from, to, step } for " + key);
@@ -226,13 +248,17 @@ std::optional<AxisDraft> Parser::parse_axis(const ParamDef& info_ref, const toml
         auto count = get_integer(*t->get("count"), "count");
         if (!count) return std::nullopt;
         if (!count_and_interval_ok(what, *count, *t->get("count"), *from, *to, *n)) return std::nullopt;
-        vals = linspace_values(*from, *to, std::uint64_t(*count));
+        d.count = std::uint64_t(*count);
+        d.generate = [from = *from, to = *to, count = d.count] { return linspace_values(from, to, count); };
       }
-      if (!gen_check(vals, *n)) return std::nullopt;
-      fill(vals);
     } else {
-      std::vector<std::string> axis_keys{"values", "from", "to", "step", "count", "random", "lhs"};
-      check_keys(*t, axis_keys, what);
+      const std::vector<std::string> axis_keys{"values", "from", "to", "step", "count", "random", "lhs"};
+      for (auto&& [k, v] : ordered(*t))
+        if (std::find(axis_keys.begin(), axis_keys.end(), k->str()) == axis_keys.end()) {
+          error(*k, what + " has the unknown key '" + std::string(k->str()) + "' and so gives no values; expected " +
+                        forms + suggest(k->str(), axis_keys));
+          return std::nullopt;
+        }
       error(*n, what + " gives no values; expected " + forms);
       return std::nullopt;
     }
@@ -242,7 +268,15 @@ std::optional<AxisDraft> Parser::parse_axis(const ParamDef& info_ref, const toml
     return std::nullopt;
   }
   if (!ok) return std::nullopt;
+  if (!d.generate && !d.lhs) d.count = d.axis.values.size();
   return d;
+}
+
+std::string Parser::value_problem(const ParamDef& info, const std::string& what, double v) {
+  if (info.type == CellType::i64 && std::abs(v - std::round(v)) > 1e-9 * std::max(1.0, std::abs(v)))
+    return what + " yields " + fmt(v) + "; expected integer values for " + info.name;
+  if (auto p = domain_problem(info, v); !p.empty()) return what + " yields " + p;
+  return "";
 }
 
 }  // namespace ks::study_parse

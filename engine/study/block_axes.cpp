@@ -1,6 +1,7 @@
 // parse_block's steps for a block's axes: its lhs settings, [block.axes], the LHS group's draw, zip
 // groups, the rejection of axes a run would ignore, and the Block built from the draft.
 #include <algorithm>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -18,7 +19,8 @@ void Parser::read_block_lhs(BlockDraft& d) {
       if (auto v = get_integer(*c, "lhs count")) {
         if (*v < 1) error(*c, "lhs count = " + std::to_string(*v) + "; expected count >= 1");
         else if (std::uint64_t(*v) > max_runs_)
-          error(*c, "lhs count = " + std::to_string(*v) + "; expected at most max_runs = " + std::to_string(max_runs_));
+          error(*c, "lhs count = " + std::to_string(*v) + "; expected at most " + std::to_string(max_runs_) + " runs" +
+                        limit_hint());
         else d.lhs_count = std::uint64_t(*v);
       }
     } else error(*lhs_node, "lhs has no count; expected lhs = { count = N, seed = S }");
@@ -54,8 +56,68 @@ void Parser::read_axes(BlockDraft& d) {
   }
 }
 
-// Drawn once all the group's axes are known.
-void Parser::draw_lhs_group(BlockDraft& d) {
+namespace {
+/// a * b, or nullopt past 64 bits.
+std::optional<std::uint64_t> times(std::uint64_t a, std::uint64_t b) {
+  if (a != 0 && b > std::numeric_limits<std::uint64_t>::max() / a) return std::nullopt;
+  return a * b;
+}
+}  // namespace
+
+bool Parser::check_block_runs(BlockDraft& d) {
+  // One factor per dimension: an axis alone, a zip group once (its lengths are equal), the LHS group once.
+  std::set<std::string> counted;
+  std::optional<std::uint64_t> runs = 1;
+  for (const auto& g : d.spec.groups) {
+    auto it = std::find_if(d.drafts.begin(), d.drafts.end(), [&](const AxisDraft& a) { return a.axis.name == g.front(); });
+    if (it != d.drafts.end() && runs) runs = times(*runs, it->count);
+    counted.insert(g.begin(), g.end());
+  }
+  bool lhs = false;
+  for (const auto& a : d.drafts) {
+    if (counted.count(a.axis.name) || !runs) continue;
+    if (a.lhs) lhs = true;
+    else runs = times(*runs, a.count);
+  }
+  if (lhs && d.lhs_count && runs) runs = times(*runs, *d.lhs_count);
+  const std::uint64_t before = d.optimize ? 0 : sweep_runs_;
+  const bool over = !runs || *runs > max_runs_ - std::min(before, max_runs_);
+  if (!over) {
+    if (!d.optimize) sweep_runs_ += *runs;
+    return true;
+  }
+  if (d.optimize)
+    error(d.pos, "too many runs per evaluation: " + d.label + " '" + d.spec.name + "' has " +
+                     (runs ? std::to_string(*runs) : std::string("more than 2^64")) + " runs; expected at most " +
+                     std::to_string(max_runs_) + limit_hint());
+  else if (!reported_runs_)
+    error(d.pos, "too many runs: block '" + d.spec.name + "' has " +
+                     (runs ? std::to_string(*runs) : std::string("more than 2^64")) + " runs, the study " +
+                     (runs && before + *runs >= before ? std::to_string(before + *runs) : std::string("overflows")) +
+                     "; expected at most " + std::to_string(max_runs_) + " runs in all" + limit_hint());
+  reported_runs_ = reported_runs_ || !d.optimize;
+  return false;
+}
+
+std::string Parser::limit_hint() const {
+  if (max_runs_ < options_.max_runs)
+    return " (the study's max_runs; the caller allows up to " + std::to_string(options_.max_runs) + ")";
+  return " (the caller's limit: kinesweep run --max-runs N raises it)";
+}
+
+void Parser::generate_axes(BlockDraft& d) {
+  for (auto& a : d.drafts) {
+    if (!a.generate) continue;
+    const ParamDef* info = d.info_of(a.axis.name);
+    const std::string what = "axis '" + a.axis.name + "'";
+    const std::vector<double> vals = a.generate();
+    for (double v : vals)
+      if (auto p = value_problem(*info, what, v); !p.empty()) {
+        error(*a.node, p);
+        a.axis.values.clear();
+        break;
+      } else a.axis.values.push_back(info->from_file(v));
+  }
   std::vector<std::pair<double, double>> ranges;
   std::vector<AxisDraft*> lhs_axes;
   for (auto& a : d.drafts)
@@ -73,7 +135,7 @@ void Parser::draw_lhs_group(BlockDraft& d) {
       d.lhs_group.push_back(lhs_axes[i]->axis.name);
     }
   }
-  // Drop LHS axes that got no values (their settings were bad: already reported).
+  // Drop axes that got no values (their settings were bad: already reported).
   std::erase_if(d.drafts, [](const AxisDraft& a) { return a.axis.values.empty(); });
 }
 
@@ -132,11 +194,11 @@ void Parser::read_zip_groups(BlockDraft& d) {
         ok = false;
         continue;
       }
-      lens.push_back(nm + " (" + std::to_string(it->axis.values.size()) + ")");
-      len_notes.emplace_back(it->pos, "axis '" + nm + "' has " + std::to_string(it->axis.values.size()) +
-                                          (it->axis.values.size() == 1 ? " value" : " values"));
-      if (len && *len != it->axis.values.size()) unequal = true;
-      len = it->axis.values.size();
+      lens.push_back(nm + " (" + std::to_string(it->count) + ")");
+      len_notes.emplace_back(it->pos, "axis '" + nm + "' has " + std::to_string(it->count) +
+                                          (it->count == 1 ? " value" : " values"));
+      if (len && *len != it->count) unequal = true;
+      len = it->count;
       group.push_back(nm);
     }
     if (unequal) {

@@ -1,5 +1,5 @@
 // [[block]] tables: parse_block and its first steps (name, kind, the table's keys, the IK problem
-// family, fixed parameters; the axes' steps are in block_axes.cpp), and the study-wide run-count limit.
+// family, fixed parameters; the axes' steps, with the run-count limit, are in block_axes.cpp).
 #include <algorithm>
 #include <map>
 #include <set>
@@ -22,6 +22,15 @@ KindContext block_context(const Study& s, bool scara) {
   ctx.robot = s.robot_shape();
   if (!s.task.vertices.empty()) ctx.first_vertex = s.task.vertex(0);
   return ctx;
+}
+
+/// Why `name` cannot name an HDF5 group (/landscapes/<block>, /optimizations/<name>); "" when it can.
+std::string hdf5_name_problem(const std::string& name) {
+  if (name == "." || name == "..") return "is '" + name + "', which HDF5 paths reserve";
+  if (name.find('/') != std::string::npos) return "contains '/', which separates HDF5 path components";
+  for (unsigned char c : name)
+    if (c < 0x20 || c == 0x7f) return "contains a control character";
+  return "";
 }
 
 }  // namespace
@@ -53,10 +62,12 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
   find_axes_table(d);
   read_ik_family(d);
   read_fixed_params(d);
+  check_block_dt(d, s);
   read_block_lhs(d);
   read_axes(d);
-  draw_lhs_group(d);
   read_zip_groups(d);
+  if (!check_block_runs(d)) return std::nullopt;  // nothing generated for a block too large
+  generate_axes(d);
   if (!d.lhs_group.empty()) d.spec.groups.push_back(d.lhs_group);  // after the zip groups
   d.ctx = block_context(s, d.scara);
   check_robot_supports(d, s);
@@ -68,7 +79,11 @@ void Parser::read_block_name(BlockDraft& d, std::map<std::string, Pos>& names) {
   const toml::table& b = d.table;
   if (auto v = get_string(b, "name", "block name")) {
     const Pos np = pos_of(b.get("name")->source());
-    if (v->empty()) error(np, "block name is empty; expected a non-empty, unique name");
+    const std::string what = d.optimize ? "optimisation name" : "block name";
+    if (v->empty()) error(np, what + " is empty; expected a non-empty, unique name");
+    else if (const std::string why = hdf5_name_problem(*v); !why.empty())
+      error(np, what + " '" + *v + "' " + why + "; expected a name without '/' or control characters, "
+                "other than '.' and '..' (it names a group in the results file)");
     else if (auto it = names.find(*v); it != names.end())
       note(error(np, "duplicate block name '" + *v + "' (first at line " + std::to_string(it->second.line) +
                          "); expected unique block names"),
@@ -231,8 +246,6 @@ void Parser::parse_blocks(const toml::table& root, Study& s) {
     return;
   }
   std::map<std::string, Pos> names;
-  std::uint64_t total = 0;
-  bool reported_total = false;
   std::optional<std::pair<bool, Pos>> ik_family;  // the first IK block's family (SCARA?) and place
   for (std::size_t i = 0; i < a->size(); ++i) {
     const auto& bt = *a->get(i)->as_table();
@@ -252,18 +265,6 @@ void Parser::parse_blocks(const toml::table& root, Study& s) {
              ik_family->second, "the first ik block, with " + fam(ik_family->first));
       }
     }
-    const bool over = block->overflowed() || total + block->run_count() < total ||
-                      total + block->run_count() > max_runs_;
-    if (over && !reported_total) {
-      error(bt.source(), "too many runs: block '" + block->name() + "' has " +
-                             (block->overflowed() ? std::string("more than 2^64") : std::to_string(block->run_count())) +
-                             " runs, the study " +
-                             (block->overflowed() ? std::string("overflows") : std::to_string(total + block->run_count())) +
-                             "; expected at most " + std::to_string(max_runs_) +
-                             " runs in all (set [study] max_runs to allow more)");
-      reported_total = true;
-    }
-    if (!block->overflowed()) total += block->run_count();
     s.blocks.push_back(std::move(*block));
   }
 }

@@ -30,6 +30,10 @@ Study study_parse::Parser::run() {
   s.file = file_;
   s.text = std::string(text);
   s.sha256 = sha256_hex(text);
+  if (const auto h = toml_hazard(text)) {  // inputs toml++ 3.3 mishandles: refused before it parses
+    error(Pos{h->line, h->column, 1}, "TOML syntax: " + h->message);
+    throw StudyError(diags_);
+  }
   toml::table root;
   try {
     root = toml::parse(text, file_);
@@ -65,6 +69,20 @@ Study parse_study(std::string_view text, std::string_view file, const StudyOptio
 }
 
 Study load_study(const std::filesystem::path& file, const StudyOptions& options) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) {
+    StudyDiagnostic d;
+    d.file = file.string();
+    d.line = d.column = 1;
+    std::vector<std::string> studies;  // the study files in it, as suggestions
+    for (const auto& e : std::filesystem::directory_iterator(file, ec))
+      if (e.path().extension() == ".toml") studies.push_back(e.path().string());
+    std::sort(studies.begin(), studies.end());
+    d.message = "is a directory; expected a study file (TOML)";
+    for (std::size_t i = 0; i < studies.size() && i < 3; ++i) d.message += (i ? ", " : ", e.g. ") + studies[i];
+    if (studies.size() > 3) d.message += ", ...";
+    throw StudyError({d});
+  }
   std::ifstream in(file, std::ios::binary);
   if (!in) {
     StudyDiagnostic d;  // no source line: the headline alone

@@ -7,8 +7,10 @@
 //   blocks.cpp           [[block]] tables: name, kind, keys, IK problem family, fixed parameters
 //   block_axes.cpp       a block's axes: lhs settings, [block.axes], lhs and zip groups, axes a run would ignore
 //   optimize_tables.cpp  [[optimize]] tables and their stages
+//   toml_prescan.cpp     the inputs toml++ 3.3 mishandles, found before it parses
 //   parse.cpp            Parser::run, parse_study, load_study
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
@@ -25,12 +27,26 @@ namespace ks::study_parse {
 /// path, and a full history holds 16 doubles per sample.
 constexpr double kMaxSamples = 1e7;
 
-/// One axis of [block.axes] as parsed, before the block's LHS group is drawn.
+/// A place in a study's text where toml++ 3.3 would reach undefined behaviour (see toml_prescan.cpp).
+struct TomlHazard {
+  int line = 1, column = 1;
+  std::string message;  ///< "<what>; expected <what>"
+};
+/// The first such place in `text`, if any.
+std::optional<TomlHazard> toml_hazard(std::string_view text);
+
+/// One axis of [block.axes] as parsed. A value list holds its values; a generated axis (range,
+/// linspace, random) holds its count and how to generate them, and an LHS axis its range: their
+/// values are made only once the block's run count, computed from the counts, is within bounds.
 struct AxisDraft {
   Axis axis;
   Pos pos;                                   // the axis key
   bool lhs = false;
   std::pair<double, double> lhs_range{0, 0};  // LHS axes: [from, to) in file units
+  std::uint64_t count = 0;                   // the axis's values (LHS axes: 0, the block's lhs count applies)
+  /// Generated axes: their values in file units, and where the axis is written (for their errors).
+  std::function<std::vector<double>()> generate;
+  const toml::node* node = nullptr;
 };
 
 /// One [[block]] table (or the block part of an [[optimize]] table) while Parser::parse_block reads
@@ -114,16 +130,26 @@ class Parser : public ParserCore {
   void read_ik_family(BlockDraft& d);
   /// Reads the fixed parameters (and vertex_alpha = [...]); reports bad values and parameters also axes.
   void read_fixed_params(BlockDraft& d);
+  /// A trajectory block whose dt is not swept: its dt (fixed, else the task's, else the default)
+  /// against the path; reports a dt that samples a segment too coarsely or the path too finely.
+  void check_block_dt(const BlockDraft& d, const Study& s);
 
   // block_axes.cpp: parse_block's steps for the axes, in order.
   /// Reads lhs = { count, seed }; reports a bad or missing count or seed.
   void read_block_lhs(BlockDraft& d);
   /// Reads [block.axes]; reports axes that are not the kind's parameters (and their bad values).
   void read_axes(BlockDraft& d);
-  /// Draws the LHS axes' values; reports lhs settings no axis uses.
-  void draw_lhs_group(BlockDraft& d);
   /// Reads zip; reports bad groups, unknown, twice-zipped or LHS axes and unequal lengths.
   void read_zip_groups(BlockDraft& d);
+  /// The block's run count from its axes' counts (nothing generated yet), against the run limit:
+  /// the block's own for an [[optimize]] block, the study's total for a [[block]]. False after
+  /// reporting the block as too large.
+  bool check_block_runs(BlockDraft& d);
+  /// Generates the axes' values (and checks each against its parameter's domain); draws the LHS
+  /// axes' values; reports lhs settings no axis uses.
+  void generate_axes(BlockDraft& d);
+  /// How the run limit in force can change, for "too many runs" messages.
+  std::string limit_hint() const;
   /// Checks the block's runs against the robot: redundancy left by the task, vertex_alpha's domain.
   void check_robot_supports(const BlockDraft& d, const Study& s);
   /// Reads the axes against their controlling parameters; reports axes a run would ignore.
@@ -144,6 +170,11 @@ class Parser : public ParserCore {
   std::optional<Cell> param_value(const ParamDef& info, const toml::node& n);
   /// Check a stored numeric value's domain (expects file units for messages). Empty when fine.
   std::string domain_problem(const ParamDef& info, double file_value);
+  /// Why dt [s] cannot sample the task's path in every run ("" when it can): fewer than
+  /// kMinSamplesPerSegment samples on a segment.
+  std::string sampling_problem(const std::vector<double>& durations, double dt) const;
+  /// Why a generated value `v` (file units) of the axis `what` cannot be the parameter's ("" when it can).
+  std::string value_problem(const ParamDef& info, const std::string& what, double v);
   /// A count >= 1 and at most max_runs, and from <= to (random and linspace axes); false after reporting.
   bool count_and_interval_ok(const std::string& what, std::int64_t count, const toml::node& count_node, double from,
                              double to, const toml::node& at);
@@ -151,7 +182,12 @@ class Parser : public ParserCore {
   std::string_view text_;
   StudyOptions options_;
   std::uint64_t max_runs_ = 0;
+  std::uint64_t sweep_runs_ = 0;     // the runs of the [[block]] tables read so far
+  bool reported_runs_ = false;       // "too many runs" said once
   double path_duration_ = 2.0;  // [s], the task's; bounds the samples a dt asks for
+  std::optional<Pos> task_dt_pos_;  // [task] dt, when given
+  Pos path_pos_;                    // [task] durations (or the table, or 1:1): where the default dt is reported
+  bool task_dt_reported_ = false;   // the task's dt found unable to sample the path (said once)
 };
 
 }  // namespace ks::study_parse

@@ -148,7 +148,8 @@ struct Study {
 };
 
 struct StudyOptions {
-  std::uint64_t max_runs = 50'000'000;  ///< total runs allowed; a [study] max_runs key overrides it
+  /// Total runs allowed (kinesweep run --max-runs); a [study] max_runs key may only lower it.
+  std::uint64_t max_runs = 50'000'000;
 };
 
 /// Parse a study from text. `file` names it in diagnostics. Throws StudyError.

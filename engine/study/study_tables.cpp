@@ -34,6 +34,10 @@ void Parser::parse_study_table(const toml::table& root, Study& s) {
   if (auto v = get_string(*t, "output", "output")) {
     const bool hdf5 = v->ends_with(".h5") || v->ends_with(".hdf5");
     if (v->empty()) error(*t->get("output"), "output is empty; expected a file path");
+    else if (const auto c = std::find_if(v->begin(), v->end(), [](unsigned char ch) { return ch < 0x20 || ch == 0x7f; });
+             c != v->end())
+      error(*t->get("output"), std::string("output contains ") + (*c == '\0' ? "a NUL" : "a control") +
+                                   " character; expected a file path without control characters");
     else if (!hdf5)
       error(*t->get("output"), "output '" + *v + "': a results file is HDF5; expected a name ending in .h5 (or .hdf5)");
     else s.output = *v;
@@ -47,7 +51,10 @@ void Parser::parse_study_table(const toml::table& root, Study& s) {
       ok = !num.empty() && num.size() < 10 && std::all_of(num.begin(), num.end(), ::isdigit) && std::stoll(num) >= 1;
       if (ok) s.histories = {HistoryPolicy::Mode::every, int(std::stoll(num))};
     } else ok = false;
-    if (!ok)
+    if (!ok && v->starts_with("every="))
+      error(*t->get("histories"), "histories = '" + *v + "' does not give a whole N >= 1; expected \"every=N\" "
+                                      "with N >= 1 (every=1 keeps every sample, as \"full\"), \"full\" or \"none\"");
+    else if (!ok)
       error(*t->get("histories"), "histories = '" + *v + "'; expected \"full\", \"every=N\" (N >= 1) or \"none\"" +
                                       suggest(*v, {"full", "none",
                                                    "every=" + (v->find('=') == std::string::npos
@@ -57,6 +64,11 @@ void Parser::parse_study_table(const toml::table& root, Study& s) {
   if (const toml::node* m = t->get("max_runs")) {
     if (auto v = get_integer(*m, "max_runs")) {
       if (*v < 1) error(*m, "max_runs = " + std::to_string(*v) + "; expected max_runs >= 1");
+      else if (std::uint64_t(*v) > options_.max_runs)
+        error(*m, "max_runs = " + std::to_string(*v) + " is above the caller's limit of " +
+                      std::to_string(options_.max_runs) + " runs; expected at most " +
+                      std::to_string(options_.max_runs) +
+                      " (a study may only lower the limit; kinesweep run --max-runs N raises it)");
       else max_runs_ = std::uint64_t(*v);
     }
   }
@@ -135,6 +147,8 @@ void Parser::parse_task(const toml::table& root, Study& s) {
     path_duration_ = 0;
     for (double d : s.task.durations) path_duration_ += d;
   }
+  path_pos_ = pos_of((t->get("durations") ? t->get("durations") : static_cast<const toml::node*>(t))->source());
+  if (t->get("dt")) task_dt_pos_ = pos_of(t->get("dt")->source());
   if (auto v = get_number(*t, "dt", "dt")) {
     if (auto p = domain_problem(*find_param(block_params(BlockKind::trajectory), "dt"), *v); !p.empty()) error(*t->get("dt"), p + " [s]");
     else s.task.dt = *v;

@@ -39,8 +39,14 @@ std::string suggest(std::string_view word, const std::vector<std::string>& candi
       pick = c;
     }
   }
-  if (pick.empty() || best > std::max<std::size_t>(2, word.size() / 2)) return "";
-  return "; did you mean '" + pick + "'?";
+  if (!pick.empty() && pick != word && best <= std::max<std::size_t>(2, word.size() / 2))
+    return "; did you mean '" + pick + "'?";
+  // else a word that begins the one candidate ("thesis" for "thesis_m11")
+  const std::string w = lower(word);
+  std::vector<std::string> starts;
+  for (const auto& c : candidates)
+    if (w.size() >= 3 && lower(c).starts_with(w) && c.size() > w.size()) starts.push_back(c);
+  return starts.size() == 1 ? "; did you mean '" + starts.front() + "'?" : "";
 }
 
 std::string suggest_either(std::string_view word, const std::vector<std::string>& mine,

@@ -30,7 +30,8 @@ Pos pos_of(const toml::source_region& r);
 std::vector<std::pair<const toml::key*, const toml::node*>> ordered(const toml::table& t);
 
 std::string lower(std::string_view s);
-/// "; did you mean 'x'?" for the closest candidate (case-insensitive edit distance), or "".
+/// "; did you mean 'x'?" for the closest candidate (case-insensitive edit distance), else for the one
+/// candidate the word begins (at least 3 characters), or "". Never the word itself.
 std::string suggest(std::string_view word, const std::vector<std::string>& candidates);
 /// A suggestion among `mine`, else among the other kind's parameters (saying so).
 std::string suggest_either(std::string_view word, const std::vector<std::string>& mine,
