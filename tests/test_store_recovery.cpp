@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -330,3 +331,29 @@ TEST(StoreRecovery, ReadersChangeNoByteOfACrashedFile) {
 }
 
 }  // namespace
+
+namespace {
+/// The PID of a process that has ended (a child that exited and was reaped).
+pid_t dead_pid() {
+  const pid_t pid = ::fork();
+  if (pid == 0) ::_exit(0);
+  ::waitpid(pid, nullptr, 0);
+  return pid;
+}
+void touch(const std::string& path) { std::ofstream(path) << "partial"; }
+}  // namespace
+
+TEST(StoreRecovery, AWriterRemovesTheTemporaryFilesOfKilledProcessesOnly) {
+  TempDir td;
+  const std::string path = td.file("o.h5");
+  const std::string dead = std::to_string(dead_pid()), live = std::to_string(::getpid());
+  const std::vector<std::string> orphans = {".o.h5.tmp-" + dead + "-0", ".o.h5.tmp-" + dead + "-7",
+                                            "o.h5.journal.new-" + dead + "-1"};
+  const std::vector<std::string> kept = {".o.h5.tmp-" + live + "-3", "o.h5.journal.new-" + live + "-2",
+                                         ".other.h5.tmp-" + dead + "-0", ".o.h5.tmp-x-1", "o.h5.tmp-" + dead + "-0"};
+  for (const auto& n : orphans) touch(td.file(n));
+  for (const auto& n : kept) touch(td.file(n));
+  ResultsWriter::create(path, test_meta(), test_columns(), 3)->close();
+  for (const auto& n : orphans) EXPECT_FALSE(fs::exists(td.file(n))) << n;
+  for (const auto& n : kept) EXPECT_TRUE(fs::exists(td.file(n))) << n;
+}

@@ -55,7 +55,7 @@ void LandscapeGrid::add(std::uint64_t local, const Record& row, const StudySchem
   }
 }
 
-store::LandscapeSpec LandscapeGrid::spec() const {
+store::LandscapeSpec LandscapeGrid::take_spec() {
   store::LandscapeSpec s;
   s.block = block_.name();
   for (const Dim& d : block_.dims()) {
@@ -79,7 +79,7 @@ store::LandscapeSpec LandscapeGrid::spec() const {
   for (std::size_t m = 0; m < names_.size(); ++m) {
     store::LandscapeMetric lm;
     lm.name = names_[m];
-    lm.grid = grids_[m];
+    lm.grid = std::move(grids_[m]);
     if (sources_[m] == Source::column) lm.unit = ms[metric_index_[m]].unit, lm.description = ms[metric_index_[m]].description;
     if (sources_[m] == Source::is_ok) lm.description = "1 where the run's status is " + lm.name + ", else 0";
     if (sources_[m] == Source::status_code) {

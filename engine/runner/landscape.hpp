@@ -20,8 +20,9 @@ class LandscapeGrid {
   /// Which value a grid takes from a row: a metric column, or a status-derived value.
   enum class Source { column, is_ok, status_code };
   /// The axes (one per dimension; a zipped dimension is named "a+b" and takes the first axis'
-  /// values; string axes take 0..n-1 with the names in the unit field) and the gridded metrics.
-  store::LandscapeSpec spec() const;
+  /// values; string axes take 0..n-1 with the names in the unit field) and the gridded metrics. The
+  /// grids are moved into the spec (no copy of a large block's grids): call once, when done adding.
+  store::LandscapeSpec take_spec();
 
  private:
   const Block& block_;

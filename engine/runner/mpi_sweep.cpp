@@ -80,12 +80,7 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
   OpenedResults opened = open_results(study, schema, out, true, so);
   std::unique_ptr<store::ResultsWriter> writer = std::move(opened.writer);
   PreviousRuns all;
-  if (opened.previous) {
-    all = std::move(*opened.previous);
-  } else {
-    all.done.assign(total, 0);
-    for (std::size_t c = 0; c < schema.columns.size(); ++c) all.columns.emplace_back(total, schema.blank.cells[c]);
-  }
+  if (opened.previous) all = std::move(*opened.previous);
   all.done.resize(total, 0);
 
   const std::vector<std::string> shards = find_shards(out);
@@ -96,16 +91,8 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
     if (r->meta().study_sha256 != study.sha256 || r->n_runs() != static_cast<std::int64_t>(total))
       throw store::StoreError(shards[s], "shard of another study");
     const auto mask = r->done_mask();
-    std::vector<std::uint64_t> ids;
     for (std::uint64_t id = 0; id < total && id < mask.size(); ++id)
-      if (mask[id] && !all.done[id]) ids.push_back(id);
-    if (!ids.empty()) {
-      for (std::size_t c = 0; c < schema.columns.size(); ++c) {
-        std::vector<Cell> col = r->read_column(schema.columns[c].name);
-        for (std::uint64_t id : ids) all.columns[c][id] = std::move(col[id]);
-      }
-      for (std::uint64_t id : ids) all.done[id] = 1, owner[id] = static_cast<std::int32_t>(s);
-    }
+      if (mask[id] && !all.done[id]) all.done[id] = 1, owner[id] = static_cast<std::int32_t>(s);
     readers.push_back(std::move(r));
   }
   const std::uint64_t missing = static_cast<std::uint64_t>(std::count(all.done.begin(), all.done.end(), 0));
@@ -134,11 +121,21 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
         enc[i] = raw[i].arrays.empty() ? store::EncodedHistory{} : store::encode_history(raw[i], level);
       });
     });
+    // The piece's rows, read from each shard that owns some of them (one read per column).
+    std::vector<Record> rows(n);
+    for (std::size_t s = 0; s < readers.size(); ++s) {
+      std::vector<std::int64_t> mine;
+      std::vector<std::size_t> slot;
+      for (std::size_t i = 0; i < n; ++i)
+        if (owner[ids[at + i]] == static_cast<std::int32_t>(s))
+          mine.push_back(static_cast<std::int64_t>(ids[at + i])), slot.push_back(i);
+      if (mine.empty()) continue;
+      std::vector<Record> got = readers[s]->read_rows(mine);
+      for (std::size_t k = 0; k < slot.size(); ++k) rows[slot[k]] = std::move(got[k]);
+    }
     for (std::size_t i = 0; i < n; ++i) {
       const std::uint64_t id = ids[at + i];
-      Record row;
-      row.cells.reserve(all.columns.size());
-      for (const auto& col : all.columns) row.cells.push_back(col[id]);
+      const Record& row = rows[i];
       writer->write_run(static_cast<std::int64_t>(id), row, enc[i]);
       raw[i] = {};
       enc[i] = {};
@@ -189,6 +186,13 @@ class MpiBackend final : public SweepBackend {
     }
     start_ = Clock::now();
     threads_ = rank_threads(r.options.threads);
+    // A signal to any rank during validation: every rank stops before a file is created.
+    int stop = r.options.stop && r.options.stop->load() ? 1 : 0;
+    MPI_Allreduce(MPI_IN_PLACE, &stop, 1, MPI_INT, MPI_MAX, comm_);
+    if (stop) {
+      if (rank_ == 0) err << "kinesweep run: interrupted before " << r.output << " was opened; nothing written\n";
+      return 130;
+    }
     // 1. Rank 0 checks the files and collects the done set; everybody learns it.
     const std::uint64_t total = study.run_count();
     int code = 0;

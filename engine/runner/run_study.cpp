@@ -51,14 +51,27 @@ void check_free_space(const std::string& out, const StudySchema& schema, std::ui
                                      std::to_string(sp.available) + " bytes free; expected more free space "
                                      "(or fewer runs)");
 }
+/// Refuses (StoreError) to resume a file whose /runs columns are not the study's (the same study
+/// text under a kinesweep whose tables differ): its rows could not be read as this schema's.
+void require_same_columns(const std::string& out, const std::vector<ColumnSpec>& file, const StudySchema& schema) {
+  for (std::size_t c = 0; c < std::max(file.size(), schema.columns.size()); ++c) {
+    const ColumnSpec* f = c < file.size() ? &file[c] : nullptr;
+    const ColumnSpec* s = c < schema.columns.size() ? &schema.columns[c] : nullptr;
+    if (f && s && f->name == s->name && f->type == s->type) continue;
+    throw store::StoreError(out, "column " + std::to_string(c) + " of /runs is " + (f ? "'" + f->name + "'" : "absent") +
+                                     ", the study's schema has " + (s ? "'" + s->name + "'" : "none") +
+                                     " (refusing to resume: rerun with --overwrite)");
+  }
+}
 }  // namespace
 
 OpenedResults open_results(const Study& study, const StudySchema& schema, const std::string& out, bool resume,
                            const store::StoreOptions& so) {
   OpenedResults r;
   if (resume && fs::exists(out)) {
-    r.previous = read_previous(out, schema);
     r.writer = std::move(store::ResultsWriter::open_for_resume(out, study.sha256, so).writer);
+    require_same_columns(out, r.writer->columns(), schema);
+    r.previous = previous_runs(*r.writer);
     return r;
   }
   if (!fs::path(out).parent_path().empty()) fs::create_directories(fs::path(out).parent_path());

@@ -104,7 +104,7 @@ class Accumulator {
 
   SweepReport finish(store::ResultsWriter& writer) {
     for (std::size_t b = 0; b < grids_.size(); ++b)
-      if (grids_[b].enabled()) writer.write_landscape(grids_[b].spec());
+      if (grids_[b].enabled()) writer.write_landscape(grids_[b].take_spec());
     for (auto& [id, s] : seed_) report_.seed_rows.push_back(s);
     return std::move(report_);
   }
@@ -156,28 +156,38 @@ class Accumulator {
 
 }  // namespace
 
-PreviousRuns read_previous(const std::string& path, const StudySchema& schema) {
-  store::ResultsReader reader(path);
+PreviousRuns previous_runs(const store::ResultsWriter& writer) {
   PreviousRuns p;
-  p.done = reader.done_mask();
-  for (const ColumnSpec& c : schema.columns) p.columns.push_back(reader.read_column(c.name));
+  p.done.resize(static_cast<std::size_t>(std::max<std::int64_t>(0, writer.n_runs())));
+  for (std::size_t id = 0; id < p.done.size(); ++id) p.done[id] = writer.is_done(static_cast<std::int64_t>(id));
   return p;
 }
+
+namespace {
+/// Feeds the rows of the runs done in `previous` to `acc`, read from `writer` in pieces of
+/// kPiece rows (memory bounded whatever the run count). Returns their number.
+std::uint64_t add_previous(const Study& study, const PreviousRuns& previous, store::ResultsWriter& writer,
+                           Accumulator& acc) {
+  constexpr std::uint64_t kPiece = 8192;
+  const std::uint64_t total = std::min<std::uint64_t>(study.run_count(), previous.done.size());
+  std::uint64_t added = 0;
+  for (std::uint64_t first = 0; first < total; first += kPiece) {
+    const std::uint64_t n = std::min(kPiece, total - first);
+    if (std::none_of(previous.done.begin() + first, previous.done.begin() + first + n, [](auto d) { return d != 0; }))
+      continue;
+    const std::vector<Record> rows = writer.read_rows(static_cast<std::int64_t>(first), static_cast<std::int64_t>(n));
+    for (std::uint64_t i = 0; i < n; ++i)
+      if (previous.done[first + i]) acc.add(first + i, study.locate(first + i), rows[i]), ++added;
+  }
+  return added;
+}
+}  // namespace
 
 SweepReport run_sweep(const Study& study, const StudySchema& schema, store::ResultsWriter& writer,
                       const SweepOptions& options, const PreviousRuns* previous) {
   const std::uint64_t total = study.run_count();
   Accumulator acc(study, schema);
-  std::uint64_t skipped = 0;
-  if (previous) {
-    for (std::uint64_t id = 0; id < total && id < previous->done.size(); ++id) {
-      if (!previous->done[id]) continue;
-      Record r;
-      for (const auto& col : previous->columns) r.cells.push_back(col[id]);
-      acc.add(id, study.locate(id), r);
-      ++skipped;
-    }
-  }
+  const std::uint64_t skipped = previous ? add_previous(study, *previous, writer, acc) : 0;
   const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
   const int stride = options.histories.mode == HistoryPolicy::Mode::none ? 0
                      : options.histories.mode == HistoryPolicy::Mode::every ? options.histories.stride

@@ -70,16 +70,17 @@ struct SweepReport {
   std::vector<SeedRow> seed_rows;  ///< in run-id order (sweeps that ran the seed presets)
 };
 
-/// What a results file already holds, read before resuming (closed again before writing).
+/// Which runs a results file already holds (resume). Their rows are read back from the writer in
+/// pieces, so a resume needs memory for this mask only, whatever the number of runs.
 struct PreviousRuns {
-  std::vector<std::uint8_t> done;           ///< per run id
-  std::vector<std::vector<Cell>> columns;   ///< schema order, one cell per run id
+  std::vector<std::uint8_t> done;  ///< per run id
 };
-/// Read the done mask and every column of an existing results file. Throws store::StoreError.
-PreviousRuns read_previous(const std::string& path, const StudySchema& schema);
+/// The done mask of `writer`'s file (its committed and pending runs).
+PreviousRuns previous_runs(const store::ResultsWriter& writer);
 
 /// Run the runs of a study not done in `previous` (all when null) into `writer`, then write its
-/// landscapes. Throws store::StoreError when the store fails.
+/// landscapes. The rows of the runs done in `previous` are read back from `writer` (their landscape
+/// cells and the report count them). Throws store::StoreError when the store fails.
 SweepReport run_sweep(const Study& study, const StudySchema& schema, store::ResultsWriter& writer,
                       const SweepOptions& options, const PreviousRuns* previous = nullptr);
 

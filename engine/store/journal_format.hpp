@@ -94,4 +94,10 @@ void pause_point(const char* step);
 /// set_error() (another writer holds it: "is being written by another process").
 int acquire_lock(const std::string& jp, const std::function<bool(int jfd)>& init);
 
+/// Removes the temporary files a killed process left beside `name` (a path): `.<base>.tmp-PID-N`
+/// (a results file being created) and `<base>.new-PID-N` (a journal being created), where <base> is
+/// the file name of `name` and process PID no longer exists on this machine. A live process's
+/// temporary files are never touched. Errors are ignored (the files are only clutter).
+void remove_orphans(const std::string& name);
+
 }  // namespace ks::store::detail::journal

@@ -11,6 +11,7 @@
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 
 #include "store/journal_format.hpp"
 
@@ -42,6 +43,33 @@ bool still_named(int jfd, const std::string& jp) {
 }
 }  // namespace
 
+namespace {
+/// The PID in "PID-N" at the start of `rest`, or 0.
+pid_t leading_pid(const std::string& rest) {
+  pid_t pid = 0;
+  std::size_t i = 0;
+  for (; i < rest.size() && rest[i] >= '0' && rest[i] <= '9' && i < 9; ++i) pid = pid * 10 + (rest[i] - '0');
+  return i > 0 && i < rest.size() && rest[i] == '-' ? pid : 0;
+}
+}  // namespace
+
+void remove_orphans(const std::string& name) {
+  namespace fs = std::filesystem;
+  const fs::path p(name);
+  const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+  const std::string base = p.filename().string();
+  const std::string prefixes[] = {"." + base + ".tmp-", base + ".new-"};
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string f = it->path().filename().string();
+    for (const std::string& prefix : prefixes) {
+      if (f.size() <= prefix.size() || f.compare(0, prefix.size(), prefix) != 0) continue;
+      const pid_t pid = leading_pid(f.substr(prefix.size()));
+      if (pid > 0 && ::kill(pid, 0) != 0 && errno == ESRCH) ::unlink(it->path().c_str());
+    }
+  }
+}
+
 int acquire_lock(const std::string& jp, const std::function<bool(int jfd)>& init) {
   const std::string busy = "results file is being written by another process (its journal " + jp + " is locked)";
   for (int round = 0; round < 100; ++round) {
@@ -62,6 +90,7 @@ int acquire_lock(const std::string& jp, const std::function<bool(int jfd)>& init
       set_error("cannot open journal " + jp, errno);
       return -1;
     }
+    remove_orphans(jp);
     const std::string tmp = jp + ".new-" + std::to_string(::getpid()) + "-" + std::to_string(g_tmp_counter++);
     jfd = ::open(tmp.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     if (jfd < 0) {

@@ -1,11 +1,13 @@
 // ResultsReader (see store.hpp, FORMAT.md).
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "store/h5util.hpp"
 #include "store/journal_vfd.hpp"
+#include "store/runs_read.hpp"
 #include "store/store.hpp"
 
 namespace ks::store {
@@ -70,31 +72,17 @@ struct ResultsReader::Impl {
     throw StoreError(path, "no column '" + name + "'");
   }
 
-  /// Reads `count` rows from `first` of a /runs dataset into typed storage.
-  template <class T>
-  std::vector<T> read_num(const std::string& name, hid_t mtype, hsize_t first, hsize_t count) const {
-    std::vector<T> out(count);
-    if (count == 0) return out;
-    Hid d(check(H5Dopen2(file, ("runs/" + name).c_str(), H5P_DEFAULT), path, "open /runs/" + name));
-    Hid fs(H5Dget_space(d));
-    H5Sselect_hyperslab(fs, H5S_SELECT_SET, &first, nullptr, &count, nullptr);
-    Hid ms(H5Screate_simple(1, &count, nullptr));
-    check(H5Dread(d, mtype, ms, fs, H5P_DEFAULT, out.data()), path, "read /runs/" + name);
-    return out;
+  /// Rows `first` .. `first + count` (clamped to n_runs).
+  RowSelection range(std::int64_t first, std::int64_t count) const {
+    if (first < 0 || count < 0) throw StoreError(path, "negative row range");
+    const std::int64_t end = std::min(n_runs, first + std::min(count, n_runs));
+    return {static_cast<hsize_t>(std::min(first, n_runs)), static_cast<hsize_t>(std::max<std::int64_t>(0, end - first))};
   }
-  std::vector<std::string> read_strs(const std::string& name, hsize_t first, hsize_t count) const {
-    std::vector<std::string> out;
-    if (count == 0) return out;
-    Hid d(check(H5Dopen2(file, ("runs/" + name).c_str(), H5P_DEFAULT), path, "open /runs/" + name));
-    Hid fs(H5Dget_space(d));
-    H5Sselect_hyperslab(fs, H5S_SELECT_SET, &first, nullptr, &count, nullptr);
-    Hid ms(H5Screate_simple(1, &count, nullptr));
-    Hid t(utf8_vlen_type());
-    VlenStrings strs(t, ms, count);
-    check(H5Dread(d, t, ms, fs, H5P_DEFAULT, strs.data()), path, "read /runs/" + name);
-    out.reserve(count);
-    for (char* p : strs.ptrs) out.emplace_back(p ? p : "");
-    return out;
+  const ColumnSpec& typed(const std::string& name, CellType type) const {
+    const ColumnSpec& c = column(name);
+    static const char* names[] = {"f64", "i64", "str"};
+    if (c.type != type) throw StoreError(path, "column " + name + " is not " + names[static_cast<int>(type)]);
+    return c;
   }
 };
 
@@ -163,25 +151,26 @@ const StoreMeta& ResultsReader::meta() const { return impl_->meta; }
 const std::vector<ColumnSpec>& ResultsReader::columns() const { return impl_->columns; }
 std::int64_t ResultsReader::n_runs() const { return impl_->n_runs; }
 
-std::vector<std::uint8_t> ResultsReader::done_mask() const {
+std::vector<std::uint8_t> ResultsReader::done_mask(std::int64_t first, std::int64_t count) const {
   QuietHdf5 quiet;
-  return impl_->read_num<std::uint8_t>("done", H5T_NATIVE_UINT8, 0, static_cast<hsize_t>(impl_->n_runs));
+  return read_runs_column<std::uint8_t>(impl_->file, impl_->path, "done", H5T_NATIVE_UINT8, impl_->range(first, count));
 }
-
-std::vector<double> ResultsReader::read_f64(const std::string& name) const {
+std::vector<double> ResultsReader::read_f64(const std::string& name, std::int64_t first, std::int64_t count) const {
   QuietHdf5 quiet;
-  if (impl_->column(name).type != CellType::f64) throw StoreError(impl_->path, "column " + name + " is not f64");
-  return impl_->read_num<double>(name, H5T_NATIVE_DOUBLE, 0, static_cast<hsize_t>(impl_->n_runs));
+  impl_->typed(name, CellType::f64);
+  return read_runs_column<double>(impl_->file, impl_->path, name, H5T_NATIVE_DOUBLE, impl_->range(first, count));
 }
-std::vector<std::int64_t> ResultsReader::read_i64(const std::string& name) const {
+std::vector<std::int64_t> ResultsReader::read_i64(const std::string& name, std::int64_t first,
+                                                  std::int64_t count) const {
   QuietHdf5 quiet;
-  if (impl_->column(name).type != CellType::i64) throw StoreError(impl_->path, "column " + name + " is not i64");
-  return impl_->read_num<std::int64_t>(name, H5T_NATIVE_INT64, 0, static_cast<hsize_t>(impl_->n_runs));
+  impl_->typed(name, CellType::i64);
+  return read_runs_column<std::int64_t>(impl_->file, impl_->path, name, H5T_NATIVE_INT64, impl_->range(first, count));
 }
-std::vector<std::string> ResultsReader::read_str(const std::string& name) const {
+std::vector<std::string> ResultsReader::read_str(const std::string& name, std::int64_t first,
+                                                 std::int64_t count) const {
   QuietHdf5 quiet;
-  if (impl_->column(name).type != CellType::str) throw StoreError(impl_->path, "column " + name + " is not str");
-  return impl_->read_strs(name, 0, static_cast<hsize_t>(impl_->n_runs));
+  impl_->typed(name, CellType::str);
+  return read_runs_strings(impl_->file, impl_->path, name, impl_->range(first, count));
 }
 
 std::vector<Cell> ResultsReader::read_column(const std::string& name) const {
@@ -194,21 +183,23 @@ std::vector<Cell> ResultsReader::read_column(const std::string& name) const {
   return out;
 }
 
-Record ResultsReader::read_record(std::int64_t run_id) const {
+std::vector<Record> ResultsReader::read_rows(std::int64_t first, std::int64_t count) const {
   QuietHdf5 quiet;
+  return read_runs_rows(impl_->file, impl_->path, impl_->columns, impl_->range(first, count));
+}
+std::vector<Record> ResultsReader::read_rows(const std::vector<std::int64_t>& ids) const {
+  QuietHdf5 quiet;
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    if (ids[i] < 0 || ids[i] >= impl_->n_runs || (i && ids[i] <= ids[i - 1]))
+      throw StoreError(impl_->path, "run ids to read must ascend within 0.." + std::to_string(impl_->n_runs - 1));
+  RowSelection sel;
+  sel.ids = &ids;
+  return read_runs_rows(impl_->file, impl_->path, impl_->columns, sel);
+}
+
+Record ResultsReader::read_record(std::int64_t run_id) const {
   if (run_id < 0 || run_id >= impl_->n_runs) throw StoreError(impl_->path, "run id out of range");
-  Record r;
-  const hsize_t at = static_cast<hsize_t>(run_id);
-  for (auto& c : impl_->columns) {
-    switch (c.type) {
-      case CellType::f64: r.cells.emplace_back(impl_->read_num<double>(c.name, H5T_NATIVE_DOUBLE, at, 1)[0]); break;
-      case CellType::i64:
-        r.cells.emplace_back(impl_->read_num<std::int64_t>(c.name, H5T_NATIVE_INT64, at, 1)[0]);
-        break;
-      case CellType::str: r.cells.emplace_back(impl_->read_strs(c.name, at, 1)[0]); break;
-    }
-  }
-  return r;
+  return std::move(read_rows(run_id, 1).front());
 }
 
 bool ResultsReader::has_history(std::int64_t run_id) const {

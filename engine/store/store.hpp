@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -186,6 +187,9 @@ class ResultsWriter {
   const std::vector<ColumnSpec>& columns() const;
   std::int64_t n_runs() const;
   bool is_done(std::int64_t run_id) const;  ///< committed or pending
+  /// Rows `first` .. `first + count` (clamped to n_runs) as they are in the file, pending rows
+  /// included (written to their datasets first, without a commit): what a resumed sweep already holds.
+  std::vector<Record> read_rows(std::int64_t first, std::int64_t count);
   std::size_t pending() const;              ///< runs written since the last flush
 
  private:
@@ -231,11 +235,18 @@ class ResultsReader {
   const StoreMeta& meta() const;
   const std::vector<ColumnSpec>& columns() const;  ///< schema order, with role and kinds
   std::int64_t n_runs() const;
-  std::vector<std::uint8_t> done_mask() const;
+  /// Reads of /runs take all rows, or `count` rows from `first` (clamped to n_runs), so a caller
+  /// can stream a large file in pieces of bounded memory.
+  static constexpr std::int64_t kAll = std::numeric_limits<std::int64_t>::max();
+  std::vector<std::uint8_t> done_mask(std::int64_t first = 0, std::int64_t count = kAll) const;
   std::vector<Cell> read_column(const std::string& name) const;
-  std::vector<double> read_f64(const std::string& name) const;
-  std::vector<std::int64_t> read_i64(const std::string& name) const;
-  std::vector<std::string> read_str(const std::string& name) const;
+  std::vector<double> read_f64(const std::string& name, std::int64_t first = 0, std::int64_t count = kAll) const;
+  std::vector<std::int64_t> read_i64(const std::string& name, std::int64_t first = 0, std::int64_t count = kAll) const;
+  std::vector<std::string> read_str(const std::string& name, std::int64_t first = 0, std::int64_t count = kAll) const;
+  /// Rows `first` .. `first + count` (clamped), every column in schema order.
+  std::vector<Record> read_rows(std::int64_t first, std::int64_t count) const;
+  /// The rows of `ids` (ascending run ids), every column in schema order (one read per column).
+  std::vector<Record> read_rows(const std::vector<std::int64_t>& ids) const;
   Record read_record(std::int64_t run_id) const;
   bool has_history(std::int64_t run_id) const;
   RunHistory read_history(std::int64_t run_id) const;  ///< empty when the run has none

@@ -18,6 +18,7 @@
 #include "store/h5util.hpp"
 #include "store/journal_format.hpp"
 #include "store/journal_vfd.hpp"
+#include "store/runs_read.hpp"
 #include "store/store.hpp"
 #include "store/writer_impl.hpp"
 
@@ -187,6 +188,7 @@ std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, co
   fs::path p(path);
   std::string dir = p.parent_path().empty() ? std::string(".") : p.parent_path().string();
   static std::atomic<unsigned> counter{0};
+  journal::remove_orphans(path);  // a killed creation's temporary file (its process is gone)
   const std::string tmp = (fs::path(dir) / ("." + p.filename().string() + ".tmp-" + std::to_string(::getpid()) +
                                             "-" + std::to_string(counter++)))
                               .string();
@@ -267,6 +269,17 @@ bool ResultsWriter::is_done(std::int64_t id) const {
   return id >= 0 && id < impl_->n_runs && impl_->done[static_cast<std::size_t>(id)] != 0;
 }
 std::size_t ResultsWriter::pending() const { return impl_->pending.size() + impl_->unflagged.size(); }
+
+std::vector<Record> ResultsWriter::read_rows(std::int64_t first, std::int64_t count) {
+  QuietHdf5 quiet;
+  impl_->usable();
+  if (first < 0 || count < 0) throw StoreError(impl_->path, "negative row range");
+  first = std::min(first, impl_->n_runs);
+  count = std::min(count, impl_->n_runs - first);
+  impl_->write_rows();
+  return read_runs_rows(impl_->file, impl_->path, impl_->columns,
+                        {static_cast<hsize_t>(first), static_cast<hsize_t>(count)});
+}
 
 
 void ResultsWriter::write_run(std::int64_t run_id, const Record& record, const RunHistory& history, int level) {

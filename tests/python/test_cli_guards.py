@@ -96,6 +96,28 @@ class Resources(TempDirTest):
             self.assertEqual(os.listdir(mnt), [])
 
 
+class ResumeMemory(TempDirTest):
+    def test_resume_of_a_2_million_run_file_stays_under_300_mb(self):
+        # The done runs' rows are read back in pieces: memory for a done mask, not for the rows.
+        study = self.write("big.toml", "[study]\nhistories = \"none\"\n[[block]]\nname = \"b\"\nkind = \"ik\"\n"
+                                       "max_iter = 1\n[block.axes]\nq0_1 = { from = 0, to = 1, count = 2000 }\n"
+                                       "q0_2 = { from = 0, to = 1, count = 1000 }\n")
+        out = os.path.join(self.dir, "big.h5")
+        self.assertEqual(run("run", study, "-o", out, "-q").returncode, 0)
+        with tempfile.TemporaryFile("w+") as err, tempfile.TemporaryFile("w+") as log:
+            p = subprocess.Popen([KS, "run", study, "-o", out, "-q", "--resume"], stdout=log, stderr=err)
+            _, status, usage = os.wait4(p.pid, 0)
+            err.seek(0)
+            log.seek(0)
+            self.assertEqual(os.waitstatus_to_exitcode(status), 0, err.read())
+            self.assertIn("2000000 runs (0 computed now, 2000000 already in the file)", log.read())
+        self.assertLess(usage.ru_maxrss * 1024, 300 * 2**20)
+        with h5py.File(out, "r") as f:  # the landscape rewritten from the rows read back
+            grid = f["landscapes/b/iterations"][()]
+            self.assertEqual(grid.shape, (2000, 1000))
+            self.assertTrue((grid.ravel() == f["runs/iterations"][()]).all())
+
+
 class Tmpfs:
     """A small tmpfs mounted for one test (the test is skipped where mounting is not permitted)."""
 

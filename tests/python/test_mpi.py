@@ -174,6 +174,28 @@ class KillOneRank(Base):
         self.assertEqual(glob.glob(out + ".rank*"), [])
 
 
+class SignalBeforeTheSweep(Base):
+    def test_sigterm_to_the_ranks_before_the_sweep_exits_130_with_nothing_written(self):
+        study = self.write("s.toml", SWEEP)
+        out = os.path.join(self.dir, "s.h5")
+        env = dict(os.environ, KINESWEEP_TEST_PAUSE_BEFORE_SWEEP="1")
+        p = subprocess.Popen([*MPIRUN, KS, "run", study, "-o", out, "-q"], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, env=env)
+        pids, deadline = [], time.time() + 60
+        while time.time() < deadline and len(pids) < 2:
+            pids = [pid for pid in (rank_pid(p.pid, 0), rank_pid(p.pid, 1)) if pid]
+            time.sleep(0.05)
+        self.assertEqual(len(pids), 2, "ranks not found")
+        lines = [p.stderr.readline(), p.stderr.readline()]  # both ranks validated the study and wait
+        self.assertTrue(all("paused before the sweep" in line for line in lines), lines)
+        os.kill(pids[1], signal.SIGTERM)  # one rank's signal stops every rank
+        os.kill(pids[0], signal.SIGTERM)
+        _, stderr = p.communicate(timeout=120)
+        self.assertEqual(p.returncode, 130, stderr)
+        self.assertIn("nothing written", stderr)
+        self.assertEqual(sorted(os.listdir(self.dir)), ["s.toml"])
+
+
 class OptimizationBlocks(Base):
     def test_mpirun_runs_the_optimize_blocks_like_one_process(self):
         """[[optimize]] blocks run under mpirun (on rank 0, after the merge) and give the single
