@@ -5,6 +5,8 @@
 #include <cmath>
 #include <iostream>
 #include <iomanip>
+#include <limits>
+#include <tuple>
 #include <map>
 #include <sstream>
 
@@ -16,11 +18,19 @@ namespace ks::cli {
 
 namespace {
 
+/// A block's rows as info summarises them, gathered piece by piece (bounded memory).
 struct BlockSummary {
   std::string name, kind;
-  std::vector<std::int64_t> rows;  ///< all rows of the block (done or not)
-  std::int64_t done = 0;
+  std::int64_t rows = 0;  ///< all rows of the block (done or not)
+  std::int64_t done = 0, good = 0;  ///< good: done runs whose status is ok / converged
   std::vector<std::pair<std::string, std::int64_t>> statuses;  ///< first-seen order
+  struct Candidate {
+    double key, tie;
+    std::int64_t run;
+  };
+  std::vector<Candidate> best;  ///< the lowest (key, tie, run id) among its good runs, at most --best
+  RunsTable first;              ///< its first done row (parameters that differ from it vary)
+  std::vector<bool> varies;     ///< per column
 };
 
 std::string cell_for_humans(const RunsColumn& c, std::int64_t r) {
@@ -32,11 +42,12 @@ std::string cell_for_humans(const RunsColumn& c, std::int64_t r) {
   return "";
 }
 
-bool same(const RunsColumn& c, std::int64_t a, std::int64_t b) {
+/// Equal values of two rows (NaN equals NaN), each in its own table.
+bool same(const RunsColumn& c, std::int64_t a, const RunsColumn& d, std::int64_t b) {
   switch (c.type) {
-    case CellType::str: return c.s[a] == c.s[b];
-    case CellType::i64: return c.i[a] == c.i[b];
-    case CellType::f64: return c.f[a] == c.f[b] || (std::isnan(c.f[a]) && std::isnan(c.f[b]));
+    case CellType::str: return c.s[a] == d.s[b];
+    case CellType::i64: return c.i[a] == d.i[b];
+    case CellType::f64: return c.f[a] == d.f[b] || (std::isnan(c.f[a]) && std::isnan(d.f[b]));
   }
   return true;
 }
@@ -202,12 +213,91 @@ std::string axis_text(const store::LandscapeAxis& a) {
   return o.str();
 }
 
+/// Ranking key of a row for "best rows": iterations (ik) or E (trajectory); NaN sorts last.
+double rank_value(const RunsColumn* c, std::int64_t r) {
+  if (!c) return 0.0;
+  const double v = c->type == CellType::i64 ? static_cast<double>(c->i[r]) : c->f[r];
+  return std::isnan(v) ? std::numeric_limits<double>::infinity() : v;
+}
+
 int run_info(const InfoArgs& args) {
   store::ResultsReader reader(args.file, v1_column_roles);
-  const RunsTable t = load_runs(reader);
+  RunsTable t = runs_header(reader);
   const store::StoreMeta& m = t.meta;
   std::ostream& os = std::cout;
-  const auto n_done = std::count(t.done.begin(), t.done.end(), std::uint8_t{1});
+  const std::size_t n_best = static_cast<std::size_t>(std::max(0, args.best));
+  const std::int64_t n_runs = reader.n_runs();
+
+  // One pass over the rows, piece by piece: blocks in run-id order, status counts, best rows, the
+  // parameters that vary, and which done runs hold a history.
+  std::vector<BlockSummary> blocks;
+  std::int64_t n_done = 0, with = 0, first_h = -1, last_h = -1;
+  std::map<std::string, std::int64_t> example;  // kind -> a run with a history
+  const RunsColumn* block = t.find("block");
+  const RunsColumn* status = t.find("status");
+  const bool consistent = for_each_piece(reader, t, [&](const RunsTable& p) {
+    for (std::int64_t r = 0; r < p.n_runs; ++r) {
+      const std::int64_t id = p.row_id(r);
+      const std::string name = block ? block->s[r] : std::string("(all)");
+      const bool is_done = p.done[static_cast<std::size_t>(r)] != 0;
+      if (name.empty() && !is_done) {  // a pending row holds no block name: count it apart
+        if (blocks.empty() || blocks.back().name != "(pending)") blocks.push_back({"(pending)", "", 0, 0, 0, {}, {}, {}, {}});
+        ++blocks.back().rows;
+        continue;
+      }
+      auto it = std::find_if(blocks.begin(), blocks.end(), [&](const BlockSummary& b) { return b.name == name; });
+      if (it == blocks.end()) {
+        blocks.push_back({name, "", 0, 0, 0, {}, {}, {}, {}});
+        it = blocks.end() - 1;
+      }
+      BlockSummary& b = *it;
+      ++b.rows;
+      if (!is_done) continue;
+      ++n_done;
+      ++b.done;
+      if (b.kind.empty()) b.kind = p.kind(r);
+      const std::string st = status ? status->s[r] : "";
+      auto s = std::find_if(b.statuses.begin(), b.statuses.end(), [&](auto& x) { return x.first == st; });
+      if (s == b.statuses.end()) b.statuses.push_back({st, 1});
+      else ++s->second;
+      // Parameters that differ from the block's first done row.
+      if (b.first.cols.empty()) {
+        b.first = runs_header(reader);
+        append_row(b.first, p, r, std::vector<bool>(p.cols.size(), true));
+        b.varies.assign(p.cols.size(), false);
+      }
+      for (std::size_t c = 0; c < p.cols.size(); ++c)
+        if (!b.varies[c] && p.cols[c].role == Role::parameter && !same(p.cols[c], r, b.first.cols[c], 0))
+          b.varies[c] = true;
+      // Best rows: trajectory lowest E among ok runs; ik fewest iterations among converged, then error.
+      const bool ik = b.kind == "ik";
+      auto metric = [&](const char* mname) {  // a metric column of the block's kind, or null
+        const RunsColumn* c = p.find(mname);
+        return c && c->role == Role::metric && c->applies_to(b.kind) ? c : nullptr;
+      };
+      if ((ik || b.kind == "trajectory") && st == (ik ? "converged" : "ok")) {
+        const RunsColumn* key = metric(ik ? "iterations" : "E");
+        if (key) ++b.good;
+        if (key && n_best > 0) {
+          const BlockSummary::Candidate c{rank_value(key, r), rank_value(ik ? metric("error") : nullptr, r), id};
+          auto less = [](const BlockSummary::Candidate& x, const BlockSummary::Candidate& y) {
+            return std::tie(x.key, x.tie, x.run) < std::tie(y.key, y.tie, y.run);
+          };
+          if (b.best.size() < n_best || less(c, b.best.back())) {
+            b.best.insert(std::upper_bound(b.best.begin(), b.best.end(), c, less), c);
+            if (b.best.size() > n_best) b.best.pop_back();
+          }
+        }
+      }
+      if (reader.has_history(id)) {
+        ++with;
+        if (first_h < 0) first_h = id;
+        last_h = id;
+        example.emplace(p.kind(r), id);
+      }
+    }
+  });
+
   os << "file        " << args.file << '\n';
   os << "study       " << m.study_name << (m.study_path.empty() ? "" : "  (source " + m.study_path + ")") << '\n';
   if (m.robot_text.empty()) {
@@ -221,37 +311,11 @@ int run_info(const InfoArgs& args) {
   if (m.format_version < store::kFormatVersion)
     os << "note        format v" << m.format_version << " stores no column roles: taken from this kinesweep's "
        << "tables (kinesweep run --overwrite rewrites the file as v" << store::kFormatVersion << ")\n";
-  os << "runs        " << n_done << " of " << t.n_runs << " done";
-  if (n_done < t.n_runs) os << " (" << (t.n_runs - n_done) << " pending: a sweep is running, was interrupted, or resume is needed)";
+  os << "runs        " << n_done << " of " << n_runs << " done";
+  if (n_done < n_runs) os << " (" << (n_runs - n_done) << " pending: a sweep is running, was interrupted, or resume is needed)";
   os << '\n';
-  if (!t.consistent) os << "note        the file kept changing while it was read (a sweep is writing it)\n";
+  if (!consistent) os << "note        the file kept changing while it was read (a sweep is writing it)\n";
 
-  // Blocks in run-id order.
-  std::vector<BlockSummary> blocks;
-  const RunsColumn* block = t.find("block");
-  const RunsColumn* status = t.find("status");
-  for (std::int64_t r = 0; r < t.n_runs; ++r) {
-    const std::string name = block ? block->s[r] : std::string("(all)");
-    const bool is_done = t.done[static_cast<std::size_t>(r)] != 0;
-    if (name.empty() && !is_done) {  // a pending row holds no block name: count it apart
-      if (blocks.empty() || blocks.back().name != "(pending)") blocks.push_back({"(pending)", "", {}, 0, {}});
-      blocks.back().rows.push_back(r);
-      continue;
-    }
-    auto it = std::find_if(blocks.begin(), blocks.end(), [&](const BlockSummary& b) { return b.name == name; });
-    if (it == blocks.end()) {
-      blocks.push_back({name, "", {}, 0, {}});
-      it = blocks.end() - 1;
-    }
-    it->rows.push_back(r);
-    if (!is_done) continue;
-    ++it->done;
-    if (it->kind.empty()) it->kind = t.kind(r);
-    const std::string st = status ? status->s[r] : "";
-    auto s = std::find_if(it->statuses.begin(), it->statuses.end(), [&](auto& p) { return p.first == st; });
-    if (s == it->statuses.end()) it->statuses.push_back({st, 1});
-    else ++s->second;
-  }
   std::size_t wn = 5;
   for (auto& b : blocks) wn = std::max(wn, b.name.size());
   os << '\n' << std::left;
@@ -259,62 +323,45 @@ int run_info(const InfoArgs& args) {
      << "runs" << std::setw(9) << "done" << "  status\n";
   for (auto& b : blocks) {
     os << std::left << std::setw(static_cast<int>(wn)) << b.name << "  " << std::setw(10) << b.kind << std::right
-       << std::setw(9) << b.rows.size() << std::setw(9) << b.done << "  ";
-    std::sort(b.statuses.begin(), b.statuses.end(), [](auto& x, auto& y) { return x.second > y.second; });
+       << std::setw(9) << b.rows << std::setw(9) << b.done << "  ";
+    std::stable_sort(b.statuses.begin(), b.statuses.end(), [](auto& x, auto& y) { return x.second > y.second; });
     for (std::size_t i = 0; i < b.statuses.size(); ++i)
       os << (i ? ", " : "") << b.statuses[i].first << " " << b.statuses[i].second;
     os << '\n';
   }
 
-  // Best rows per block.
+  // Best rows per block: the candidates' rows read back by run id.
   os << "\nbest rows per block (trajectory: lowest E among ok runs; ik: fewest iterations among converged runs,\n"
         "then smallest error)\n";
   for (const auto& b : blocks) {
     if (b.done == 0 || b.name == "(pending)") continue;
     const bool ik = b.kind == "ik";
     if (!ik && b.kind != "trajectory") continue;  // no ranking defined for another kind
-    auto metric = [&](const char* name) {  // a metric column of the block's kind, or null
+    auto metric = [&](const char* name) {
       const RunsColumn* c = t.find(name);
       return c && c->role == Role::metric && c->applies_to(b.kind) ? c : nullptr;
     };
     const RunsColumn* key = metric(ik ? "iterations" : "E");
     const RunsColumn* tie = ik ? metric("error") : nullptr;
-    const std::string good = ik ? "converged" : "ok";
     if (!key || !status) continue;
-    std::vector<std::int64_t> cand;
-    for (auto r : b.rows)
-      if (t.done[static_cast<std::size_t>(r)] && status->s[r] == good) cand.push_back(r);
-    auto val = [&](const RunsColumn* c, std::int64_t r) {
-      return c->type == CellType::i64 ? static_cast<double>(c->i[r]) : c->f[r];
-    };
-    std::stable_sort(cand.begin(), cand.end(), [&](std::int64_t x, std::int64_t y) {
-      const double u = val(key, x), v = val(key, y);
-      if (u != v) return u < v;
-      return tie ? val(tie, x) < val(tie, y) : false;
-    });
-    // Parameters that vary within the block identify a row.
-    std::vector<const RunsColumn*> varying;
-    for (const auto& c : t.cols) {
-      if (c.role != Role::parameter || !c.applies_to(b.kind)) continue;
-      for (auto r : b.rows)
-        if (t.done[static_cast<std::size_t>(r)] && !same(c, r, b.rows.front())) {
-          varying.push_back(&c);
-          break;
-        }
-    }
-    if (cand.empty()) {
-      os << "  " << b.name << ": no " << good << " run\n";
+    if (b.good == 0) {
+      os << "  " << b.name << ": no " << (ik ? "converged" : "ok") << " run\n";
       continue;
     }
-    for (std::size_t i = 0; i < cand.size() && i < static_cast<std::size_t>(std::max(0, args.best)); ++i) {
-      const auto r = cand[i];
+    std::vector<std::int64_t> ids;
+    for (const auto& c : b.best) ids.push_back(c.run);
+    std::vector<std::int64_t> sorted = ids;
+    std::sort(sorted.begin(), sorted.end());
+    load_ids(reader, t, sorted);
+    for (const std::int64_t id : ids) {
+      const auto r = static_cast<std::int64_t>(std::lower_bound(sorted.begin(), sorted.end(), id) - sorted.begin());
       os << "  " << std::left << std::setw(static_cast<int>(wn)) << b.name << std::right << "  run " << std::setw(6)
-         << r << "  " << key->name << " = " << cell_for_humans(*key, r) << (key->unit.empty() ? "" : " " + key->unit);
+         << id << "  " << key->name << " = " << cell_for_humans(*key, r) << (key->unit.empty() ? "" : " " + key->unit);
       if (tie) os << ", error = " << cell_for_humans(*tie, r) << " " << tie->unit;
       std::string label;  // the varying parameters that have an effect on this row (the tables' rules)
-      for (const RunsColumn* c : varying)
-        if (has_effect_in_row(t, b.kind, *c, r))
-          label += (label.empty() ? "" : ", ") + c->name + " = " + cell_for_humans(*c, r);
+      for (std::size_t c = 0; c < t.cols.size(); ++c)
+        if (b.varies[c] && t.cols[c].applies_to(b.kind) && has_effect_in_row(t, b.kind, t.cols[c], r))
+          label += (label.empty() ? "" : ", ") + t.cols[c].name + " = " + cell_for_humans(t.cols[c], r);
       if (!label.empty()) os << "   (" << label << ")";
       os << '\n';
     }
@@ -322,26 +369,12 @@ int run_info(const InfoArgs& args) {
 
   // Histories: which runs hold one, and the arrays of each kind.
   os << '\n';
-  std::int64_t with = 0, first = -1, last = -1;
-  std::map<std::string, std::int64_t> example;  // kind -> a run with a history
-  consistent_read(reader, [&] {
-    with = 0, first = last = -1;
-    example.clear();
-    for (std::int64_t r = 0; r < t.n_runs; ++r) {
-      if (!t.done[static_cast<std::size_t>(r)] || !reader.has_history(r)) continue;
-      ++with;
-      if (first < 0) first = r;
-      last = r;
-      example.emplace(t.kind(r), r);
-    }
-    return 0;
-  });
   print_columns(t, os);
   os << "histories   ";
   if (with == 0) {
     os << "none\n";
   } else {
-    os << with << " of " << n_done << " done runs (run ids " << first << " .. " << last
+    os << with << " of " << n_done << " done runs (run ids " << first_h << " .. " << last_h
        << "); kinesweep query FILE --run ID --history NAME\n";
     for (auto& [kind, run] : example) {
       const std::int64_t r = run;  // a plain variable: a lambda cannot capture a structured binding (C++17/20)

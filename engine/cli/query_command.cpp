@@ -147,14 +147,36 @@ int optimization_mode(const QueryArgs& a, store::ResultsReader& reader, Format f
   return table_mode(a, evaluations_table(o), fmt, w);
 }
 
+/// Rows of /runs: the file is read in pieces; the rows that pass --where (and are done, unless
+/// --include-pending) are gathered with the columns the query reads, then filtered, sorted and
+/// printed by table_mode. Memory: the matching rows' needed columns, not the file's.
 int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
-  const RunsTable t = load_runs(reader);
-  if (!t.consistent)
-    std::cerr << "kinesweep query: note: the file kept changing while it was read (a sweep is writing it)\n";
+  RunsTable t = runs_header(reader);
   TableWording w;
-  const auto done = std::count(t.done.begin(), t.done.end(), std::uint8_t{1});
-  w.summary = std::to_string(done) + " of " + std::to_string(t.n_runs) + " runs done";
-  return table_mode(a, t, fmt, w);
+  std::vector<Disjunction> filters;
+  for (const auto& expr : a.where) filters.push_back(parse_where(expr, t));
+  const std::vector<Condition> conds = all_conditions(filters);
+  const std::vector<bool> take = columns_read(a, t, fmt, w);
+  RunsTable g = runs_header(reader);
+  HeldValues held;
+  std::int64_t done = 0;
+  const Selector sel{t, a.radians};
+  const bool consistent = for_each_piece(reader, t, [&](const RunsTable& p) {
+    collect_held(conds, p, a.include_pending, held);
+    for (std::int64_t r = 0; r < p.n_runs; ++r) {
+      const bool is_done = p.done[static_cast<std::size_t>(r)] != 0;
+      done += is_done;
+      if (!a.include_pending && !is_done) continue;
+      if (std::all_of(filters.begin(), filters.end(), [&](const Disjunction& d) { return sel.test(d, r); }))
+        append_row(g, p, r, take);
+    }
+  });
+  if (!consistent)
+    std::cerr << "kinesweep query: note: the file kept changing while it was read (a sweep is writing it)\n";
+  for (const std::string& note : unheld_value_notes(conds, held)) std::cerr << "kinesweep query: note: " << note << '\n';
+  w.notes_said = true;
+  w.summary = std::to_string(done) + " of " + std::to_string(reader.n_runs()) + " runs done";
+  return table_mode(a, g, fmt, w);
 }
 
 }  // namespace

@@ -250,13 +250,44 @@ int group_mode(const QueryArgs& a, const RunsTable& t, Format fmt, const std::ve
 
 }  // namespace
 
+std::vector<bool> columns_read(const QueryArgs& a, const RunsTable& t, Format fmt, const TableWording& wording) {
+  std::vector<bool> take(t.cols.size(), false);
+  auto mark = [&](const std::string& name, const char* where) {
+    const RunsColumn* c = t.find(name);
+    if (!c) throw ArgError(unknown_column_message(name, t, where));
+    take[static_cast<std::size_t>(c - t.cols.data())] = true;
+  };
+  for (const auto& w : a.where)
+    for (const Condition& k : all_conditions({parse_where(w, t)})) take[static_cast<std::size_t>(k.col - t.cols.data())] = true;
+  for (const SortKey& k : parse_sort(a, t)) take[static_cast<std::size_t>(k.col - t.cols.data())] = true;
+  for (const std::string& name : split(a.group_by, ','))
+    if (!name.empty()) mark(name, " in --group-by");
+  if (!a.group_by.empty())
+    for (const AggSpec& s : parse_agg(a.agg, t))
+      if (s.col) take[static_cast<std::size_t>(s.col - t.cols.data())] = true;
+  if (t.find("run_id")) mark("run_id", "");
+  const bool all = a.columns == "all" || (a.columns.empty() && (fmt != Format::table || !wording.compact_default));
+  for (std::size_t c = 0; c < t.cols.size(); ++c) {
+    const RunsColumn& col = t.cols[c];
+    if (all) take[c] = true;
+    if (a.columns.empty() && a.group_by.empty() &&
+        (col.role != Role::bookkeeping || col.name == "block" || col.name == "status"))
+      take[c] = true;  // the compact default's candidates, and what a row's kind is read from
+  }
+  if (!all && a.group_by.empty())
+    for (const std::string& name : split(a.columns, ','))
+      if (!name.empty()) mark(name, " in --columns");
+  return take;
+}
+
 int table_mode(const QueryArgs& a, const RunsTable& t, Format fmt, const TableWording& wording) {
   Selector sel{t, a.radians};
   std::vector<Disjunction> filters;
   for (const auto& w : a.where) filters.push_back(parse_where(w, t));
   const std::vector<Condition> conds = all_conditions(filters);
-  for (const std::string& note : unheld_value_notes(conds, t, a.include_pending))
-    std::cerr << "kinesweep query: note: " << note << '\n';
+  if (!wording.notes_said)
+    for (const std::string& note : unheld_value_notes(conds, t, a.include_pending))
+      std::cerr << "kinesweep query: note: " << note << '\n';
   std::set<const RunsColumn*> mentioned;
   for (const Condition& c : conds) mentioned.insert(c.col);
   const std::vector<SortKey> keys = parse_sort(a, t);

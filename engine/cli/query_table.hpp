@@ -13,7 +13,13 @@ struct TableWording {
   std::string rows = "matching rows";  ///< "(3 of 10 matching rows; ...)"
   std::string summary;                 ///< the trailer's second part, e.g. "8 of 10 runs done"
   bool compact_default = true;         ///< table format without --columns: run_id, varying parameters, key metrics
+  bool notes_said = false;             ///< the caller printed the --where value notes (over rows `t` lacks)
 };
+
+/// The columns table_mode reads for these arguments (by index into t.cols): the ones it filters,
+/// sorts, groups, aggregates and prints; for the compact default, every parameter and metric (the
+/// row kinds and the varying parameters decide what it prints). Throws ArgError on an unknown name.
+std::vector<bool> columns_read(const QueryArgs& a, const RunsTable& t, Format fmt, const TableWording& wording);
 
 /// Filter, sort and print `t` (or its groups, with --group-by) as the arguments say.
 /// Throws ArgError on a bad argument.

@@ -91,37 +91,97 @@ void v1_column_roles(std::vector<ColumnSpec>& columns) {
   }
 }
 
-RunsTable load_runs(store::ResultsReader& reader) {
-  return consistent_read(reader, [&] {
-    RunsTable t;
-    t.meta = reader.meta();
-    t.n_runs = reader.n_runs();
-    t.done = reader.done_mask();  // before the columns: a row done here is complete in them
-    for (const ColumnSpec& spec : reader.columns()) {
-      RunsColumn c;
-      c.name = spec.name;
-      c.unit = spec.unit;
-      c.description = spec.description;
-      c.type = spec.type;
-      c.role = spec.role;
-      for (std::size_t at = 0; at < spec.kinds.size();) {  // "trajectory,ik" -> {"trajectory", "ik"}
-        std::size_t comma = spec.kinds.find(',', at);
-        if (comma == std::string::npos) comma = spec.kinds.size();
-        if (comma > at) c.kinds.push_back(spec.kinds.substr(at, comma - at));
-        at = comma + 1;
+RunsTable runs_header(store::ResultsReader& reader) {
+  RunsTable t;
+  t.meta = reader.meta();
+  for (const ColumnSpec& spec : reader.columns()) {
+    RunsColumn c;
+    c.name = spec.name;
+    c.unit = spec.unit;
+    c.description = spec.description;
+    c.type = spec.type;
+    c.role = spec.role;
+    for (std::size_t at = 0; at < spec.kinds.size();) {  // "trajectory,ik" -> {"trajectory", "ik"}
+      std::size_t comma = spec.kinds.find(',', at);
+      if (comma == std::string::npos) comma = spec.kinds.size();
+      if (comma > at) c.kinds.push_back(spec.kinds.substr(at, comma - at));
+      at = comma + 1;
+    }
+    for (const auto& k : c.kinds)
+      if (std::find(t.kinds.begin(), t.kinds.end(), k) == t.kinds.end()) t.kinds.push_back(k);
+    t.cols.push_back(std::move(c));
+  }
+  return t;
+}
+
+void load_piece(store::ResultsReader& reader, RunsTable& t, std::int64_t first, std::int64_t count) {
+  t.consistent = true;
+  consistent_read(reader, [&] {
+    t.first = std::min(first, reader.n_runs());
+    t.ids.clear();
+    t.done = reader.done_mask(first, count);  // before the columns: a row done here is complete in them
+    t.n_runs = static_cast<std::int64_t>(t.done.size());
+    for (RunsColumn& c : t.cols) {
+      switch (c.type) {
+        case CellType::f64: c.f = reader.read_f64(c.name, first, count); break;
+        case CellType::i64: c.i = reader.read_i64(c.name, first, count); break;
+        case CellType::str: c.s = reader.read_str(c.name, first, count); break;
       }
-      for (const auto& k : c.kinds)
-        if (std::find(t.kinds.begin(), t.kinds.end(), k) == t.kinds.end()) t.kinds.push_back(k);
-      switch (spec.type) {
-        case CellType::f64: c.f = reader.read_f64(spec.name); break;
-        case CellType::i64: c.i = reader.read_i64(spec.name); break;
-        case CellType::str: c.s = reader.read_str(spec.name); break;
-      }
-      t.cols.push_back(std::move(c));
     }
     t.consistent = reader.unchanged_since_open();
-    return t;
+    return 0;
   });
+}
+
+RunsTable load_runs(store::ResultsReader& reader) {
+  RunsTable t = runs_header(reader);
+  load_piece(reader, t, 0, store::ResultsReader::kAll);
+  return t;
+}
+
+void load_ids(store::ResultsReader& reader, RunsTable& t, const std::vector<std::int64_t>& ids) {
+  const auto done = consistent_read(reader, [&] {  // the ids' done flags (one read per piece they span)
+    std::vector<std::uint8_t> d;
+    for (std::size_t i = 0; i < ids.size();) {
+      const std::int64_t base = ids[i];
+      const auto mask = reader.done_mask(base, kPieceRows);
+      for (; i < ids.size() && ids[i] < base + static_cast<std::int64_t>(mask.size()); ++i)
+        d.push_back(mask[static_cast<std::size_t>(ids[i] - base)]);
+    }
+    return d;
+  });
+  const std::vector<Record> rows = consistent_read(reader, [&] { return reader.read_rows(ids); });  // after the flags
+  t.first = 0;
+  t.ids = ids;
+  t.n_runs = static_cast<std::int64_t>(ids.size());
+  t.done = done;
+  for (std::size_t c = 0; c < t.cols.size(); ++c) {
+    RunsColumn& col = t.cols[c];
+    col.f.clear(), col.i.clear(), col.s.clear();
+    for (const Record& r : rows) {
+      switch (col.type) {
+        case CellType::f64: col.f.push_back(std::get<double>(r.cells[c])); break;
+        case CellType::i64: col.i.push_back(std::get<std::int64_t>(r.cells[c])); break;
+        case CellType::str: col.s.push_back(std::get<std::string>(r.cells[c])); break;
+      }
+    }
+  }
+}
+
+void append_row(RunsTable& g, const RunsTable& t, std::int64_t r, const std::vector<bool>& take) {
+  for (std::size_t c = 0; c < t.cols.size(); ++c) {
+    if (!take[c]) continue;
+    const RunsColumn& from = t.cols[c];
+    RunsColumn& to = g.cols[c];
+    switch (from.type) {
+      case CellType::f64: to.f.push_back(from.f[r]); break;
+      case CellType::i64: to.i.push_back(from.i[r]); break;
+      case CellType::str: to.s.push_back(from.s[r]); break;
+    }
+  }
+  g.done.push_back(t.done[static_cast<std::size_t>(r)]);
+  g.ids.push_back(t.row_id(r));
+  ++g.n_runs;
 }
 
 std::optional<Format> parse_format(const std::string& s) {

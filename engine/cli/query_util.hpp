@@ -30,12 +30,15 @@ struct RunsColumn {
 
 struct RunsTable {
   store::StoreMeta meta;
-  std::int64_t n_runs = 0;
+  std::int64_t n_runs = 0;  ///< rows held (the file's runs, or the piece's rows: see first, ids)
+  std::int64_t first = 0;   ///< run id of row 0 (a piece of a file read in pieces)
+  std::vector<std::int64_t> ids;  ///< when not empty: run id (or evaluation index) of each row (gathered rows)
   std::vector<std::uint8_t> done;
   std::vector<RunsColumn> cols;
   std::vector<std::string> kinds;  ///< the run kinds the columns name, first seen first
   bool consistent = true;  ///< false: a writer kept committing during every attempt (rows still done-safe)
 
+  std::int64_t row_id(std::int64_t row) const { return ids.empty() ? first + row : ids[static_cast<std::size_t>(row)]; }
   const RunsColumn* find(const std::string& name) const;
   std::vector<std::string> names() const;
   /// A row's run kind: the kind of the parameter (else metric) columns of a single kind that hold a
@@ -58,6 +61,34 @@ void v1_column_roles(std::vector<ColumnSpec>& columns);
 /// read before the columns, and the read is repeated (refresh) when a commit happened meanwhile.
 /// Throws store::StoreError.
 RunsTable load_runs(store::ResultsReader& reader);
+
+/// The /runs columns of `reader` (names, units, roles, kinds) and its metadata, holding no rows.
+RunsTable runs_header(store::ResultsReader& reader);
+/// Rows a piece holds when a command streams a file (memory bounded whatever the run count).
+inline constexpr std::int64_t kPieceRows = 16384;
+/// Fills `t` (a runs_header of `reader`) with the rows `first` .. `first + count` (clamped): their
+/// done flags and values, read like load_runs (done mask first, repeated on a commit meanwhile). The
+/// column objects stay in place (pointers to them stay valid); their values are replaced.
+void load_piece(store::ResultsReader& reader, RunsTable& t, std::int64_t first, std::int64_t count);
+/// Calls f(t) for each piece of kPieceRows rows of the file, in run-id order (t.first: the piece's
+/// first run id; rows are indexed from 0 within the piece). Returns false when some piece was read
+/// while a writer kept committing (rows marked done are complete either way).
+template <class F>
+bool for_each_piece(store::ResultsReader& reader, RunsTable& t, F&& f) {
+  bool consistent = true;
+  const std::int64_t total = reader.n_runs();
+  for (std::int64_t first = 0; first < total; first += kPieceRows) {
+    load_piece(reader, t, first, kPieceRows);
+    consistent = consistent && t.consistent;
+    f(static_cast<const RunsTable&>(t));
+  }
+  return consistent;
+}
+/// Fills `t` (a runs_header of `reader`) with the rows of `ids` (ascending run ids), row i = ids[i].
+void load_ids(store::ResultsReader& reader, RunsTable& t, const std::vector<std::int64_t>& ids);
+/// Appends row `r` of `t` to `g` (a table with t's columns): the values of the columns whose index
+/// is set in `take` (the others stay empty), its done flag and its run id.
+void append_row(RunsTable& g, const RunsTable& t, std::int64_t r, const std::vector<bool>& take);
 
 /// Retry helper for other reads (histories, landscapes) on a live file.
 template <class F>

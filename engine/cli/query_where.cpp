@@ -201,16 +201,22 @@ std::vector<Condition> all_conditions(const std::vector<Disjunction>& filters) {
   return out;
 }
 
-std::vector<std::string> unheld_value_notes(const std::vector<Condition>& conditions, const RunsTable& t,
-                                            bool include_pending) {
+void collect_held(const std::vector<Condition>& conditions, const RunsTable& t, bool include_pending, HeldValues& held) {
+  for (const Condition& k : conditions) {
+    if (k.col->type != CellType::str || (k.op != Op::eq && k.op != Op::ne)) continue;
+    std::set<std::string>& h = held[k.col];
+    for (std::int64_t r = 0; r < t.n_runs; ++r)
+      if (include_pending || t.done[static_cast<std::size_t>(r)]) h.insert(k.col->s[r]);
+  }
+}
+
+std::vector<std::string> unheld_value_notes(const std::vector<Condition>& conditions, const HeldValues& held_by) {
   std::vector<std::string> notes;
   std::set<std::pair<const RunsColumn*, std::string>> said;
   for (const Condition& k : conditions) {
-    if (k.col->type != CellType::str || (k.op != Op::eq && k.op != Op::ne)) continue;
-    std::set<std::string> held;  // the values the rows in question hold
-    for (std::int64_t r = 0; r < t.n_runs; ++r)
-      if (include_pending || t.done[static_cast<std::size_t>(r)]) held.insert(k.col->s[r]);
-    if (held.empty()) continue;  // no row at all: nothing to hint at
+    const auto it = held_by.find(k.col);
+    if (it == held_by.end() || it->second.empty()) continue;  // no row at all: nothing to hint at
+    const std::set<std::string>& held = it->second;  // the values the rows in question hold
     for (const std::string& v : k.strs) {
       if (held.count(v) || !said.insert({k.col, v}).second) continue;
       std::string m = "no row has " + k.col->name + " = '" + v + "'";
@@ -222,6 +228,13 @@ std::vector<std::string> unheld_value_notes(const std::vector<Condition>& condit
     }
   }
   return notes;
+}
+
+std::vector<std::string> unheld_value_notes(const std::vector<Condition>& conditions, const RunsTable& t,
+                                            bool include_pending) {
+  HeldValues held;
+  collect_held(conditions, t, include_pending, held);
+  return unheld_value_notes(conditions, held);
 }
 
 }  // namespace ks::cli

@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -63,5 +65,10 @@ std::vector<Condition> all_conditions(const std::vector<Disjunction>& filters);
 /// (or the values the column holds, when few and none is close).
 std::vector<std::string> unheld_value_notes(const std::vector<Condition>& conditions, const RunsTable& t,
                                             bool include_pending);
+/// The text values the rows hold in the columns of = / != text conditions, gathered over the pieces
+/// of a file read in pieces (collect_held per piece, then the notes once).
+using HeldValues = std::map<const RunsColumn*, std::set<std::string>>;
+void collect_held(const std::vector<Condition>& conditions, const RunsTable& t, bool include_pending, HeldValues& held);
+std::vector<std::string> unheld_value_notes(const std::vector<Condition>& conditions, const HeldValues& held);
 
 }  // namespace ks::cli
