@@ -42,16 +42,6 @@ std::string cell_for_humans(const RunsColumn& c, std::int64_t r) {
   return "";
 }
 
-/// Equal values of two rows (NaN equals NaN), each in its own table.
-bool same(const RunsColumn& c, std::int64_t a, const RunsColumn& d, std::int64_t b) {
-  switch (c.type) {
-    case CellType::str: return c.s[a] == d.s[b];
-    case CellType::i64: return c.i[a] == d.i[b];
-    case CellType::f64: return c.f[a] == d.f[b] || (std::isnan(c.f[a]) && std::isnan(d.f[b]));
-  }
-  return true;
-}
-
 /// A value of variable `unit` for humans: angles (stored "rad") in degrees.
 std::string var_value(double v, const std::string& unit) {
   if (unit == "rad") return format_double(v * kRadToDeg) + " deg";
@@ -267,7 +257,7 @@ int run_info(const InfoArgs& args) {
         b.varies.assign(p.cols.size(), false);
       }
       for (std::size_t c = 0; c < p.cols.size(); ++c)
-        if (!b.varies[c] && p.cols[c].role == Role::parameter && !same(p.cols[c], r, b.first.cols[c], 0))
+        if (!b.varies[c] && p.cols[c].role == Role::parameter && !same_value(p.cols[c], r, b.first.cols[c], 0))
           b.varies[c] = true;
       // Best rows: trajectory lowest E among ok runs; ik fewest iterations among converged, then error.
       const bool ik = b.kind == "ik";

@@ -161,14 +161,25 @@ int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
   HeldValues held;
   std::int64_t done = 0;
   const Selector sel{t, a.radians};
+  // Rows in file order up to --limit are all table_mode prints (no sort, no groups): gather only those.
+  const bool head_only = a.limit >= 0 && a.sort.empty() && a.group_by.empty();
   const bool consistent = for_each_piece(reader, t, [&](const RunsTable& p) {
     collect_held(conds, p, a.include_pending, held);
     for (std::int64_t r = 0; r < p.n_runs; ++r) {
       const bool is_done = p.done[static_cast<std::size_t>(r)] != 0;
       done += is_done;
       if (!a.include_pending && !is_done) continue;
-      if (std::all_of(filters.begin(), filters.end(), [&](const Disjunction& d) { return sel.test(d, r); }))
+      if (!std::all_of(filters.begin(), filters.end(), [&](const Disjunction& d) { return sel.test(d, r); })) continue;
+      if (!head_only || g.n_runs < a.limit) {
         append_row(g, p, r, take);
+        continue;
+      }
+      // Beyond the --limit rows printed: counted, and what the compact default shows learns from it.
+      ++w.more_matching;
+      w.more_kinds.insert(p.kind(r));
+      for (std::size_t c = 0; c < p.cols.size(); ++c)
+        if (take[c] && g.n_runs > 0 && !w.more_varying.count(p.cols[c].name) && !same_value(p.cols[c], r, g.cols[c], 0))
+          w.more_varying.insert(p.cols[c].name);
     }
   });
   if (!consistent)

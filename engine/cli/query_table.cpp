@@ -75,13 +75,15 @@ OutCell cell(const RunsColumn& c, std::int64_t r, const Selector& sel) {
 /// The default columns of table output: run id, block (when several), the parameters that vary, the
 /// key metrics of the kinds of the rows shown, status, and every column a filter or sort mentions.
 std::vector<const RunsColumn*> compact_columns(const RunsTable& t, const std::vector<std::int64_t>& selected,
-                                               const std::set<const RunsColumn*>& mentioned) {
-  std::set<std::string> kinds;
+                                               const std::set<const RunsColumn*>& mentioned,
+                                               const TableWording& more) {
+  std::set<std::string> kinds = more.more_kinds;
   for (auto r : selected) kinds.insert(t.kind(r));
   std::set<const RunsColumn*> key_metrics;
   for (const auto& kind : kinds)
     for (const RunsColumn* c : t.key_metrics(kind)) key_metrics.insert(c);
   auto varies = [&](const RunsColumn& c) {
+    if (more.more_varying.count(c.name)) return true;
     for (std::size_t i = 1; i < selected.size(); ++i) {
       const auto r0 = selected[0], r = selected[i];
       if (c.type == CellType::str ? c.s[r] != c.s[r0]
@@ -313,10 +315,10 @@ int table_mode(const QueryArgs& a, const RunsTable& t, Format fmt, const TableWo
       cols.push_back(c);
     }
   } else {
-    cols = compact_columns(t, selected, mentioned);
+    cols = compact_columns(t, selected, mentioned, wording);
   }
   sort_rows(selected, keys, sel);
-  const std::size_t matching = selected.size();
+  const std::size_t matching = selected.size() + static_cast<std::size_t>(wording.more_matching);
   if (a.limit >= 0 && selected.size() > static_cast<std::size_t>(a.limit)) selected.resize(static_cast<std::size_t>(a.limit));
 
   OutTable out;

@@ -1,6 +1,7 @@
 #pragma once
 // `kinesweep query` on a table in memory (the /runs rows, or one optimisation's evaluations): the
 // --where filter, --sort, --columns, --limit, and --group-by with --agg.
+#include <set>
 #include <string>
 
 #include "cli/query_command.hpp"
@@ -14,6 +15,11 @@ struct TableWording {
   std::string summary;                 ///< the trailer's second part, e.g. "8 of 10 runs done"
   bool compact_default = true;         ///< table format without --columns: run_id, varying parameters, key metrics
   bool notes_said = false;             ///< the caller printed the --where value notes (over rows `t` lacks)
+  /// Matching rows the caller left out of `t` (it holds the first --limit of them, unsorted): their
+  /// number, the kinds they hold and the columns in which they differ from t's first row.
+  std::int64_t more_matching = 0;
+  std::set<std::string> more_kinds;
+  std::set<std::string> more_varying;
 };
 
 /// The columns table_mode reads for these arguments (by index into t.cols): the ones it filters,

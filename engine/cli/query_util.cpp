@@ -168,6 +168,15 @@ void load_ids(store::ResultsReader& reader, RunsTable& t, const std::vector<std:
   }
 }
 
+bool same_value(const RunsColumn& c, std::int64_t a, const RunsColumn& d, std::int64_t b) {
+  switch (c.type) {
+    case CellType::str: return c.s[a] == d.s[b];
+    case CellType::i64: return c.i[a] == d.i[b];
+    case CellType::f64: return c.f[a] == d.f[b] || (std::isnan(c.f[a]) && std::isnan(d.f[b]));
+  }
+  return true;
+}
+
 void append_row(RunsTable& g, const RunsTable& t, std::int64_t r, const std::vector<bool>& take) {
   for (std::size_t c = 0; c < t.cols.size(); ++c) {
     if (!take[c]) continue;

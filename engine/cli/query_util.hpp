@@ -86,6 +86,8 @@ bool for_each_piece(store::ResultsReader& reader, RunsTable& t, F&& f) {
 }
 /// Fills `t` (a runs_header of `reader`) with the rows of `ids` (ascending run ids), row i = ids[i].
 void load_ids(store::ResultsReader& reader, RunsTable& t, const std::vector<std::int64_t>& ids);
+/// Equal values in row `a` of column `c` and row `b` of column `d` (of the same type; NaN equals NaN).
+bool same_value(const RunsColumn& c, std::int64_t a, const RunsColumn& d, std::int64_t b);
 /// Appends row `r` of `t` to `g` (a table with t's columns): the values of the columns whose index
 /// is set in `take` (the others stay empty), its done flag and its run id.
 void append_row(RunsTable& g, const RunsTable& t, std::int64_t r, const std::vector<bool>& take);
