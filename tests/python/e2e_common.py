@@ -118,3 +118,23 @@ class TempDirTest(unittest.TestCase):
         with open(p, "w") as f:
             f.write(text)
         return p
+
+
+class StudyFileTest(unittest.TestCase):
+    """A test case over one results file, run once for the class: subclasses set KS (the kinesweep
+    binary), NAME and STUDY (the study text); cls.h5 is the file and cls.runs its /runs columns as
+    read by h5py (text columns as numpy arrays of str)."""
+    KS = NAME = STUDY = None
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.h5 = run_study_text(cls.KS, cls.tmp.name, cls.NAME, cls.STUDY)
+        with h5py.File(cls.h5, "r") as f:
+            g = f["runs"]
+            cls.runs = {k: (np.array(g[k].asstr()[()], dtype=object) if g[k].dtype.kind == "O" else g[k][()])
+                        for k in g}
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()

@@ -15,7 +15,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, run_study_text
+from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, StudyFileTest, run_study_text
 
 KS = None
 D = 180.0 / math.pi
@@ -59,19 +59,14 @@ def s(v):
     return v.decode() if isinstance(v, bytes) else str(v)
 
 
-class GroupAndOr(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        cls.tmp = tempfile.TemporaryDirectory()
-        cls.h5 = run_study_text(KS, cls.tmp.name, "g", STUDY)
-        with h5py.File(cls.h5, "r") as f:
-            g = f["runs"]
-            cls.t = {k: (np.array([s(x) for x in g[k][()]], dtype=object) if g[k].dtype.kind == "O" else g[k][()])
-                     for k in g}
+class GroupAndOr(StudyFileTest):
+    NAME, STUDY = "g", STUDY
 
     @classmethod
-    def tearDownClass(cls):
-        cls.tmp.cleanup()
+    def setUpClass(cls):
+        cls.KS = KS
+        super().setUpClass()
+        cls.t = cls.runs
 
     def test_or_form(self):
         t = self.t

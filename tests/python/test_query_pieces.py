@@ -10,10 +10,9 @@ import subprocess
 import sys
 import unittest
 
-import h5py
 import numpy as np
 
-from e2e_common import TempDirTest, run_study_text
+from e2e_common import StudyFileTest
 
 KS = None
 
@@ -50,23 +49,16 @@ def ks(*args):
     return r.stdout
 
 
-class Pieces(TempDirTest):
-    @classmethod
-    def setUpClass(cls):
-        import tempfile
-        cls.tmp = tempfile.TemporaryDirectory()
-        cls.out = run_study_text(KS, cls.tmp.name, "pieces", STUDY)
-        with h5py.File(cls.out, "r") as f:
-            runs = f["runs"]
-            cls.block = runs["block"].asstr()[()]
-            cls.status = runs["status"].asstr()[()]
-            cls.iters = runs["iterations"][()]
-            cls.error = runs["error"][()]
-            cls.run_id = runs["run_id"][()]
+class Pieces(StudyFileTest):
+    NAME, STUDY = "pieces", STUDY
 
     @classmethod
-    def tearDownClass(cls):
-        cls.tmp.cleanup()
+    def setUpClass(cls):
+        cls.KS = KS
+        super().setUpClass()
+        cls.out = cls.h5
+        cls.block, cls.status = cls.runs["block"], cls.runs["status"]
+        cls.iters, cls.error, cls.run_id = cls.runs["iterations"], cls.runs["error"], cls.runs["run_id"]
 
     def test_the_file_spans_several_pieces(self):
         self.assertEqual(len(self.run_id), 36900)
