@@ -43,30 +43,34 @@ struct DynamicsCoefficients {
 };
 
 /// Joint-space inertia matrix M(q) [kg m^2], symmetric positive definite (in either InertiaForm).
-inline Sym3 mass_matrix_sym(const DynamicsCoefficients& d, const JointTrig& t) {
-  const double k2 = d.k2 * t.c2, k23 = d.k23 * t.c23, k3 = d.k3 * t.c3;
-  const double m22 = d.m22 + 2.0 * k3;
-  double m11 = d.m11 + 2.0 * (k3 + k2 + k23);
+/// T: double, or lanes (model/lanes.hpp) for runs computed side by side.
+template <class T>
+inline Sym3Of<T> mass_matrix_sym(const DynamicsCoefficients& d, const JointTrigOf<T>& t) {
+  const T k2 = d.k2 * t.c2, k23 = d.k23 * t.c23, k3 = d.k3 * t.c3;
+  const T m22 = d.m22 + 2.0 * k3;
+  T m11 = d.m11 + 2.0 * (k3 + k2 + k23);
   // InertiaForm::thesis_m11: m2*(l1^2 + lc2^2 + 2 l1 lc2 c2 + m3*(bracket)) adds (m2 - 1) m3 bracket
   if (d.thesis_extra != 0.0) m11 += d.thesis_extra * (d.b0 + d.b2 * t.c2 + d.b3 * t.c3 + d.b23 * t.c23);
-  return {m11, m22 + k2 + k23, d.m33 + k3 + k23, m22, d.m33 + k3, d.m33};
+  return {m11, m22 + k2 + k23, d.m33 + k3 + k23, m22, d.m33 + k3, T(d.m33)};
 }
 inline Mat3 mass_matrix(const DynamicsCoefficients& d, const JointTrig& t) { return mass_matrix_sym(d, t).dense(); }
 
 /// Centrifugal and Coriolis torques c(q, qd) [Nm] (Christoffel form of M).
-inline Vec3 coriolis(const DynamicsCoefficients& d, const JointTrig& t, const Vec3& qd) {
-  const double h2 = d.k2 * t.s2, h23 = d.k23 * t.s23, h3 = d.k3 * t.s3;
-  const double d1 = qd[0], d2 = qd[1], d3 = qd[2];
-  const double d23 = d2 + d3, d12 = d1 + d2;
-  const double h3t = h3 * d3 * (2.0 * d12 + d3);
+template <class T>
+inline Vec3Of<T> coriolis(const DynamicsCoefficients& d, const JointTrigOf<T>& t, const Vec3Of<T>& qd) {
+  const T h2 = d.k2 * t.s2, h23 = d.k23 * t.s23, h3 = d.k3 * t.s3;
+  const T d1 = qd[0], d2 = qd[1], d3 = qd[2];
+  const T d23 = d2 + d3, d12 = d1 + d2;
+  const T h3t = h3 * d3 * (2.0 * d12 + d3);
   return {-h2 * d2 * (2.0 * d1 + d2) - h23 * d23 * (2.0 * d1 + d23) - h3t, (h2 + h23) * d1 * d1 - h3t,
           h3 * d12 * d12 + h23 * d1 * d1};
 }
 
 /// Gravity torques g(q) = dU/dq [Nm], gravity along -y.
-inline Vec3 gravity(const DynamicsCoefficients& d, const JointTrig& t) {
-  const double g3 = d.g3 * t.c123;
-  const double g2 = d.g2 * t.c12 + g3;
+template <class T>
+inline Vec3Of<T> gravity(const DynamicsCoefficients& d, const JointTrigOf<T>& t) {
+  const T g3 = d.g3 * t.c123;
+  const T g2 = d.g2 * t.c12 + g3;
   return {d.g1 * t.c1 + g2, g2, g3};
 }
 

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "model/arm.hpp"
+#include "model/lanes.hpp"
 #include "model/trig.hpp"
 
 namespace ks {
@@ -38,13 +39,15 @@ inline ArmPose forward_kinematics(const PlanarArm3& a, const Vec3& q) {
   return p;
 }
 
-/// 2x3 position Jacobian d(tip)/dq [m/rad] (seed Eq. 24).
-inline Mat23 jacobian(const PlanarArm3& a, const JointTrig& t) {
-  const double x3 = a.l[2] * t.c123, y3 = a.l[2] * t.s123;
-  const double x2 = a.l[1] * t.c12 + x3, y2 = a.l[1] * t.s12 + y3;
-  const double x1 = a.l[0] * t.c1 + x2, y1 = a.l[0] * t.s1 + y2;
-  Mat23 J;
-  J << -y1, -y2, -y3, x1, x2, x3;
+/// 2x3 position Jacobian d(tip)/dq [m/rad] (seed Eq. 24). T: double (an Eigen Mat23) or lanes.
+template <class T>
+inline Mat23Of<T> jacobian(const PlanarArm3& a, const JointTrigOf<T>& t) {
+  const T x3 = a.l[2] * t.c123, y3 = a.l[2] * t.s123;
+  const T x2 = a.l[1] * t.c12 + x3, y2 = a.l[1] * t.s12 + y3;
+  const T x1 = a.l[0] * t.c1 + x2, y1 = a.l[0] * t.s1 + y2;
+  Mat23Of<T> J;
+  J(0, 0) = -y1, J(0, 1) = -y2, J(0, 2) = -y3;
+  J(1, 0) = x1, J(1, 1) = x2, J(1, 2) = x3;
   return J;
 }
 
@@ -69,22 +72,28 @@ inline Mat23 jacobian_dot(const PlanarArm3& a, const JointTrig& t, const Vec3& q
 
 /// Jdot qd [m/s^2], the velocity-product part of the tip acceleration: (-sum l_j cos(phi_j) w_j^2,
 /// -sum l_j sin(phi_j) w_j^2) with phi_j, w_j the absolute angle and rate of link j. Equals
-/// jacobian_dot(a, t, qd) * qd at a third of the cost.
-inline Vec2 jacobian_dot_times_qd(const PlanarArm3& a, const JointTrig& t, const Vec3& qd) {
-  const double w1 = qd[0], w2 = w1 + qd[1], w3 = w2 + qd[2];
-  const double e1 = a.l[0] * w1 * w1, e2 = a.l[1] * w2 * w2, e3 = a.l[2] * w3 * w3;
+/// jacobian_dot(a, t, qd) * qd at a third of the cost. T: double (Eigen vectors) or lanes.
+template <class T>
+inline Vec2Of<T> jacobian_dot_times_qd(const PlanarArm3& a, const JointTrigOf<T>& t, const Vec3Of<T>& qd) {
+  const T w1 = qd[0], w2 = w1 + qd[1], w3 = w2 + qd[2];
+  const T e1 = a.l[0] * w1 * w1, e2 = a.l[1] * w2 * w2, e3 = a.l[2] * w3 * w3;
   return {-(e1 * t.c1 + e2 * t.c12 + e3 * t.c123), -(e1 * t.s1 + e2 * t.s12 + e3 * t.s123)};
 }
 
 /// The end-effector position read off the Jacobian's first column (J = [-y1 ...; x1 ...]).
 inline Vec2 end_effector_from_jacobian(const Mat23& J) { return {J(1, 0), -J(0, 0)}; }
 
-/// Manipulability sqrt(det(J J^T)) of the 2x3 position Jacobian [m^2]; 0 at a singular configuration.
-inline double manipulability_squared(const Mat23& J) {
-  const double a = J.row(0).squaredNorm(), b = J.row(0).dot(J.row(1)), c = J.row(1).squaredNorm();
-  const double d = a * c - b * b;
-  return d > 0.0 ? d : 0.0;
+/// Manipulability squared det(J J^T) of the 2x3 position Jacobian [m^4]; 0 at a singular configuration.
+/// The row sums are taken as Eigen's squaredNorm() and dot() of a 3-vector take them: x0 + (x1 + x2).
+template <class J23>
+inline auto manipulability_squared(const J23& J) {
+  const auto a = J(0, 0) * J(0, 0) + (J(0, 1) * J(0, 1) + J(0, 2) * J(0, 2));
+  const auto b = J(0, 0) * J(1, 0) + (J(0, 1) * J(1, 1) + J(0, 2) * J(1, 2));
+  const auto c = J(1, 0) * J(1, 0) + (J(1, 1) * J(1, 1) + J(1, 2) * J(1, 2));
+  const auto d = a * c - b * b;
+  return select(d > 0.0, d, decltype(d)(0.0));
 }
+/// Manipulability sqrt(det(J J^T)) [m^2].
 inline double manipulability(const Mat23& J) { return std::sqrt(manipulability_squared(J)); }
 
 /// Elbow branch of the analytic IK: sign of sin(theta2). The seed uses +1.

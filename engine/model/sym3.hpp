@@ -12,16 +12,20 @@
 
 namespace ks {
 
-/// A symmetric 3x3 matrix by its upper triangle.
-struct Sym3 {
-  double a00, a01, a02, a11, a12, a22;
+/// A symmetric 3x3 matrix by its upper triangle (T: double, or lanes as in model/lanes.hpp).
+template <class T>
+struct Sym3Of {
+  T a00, a01, a02, a11, a12, a22;
 
-  Vec3 operator*(const Vec3& x) const {
+  /// S x, for x an Eigen Vec3 (T = double) or lanes
+  template <class V>
+  V operator*(const V& x) const {
     return {a00 * x[0] + a01 * x[1] + a02 * x[2], a01 * x[0] + a11 * x[1] + a12 * x[2],
             a02 * x[0] + a12 * x[1] + a22 * x[2]};
   }
   /// x^T S x
-  double quadratic_form(const Vec3& x) const {
+  template <class V>
+  T quadratic_form(const V& x) const {
     return a00 * x[0] * x[0] + a11 * x[1] * x[1] + a22 * x[2] * x[2] +
            2.0 * (a01 * x[0] * x[1] + a02 * x[0] * x[2] + a12 * x[1] * x[2]);
   }
@@ -31,14 +35,16 @@ struct Sym3 {
     return m;
   }
 };
+using Sym3 = Sym3Of<double>;
 
 /// M^-1 as P / det with P = adj(M) (symmetric for symmetric M): P takes two levels of products.
-struct SymInverse3 {
-  Sym3 P;      ///< adjugate of M
-  double det;  ///< det(M) = M00 P00 + M01 P01 + M02 P02
+template <class T>
+struct SymInverse3Of {
+  Sym3Of<T> P;  ///< adjugate of M
+  T det;        ///< det(M) = M00 P00 + M01 P01 + M02 P02
 
-  SymInverse3() = default;
-  explicit SymInverse3(const Sym3& M) {
+  SymInverse3Of() = default;
+  explicit SymInverse3Of(const Sym3Of<T>& M) {
     P.a00 = M.a11 * M.a22 - M.a12 * M.a12;
     P.a01 = M.a02 * M.a12 - M.a01 * M.a22;
     P.a02 = M.a01 * M.a12 - M.a02 * M.a11;
@@ -56,5 +62,6 @@ struct SymInverse3 {
   /// b^T M^-1 b (>= 0 for SPD M)
   double inverse_quadratic_form(const Vec3& b) const { return P.quadratic_form(b) / det; }
 };
+using SymInverse3 = SymInverse3Of<double>;
 
 }  // namespace ks

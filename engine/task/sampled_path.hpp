@@ -54,6 +54,10 @@ class SampledQuinticPath {
   Point position(std::size_t i) const { return Eigen::Map<const Point>(&xa_[2 * Dim * i]); }
   Point acceleration(std::size_t i) const { return Eigen::Map<const Point>(&xa_[2 * Dim * i + Dim]); }
   std::size_t segment(std::size_t i) const { return segment_[i]; }
+  /// The samples as one array: position (Dim), then acceleration (Dim), per sample.
+  const double* data() const { return xa_.data(); }
+  /// The segment of every sample.
+  const std::uint32_t* segments() const { return segment_.data(); }
 
  private:
   QuinticPath<Dim> path_;

@@ -1,0 +1,332 @@
+#pragma once
+// The simulation loop of simulate() as a template over the lane type T (model/lanes.hpp). T = double
+// is simulate() itself; F64x4 and F64x8 run 4 or 8 runs side by side (simulate_lanes), every lane with
+// the operations of the run alone in the same order, so with its bits. Per-lane decisions: the trig
+// tracker's direct evaluations, the statuses (a lane that stops is masked: its sums stop where the run
+// alone breaks, its state is parked at its start with zero velocity so that it computes harmless
+// values), the histories.
+// The kernel reads plain arrays and calls only templates over T and out-of-line functions, so that a
+// translation unit compiled for wider vectors (methods/trajectory_lanes_x8.cpp) emits no inline
+// function that the rest of the program could end up calling (tests/CMakeLists.txt checks its symbols).
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+
+#include "methods/resolution.hpp"
+#include "methods/run_sums.hpp"
+#include "methods/trajectory.hpp"
+#include "model/dynamics.hpp"
+
+namespace ks::kernel {
+
+constexpr int kMaxLanes = 8;
+
+/// The path's data at one RK4 step's stage times t + dt/2 and t + dt (the same for every lane).
+struct StageTasks {
+  std::size_t seg_h, seg_1;  ///< segments of the two times
+  double a_h[2], a_1[2];     ///< path accelerations [m/s^2]
+  double unit_h, unit_1;     ///< vertex_alpha: the orientation acceleration per radian of segment rise [1/s^2]
+};
+/// Out of line (methods/trajectory.cpp): the tasks of QuinticPath::sample_on at RK4's stage times, and
+/// the orientation acceleration per radian of rise of a vertex_alpha segment (a profile whose segments
+/// each rise by exactly 1: `unit`, null when the method is not vertex_alpha).
+void stage_tasks(const Path2& path, const Profile1* unit, double t, double dt, StageTasks& out);
+double unit_alpha_acceleration(const Profile1& unit, std::size_t segment, double t);
+
+/// A run's history as raw column-major arrays (TrajectoryHistory's storage), written in place.
+struct HistoryView {
+  int stride = 1;
+  double *t = nullptr, *q = nullptr, *qd = nullptr, *qdd = nullptr, *tau = nullptr, *x = nullptr, *alpha = nullptr;
+  Eigen::Index* size = nullptr;
+};
+
+/// What every run of a batch shares.
+struct Shared {
+  const PlanarArm3* arm = nullptr;
+  const DynamicsCoefficients* dyn = nullptr;
+  const Path2* path = nullptr;
+  const Profile1* alpha_unit = nullptr;  ///< vertex_alpha (see stage_tasks)
+  TrajectoryMethod method = TrajectoryMethod::local_weighted;
+  Integrator integrator = Integrator::semi_implicit_euler;
+  double dt = 0;
+  std::size_t n = 0;                    ///< samples
+  const double* samples = nullptr;      ///< SampledPath::data(): position (2), acceleration (2) per sample
+  const std::uint32_t* segment = nullptr;  ///< SampledPath::segments()
+};
+
+/// The per-run inputs, one slot per lane (lanes past the batch and unreachable starts: active = 0, with
+/// another run's inputs so that they compute ordinary numbers).
+struct Lanes {
+  double active[kMaxLanes] = {};
+  double q0[3][kMaxLanes] = {};
+  double k[kMaxLanes] = {}, null_damping[kMaxLanes] = {}, torque_bound[kMaxLanes] = {}, tolerance[kMaxLanes] = {};
+  const double* alpha_rise = nullptr;  ///< vertex_alpha: rise of segment s in lane l at [s * kMaxLanes + l] [rad]
+  const HistoryView* history[kMaxLanes] = {};
+  bool any_history = false;
+};
+
+/// A lane's sums when the loop ends (finish_metrics turns them into TrajectoryMetrics).
+struct Sums {
+  RunStatus status = RunStatus::ok;
+  std::size_t done = 0;
+  double sumE = 0, sumEM = 0, inf[3] = {0, 0, 0}, min_w2 = 0, max_err2 = 0, last_alpha = 0, last_t = 0;
+  double f5 = 0, f6 = 0, first5 = 0, first6 = 0, last5 = 0, last6 = 0;  ///< TrapezoidSums
+};
+
+template <class T>
+inline T load_lanes(const double* p) {
+  if constexpr (std::is_same_v<T, double>) return *p;
+  else return T::load(p);
+}
+template <class T>
+inline void store_lanes(const T& x, double* p) {
+  if constexpr (std::is_same_v<T, double>) *p = x;
+  else x.store(p);
+}
+
+/// What the path asks of the arm at one instant, per lane.
+template <class T>
+struct Task {
+  double a[2];  // path acceleration (shared)
+  T alpha_dd;   // vertex_alpha: orientation acceleration
+};
+
+template <class T>
+struct Evaluation {
+  Sym3Of<T> M;
+  SymInverse3Of<T> Mi;  // M^-1 as adj(M) / det(M)
+  Vec3Of<T> c, g, qdd;
+  Mat23Of<T> J;
+  T w2;  // squared manipulability det(J J^T) (the square root is taken once, at the end)
+};
+
+template <class T>
+class Resolver {
+ public:
+  using V3 = Vec3Of<T>;
+  Resolver(const Shared& s, const Lanes& in)
+      : arm_(*s.arm), dyn_(*s.dyn), method_(s.method),
+        w_(s.method == TrajectoryMethod::local_unweighted ? Weighting::inertia_squared : Weighting::inertia),
+        k_(load_lanes<T>(in.k)), kn_(load_lanes<T>(in.null_damping)), tol_(load_lanes<T>(in.tolerance)),
+        tol2_(tol_ * tol_) {}
+
+  /// Joint accelerations of the method for task x at (trig, qd); fills every intermediate in `e`.
+  /// The mask: lanes whose Jacobian is not singular.
+  MaskOf<T> evaluate(const Task<T>& x, const JointTrigOf<T>& trig, const V3& qd, Evaluation<T>& e) const {
+    e.M = mass_matrix_sym(dyn_, trig);
+    e.c = coriolis(dyn_, trig, qd);
+    e.g = gravity(dyn_, trig);
+    e.J = jacobian(arm_, trig);
+    e.Mi = SymInverse3Of<T>(e.M);
+    const Vec2Of<T> jdqd = jacobian_dot_times_qd(arm_, trig, qd);
+    const Vec2Of<T> b{x.a[0] - jdqd[0], x.a[1] - jdqd[1]};
+    if (method_ == TrajectoryMethod::vertex_alpha) {
+      T det = 0.0;
+      e.qdd = nonredundant_acceleration<T>(e.J, b, x.alpha_dd, det);
+      e.w2 = manipulability_squared(e.J);
+      return vabs(det) >= tol_;
+    }
+    e.w2 = manipulability_squared(e.J);
+    const MaskOf<T> ok = e.w2 >= tol2_;
+    if (!any(ok)) return ok;
+    e.qdd = local_acceleration<T>(w_, e.Mi, e.J, b, e.c, e.g, k_, kn_, qd);
+    return ok;
+  }
+
+ private:
+  const PlanarArm3& arm_;
+  const DynamicsCoefficients& dyn_;
+  const TrajectoryMethod method_;
+  const Weighting w_;
+  const T k_, kn_, tol_, tol2_;
+};
+
+/// Writes sample i of the lanes in `write` (a bit per lane) to their histories.
+template <class T>
+void write_histories(const Lanes& in, int write, double t, const Vec3Of<T>& q, const Vec3Of<T>& qd,
+                     const Evaluation<T>& e, const T (&tau)[3], const T& alpha) {
+  constexpr int N = lanes_of<T>;
+  alignas(64) double v[15][N];
+  for (int j = 0; j < 3; ++j) {
+    store_lanes(q[j], v[j]);
+    store_lanes(qd[j], v[3 + j]);
+    store_lanes(e.qdd[j], v[6 + j]);
+    store_lanes(tau[j], v[9 + j]);
+  }
+  store_lanes(T(e.J(1, 0)), v[12]);  // tip = (x1, y1) = (J10, -J00)
+  store_lanes(T(-e.J(0, 0)), v[13]);
+  store_lanes(alpha, v[14]);
+  for (int l = 0; l < N; ++l) {
+    if (!(write >> l & 1)) continue;
+    const HistoryView& h = *in.history[l];
+    const Eigen::Index c = (*h.size)++;
+    h.t[c] = t;
+    for (int j = 0; j < 3; ++j) {
+      h.q[3 * c + j] = v[j][l];
+      h.qd[3 * c + j] = v[3 + j][l];
+      h.qdd[3 * c + j] = v[6 + j][l];
+      h.tau[3 * c + j] = v[9 + j][l];
+    }
+    h.x[2 * c] = v[12][l];
+    h.x[2 * c + 1] = v[13][l];
+    h.alpha[c] = v[14][l];
+  }
+}
+
+template <class T>
+inline int lane_bits(MaskOf<T> m) {
+  if constexpr (std::is_same_v<T, double>) return m ? 1 : 0;
+  else return bits(m);
+}
+
+/// The loop of simulate() over lanes: out[l] for lane l (the lanes of `in` that are active).
+template <class T>
+void run(const Shared& s, const Lanes& in, Sums* out) {
+  using V3 = Vec3Of<T>;
+  using M = MaskOf<T>;
+  constexpr bool one = std::is_same_v<T, double>;
+  constexpr int N = lanes_of<T>;
+  const Resolver<T> resolver(s, in);
+  const V3 q_start{load_lanes<T>(in.q0[0]), load_lanes<T>(in.q0[1]), load_lanes<T>(in.q0[2])};
+  V3 q = q_start, qd{T(0.0), T(0.0), T(0.0)};
+  M active = load_lanes<T>(in.active) != 0.0;
+  M singular = T(0.0) != T(0.0), diverged = singular;
+  Evaluation<T> e, st;  // e: at the sample; st: RK4 stages
+  TrigTrackerOf<T> trig(q);  // the sample's trig, carried from step to step (semi-implicit Euler)
+  struct NoRoots {};
+  std::conditional_t<one, RootSums, NoRoots> roots;  // one lane: square roots a block at a time (the same sums)
+  T sumE = 0.0, sumEM = 0.0, inf0 = 0.0, inf1 = 0.0, inf2 = 0.0;
+  T min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0.0;
+  T f5 = 0.0, f6 = 0.0, first5 = 0.0, first6 = 0.0, last5 = 0.0, last6 = 0.0;
+  T done = 0.0, last_t = 0.0, last_alpha = q[0] + q[1] + q[2];
+  // a sample's value enters a lane's sums only while the lane runs (one lane: the loop stops instead;
+  // while every lane runs, nothing is masked)
+  bool all_on = all(active);
+  const auto keep = [&active, &all_on](const T& updated, const T& old) -> T {
+    if constexpr (one) return updated;
+    else return all_on ? updated : select(active, updated, old);
+  };
+  const double dt = s.dt, hdt = 0.5 * dt, dt6 = dt / 6.0;
+  const std::size_t n = s.n;
+  const bool vertex = s.method == TrajectoryMethod::vertex_alpha;
+  const auto rise = [&](std::size_t segment) -> T { return load_lanes<T>(in.alpha_rise + segment * kMaxLanes); };
+  const auto stop = [&](M ok, M& status) {  // lanes failing ok stop with `status`; true when none runs on
+    if constexpr (one) {
+      if (!ok) status = true;
+      return !ok;
+    } else {
+      status = status | (active & !ok);
+      active = active & ok;
+      all_on = all(active);
+      return !any(active);
+    }
+  };
+
+  for (std::size_t i = 0; i < n; ++i) {
+    const double t = static_cast<double>(i) * dt;  // SampledPath::time(i)
+    const double* xa = s.samples + 4 * i;
+    Task<T> x{{xa[2], xa[3]}, T(0.0)};
+    if (vertex) x.alpha_dd = unit_alpha_acceleration(*s.alpha_unit, s.segment[i], t) * rise(s.segment[i]);
+    if (stop(resolver.evaluate(x, trig.trig(), qd, e), singular)) break;
+    const V3 Mqdd = e.M * e.qdd;
+    const T tau0 = Mqdd[0] + e.c[0] + e.g[0], tau1 = Mqdd[1] + e.c[1] + e.g[1], tau2 = Mqdd[2] + e.c[2] + e.g[2];
+    const T a0 = vabs(tau0), a1 = vabs(tau1), a2 = vabs(tau2);
+    const T tt = tau0 * tau0 + tau1 * tau1 + tau2 * tau2;
+    // NaN fails every comparison: one test catches non-finite values and the bound
+    const T bound = load_lanes<T>(in.torque_bound);
+    const M good = (a0 <= bound) & (a1 <= bound) & (a2 <= bound) & (vabs(tt) < std::numeric_limits<double>::infinity());
+    if (stop(good, diverged)) break;
+    // metrics of this sample
+    const V3 tau{tau0, tau1, tau2};
+    if constexpr (one) {
+      roots.add(tt, e.Mi.P.quadratic_form(tau), e.Mi.det);
+    } else {
+      // lanes: the square roots sample by sample (measured faster here than a block at a time)
+      const T qf = e.Mi.P.quadratic_form(tau);
+      sumE = keep(sumE + vsqrt(tt), sumE);
+      sumEM = keep(sumEM + vsqrt(qf / e.Mi.det), sumEM);
+    }
+    inf0 = keep(vmax(inf0, a0), inf0);
+    inf1 = keep(vmax(inf1, a1), inf1);
+    inf2 = keep(vmax(inf2, a2), inf2);
+    min_w2 = keep(vmin(min_w2, e.w2), min_w2);
+    const T ex = e.J(1, 0) - xa[0], ey = -e.J(0, 0) - xa[1];  // tip = (x1, y1) = (J10, -J00)
+    max_err2 = keep(vmax(max_err2, ex * ex + ey * ey), max_err2);
+    const T p0 = tau0 * qd[0], p1 = tau1 * qd[1], p2 = tau2 * qd[2];
+    const T p6 = p0 * p0 + p1 * p1 + p2 * p2;
+    f5 = keep(f5 + tt, f5);
+    f6 = keep(f6 + p6, f6);
+    if (i == 0) {
+      first5 = keep(tt, first5);
+      first6 = keep(p6, first6);
+    }
+    last5 = keep(tt, last5);
+    last6 = keep(p6, last6);
+    last_t = keep(T(t), last_t);
+    last_alpha = keep(q[0] + q[1] + q[2], last_alpha);
+    if (in.any_history) {
+      int write = 0;
+      for (int l = 0; l < N; ++l)
+        if (in.history[l] && (i % in.history[l]->stride == 0 || i + 1 == n)) write |= 1 << l;
+      write &= lane_bits<T>(active);
+      if (write) write_histories<T>(in, write, t, q, qd, e, {tau0, tau1, tau2}, last_alpha);
+    }
+    done = keep(done + 1.0, done);
+    if (i + 1 == n) break;  // the last sample is measured, not integrated past
+    // integrate to the next sample
+    if (s.integrator == Integrator::semi_implicit_euler) {
+      for (int j = 0; j < 3; ++j) qd[j] = keep(qd[j] + dt * e.qdd[j], T(0.0));
+      const V3 dq{dt * qd[0], dt * qd[1], dt * qd[2]};
+      for (int j = 0; j < 3; ++j) q[j] = keep(q[j] + dq[j], q_start[j]);
+      trig.advance(q, dq);
+    } else {
+      StageTasks stt;
+      stage_tasks(*s.path, s.alpha_unit, t, dt, stt);
+      Task<T> xh{{stt.a_h[0], stt.a_h[1]}, T(0.0)}, x1{{stt.a_1[0], stt.a_1[1]}, T(0.0)};
+      if (vertex) {
+        xh.alpha_dd = stt.unit_h * rise(stt.seg_h);
+        x1.alpha_dd = stt.unit_1 * rise(stt.seg_1);
+      }
+      const V3 k1q = qd, k1v = e.qdd;
+      const V3 q2{q[0] + hdt * k1q[0], q[1] + hdt * k1q[1], q[2] + hdt * k1q[2]};
+      const V3 k2q{qd[0] + hdt * k1v[0], qd[1] + hdt * k1v[1], qd[2] + hdt * k1v[2]};
+      M good_stages = resolver.evaluate(xh, joint_trig(q2), k2q, st);
+      const V3 k2v = st.qdd;
+      const V3 q3{q[0] + hdt * k2q[0], q[1] + hdt * k2q[1], q[2] + hdt * k2q[2]};
+      const V3 k3q{qd[0] + hdt * k2v[0], qd[1] + hdt * k2v[1], qd[2] + hdt * k2v[2]};
+      good_stages = good_stages & resolver.evaluate(xh, joint_trig(q3), k3q, st);
+      const V3 k3v = st.qdd;
+      const V3 q4{q[0] + dt * k3q[0], q[1] + dt * k3q[1], q[2] + dt * k3q[2]};
+      const V3 k4q{qd[0] + dt * k3v[0], qd[1] + dt * k3v[1], qd[2] + dt * k3v[2]};
+      good_stages = good_stages & resolver.evaluate(x1, joint_trig(q4), k4q, st);
+      if (stop(good_stages, singular)) break;
+      const V3 k4v = st.qdd;
+      for (int j = 0; j < 3; ++j) {
+        q[j] = keep(q[j] + dt6 * (k1q[j] + 2.0 * k2q[j] + 2.0 * k3q[j] + k4q[j]), q_start[j]);
+        qd[j] = keep(qd[j] + dt6 * (k1v[j] + 2.0 * k2v[j] + 2.0 * k3v[j] + k4v[j]), T(0.0));
+      }
+      trig.reset(q);
+    }
+  }
+
+  if constexpr (one) {
+    roots.flush();
+    sumE = roots.sumE;
+    sumEM = roots.sumEM;
+  }
+  alignas(64) double v[16][N];
+  const T fields[16] = {sumE, sumEM, inf0, inf1, inf2, min_w2, max_err2, last_alpha, last_t,
+                        f5, f6, first5, first6, last5, last6, done};
+  for (int f = 0; f < 16; ++f) store_lanes(fields[f], v[f]);
+  const int sing = lane_bits<T>(singular), div = lane_bits<T>(diverged);
+  for (int l = 0; l < N; ++l) {
+    Sums& o = out[l];
+    o.status = (sing >> l & 1) ? RunStatus::singular : (div >> l & 1) ? RunStatus::diverged : RunStatus::ok;
+    o.sumE = v[0][l], o.sumEM = v[1][l], o.inf[0] = v[2][l], o.inf[1] = v[3][l], o.inf[2] = v[4][l];
+    o.min_w2 = v[5][l], o.max_err2 = v[6][l], o.last_alpha = v[7][l], o.last_t = v[8][l];
+    o.f5 = v[9][l], o.f6 = v[10][l], o.first5 = v[11][l], o.first6 = v[12][l], o.last5 = v[13][l], o.last6 = v[14][l];
+    o.done = static_cast<std::size_t>(v[15][l]);
+  }
+}
+
+}  // namespace ks::kernel
