@@ -3,6 +3,7 @@
 // and per-run time in SIMD lanes (simulate_lanes: 1, 4 and 8 runs at once; items = runs).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "methods/seed_cases.hpp"
@@ -58,12 +59,13 @@ static void lanes(benchmark::State& st, const char* name, Integrator integ) {
   st.counters["per_run"] = benchmark::Counter(static_cast<double>(st.iterations() * width),
                                               benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
-BENCHMARK_CAPTURE(lanes, local_weighted_1a, "1a", Integrator::semi_implicit_euler)
-    ->Name("BM_LocalWeighted_Lanes")->Arg(1)->Arg(4)->Arg(8)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(lanes, local_unweighted_2a, "2a", Integrator::semi_implicit_euler)
-    ->Name("BM_LocalUnweighted_Lanes")->Arg(1)->Arg(4)->Arg(8)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(lanes, vertex_alpha_5a, "5a", Integrator::semi_implicit_euler)
-    ->Name("BM_VertexAlpha_Lanes")->Arg(1)->Arg(4)->Arg(8)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(lanes, local_weighted_1a_rk4, "1a", Integrator::rk4)
-    ->Name("BM_LocalWeightedRk4_Lanes")->Arg(1)->Arg(4)->Arg(8)->Unit(benchmark::kMicrosecond);
+static double minimum(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
+// with --benchmark_repetitions: mean, median, stddev, cv and min of the repetitions
+#define KS_LANES(name, ...)                                                                         \
+  BENCHMARK_CAPTURE(lanes, name, __VA_ARGS__)->Arg(1)->Arg(4)->Arg(8)->Unit(benchmark::kMicrosecond) \
+      ->ComputeStatistics("min", minimum)
+KS_LANES(local_weighted_1a, "1a", Integrator::semi_implicit_euler)->Name("BM_LocalWeighted_Lanes");
+KS_LANES(local_unweighted_2a, "2a", Integrator::semi_implicit_euler)->Name("BM_LocalUnweighted_Lanes");
+KS_LANES(vertex_alpha_5a, "5a", Integrator::semi_implicit_euler)->Name("BM_VertexAlpha_Lanes");
+KS_LANES(local_weighted_1a_rk4, "1a", Integrator::rk4)->Name("BM_LocalWeightedRk4_Lanes");
 BENCHMARK_MAIN();
