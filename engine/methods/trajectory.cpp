@@ -98,8 +98,8 @@ void prepare(Batch& b, int lanes, const PlanarArm3& arm, const SampledPath& samp
     s.alpha_unit = &*b.alpha_unit;
     b.alpha_rise.assign(segments * kMaxLanes, 0.0);
   }
-  Lanes& L = b.lanes;
-  L = Lanes{};
+  Runs& L = b.runs;
+  L = Runs{};
   int donor = -1;  // the first run with a reachable start: its inputs fill the idle lanes
   for (int i = 0; i < lanes; ++i) {
     L.history[i] = nullptr;
@@ -146,7 +146,7 @@ void prepare(Batch& b, int lanes, const PlanarArm3& arm, const SampledPath& samp
 }
 
 TrajectoryMetrics finish(const Batch& b, int i, const Sums& r) {
-  if (b.lanes.active[i] == 0.0) return not_simulated(RunStatus::unreachable_start, 3);
+  if (b.runs.active[i] == 0.0) return not_simulated(RunStatus::unreachable_start, 3);
   TrajectoryMetrics out;
   out.status = r.status;
   if (r.done > 0) out.tau_inf = Vec3(r.inf[0], r.inf[1], r.inf[2]);  // VecN of size 3: no allocation
@@ -169,7 +169,7 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, co
   kernel::Batch b;
   kernel::prepare(b, 1, arm, sampled, &o, 1, &history);
   kernel::Sums sums;
-  if (b.any_active) kernel::run<double>(b.shared, b.lanes, &sums);
+  if (b.any_active) kernel::run<double>(b.shared, b.runs, &sums);
   return kernel::finish(b, 0, sums);
 }
 

@@ -10,12 +10,12 @@ namespace ks::kernel {
 
 struct Batch {
   Shared shared;
-  Lanes lanes;
+  Runs runs;
   int count = 0;            ///< runs in the batch (lanes 0 .. count - 1)
   bool any_active = false;  ///< some run has a reachable start
   std::optional<DynamicsCoefficients> dyn;
   std::optional<Profile1> alpha_unit;  ///< vertex_alpha: each segment rises by exactly 1
-  std::vector<double> alpha_rise;      ///< vertex_alpha: see Lanes::alpha_rise
+  std::vector<double> alpha_rise;      ///< vertex_alpha: see Runs::alpha_rise
   HistoryView views[kMaxLanes];
 };
 

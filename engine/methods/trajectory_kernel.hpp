@@ -56,7 +56,7 @@ struct Shared {
 
 /// The per-run inputs, one slot per lane (lanes past the batch and unreachable starts: active = 0, with
 /// another run's inputs so that they compute ordinary numbers).
-struct Lanes {
+struct Runs {
   double active[kMaxLanes] = {};
   double q0[3][kMaxLanes] = {};
   double k[kMaxLanes] = {}, null_damping[kMaxLanes] = {}, torque_bound[kMaxLanes] = {}, tolerance[kMaxLanes] = {};
@@ -104,7 +104,7 @@ template <class T>
 class Resolver {
  public:
   using V3 = Vec3Of<T>;
-  Resolver(const Shared& s, const Lanes& in)
+  Resolver(const Shared& s, const Runs& in)
       : arm_(*s.arm), dyn_(*s.dyn), method_(s.method),
         w_(s.method == TrajectoryMethod::local_unweighted ? Weighting::inertia_squared : Weighting::inertia),
         k_(load_lanes<T>(in.k)), kn_(load_lanes<T>(in.null_damping)), tol_(load_lanes<T>(in.tolerance)),
@@ -143,7 +143,7 @@ class Resolver {
 
 /// Writes sample i of the lanes in `write` (a bit per lane) to their histories.
 template <class T>
-void write_histories(const Lanes& in, int write, double t, const Vec3Of<T>& q, const Vec3Of<T>& qd,
+void write_histories(const Runs& in, int write, double t, const Vec3Of<T>& q, const Vec3Of<T>& qd,
                      const Evaluation<T>& e, const T (&tau)[3], const T& alpha) {
   constexpr int N = lanes_of<T>;
   alignas(64) double v[15][N];
@@ -181,7 +181,7 @@ inline int lane_bits(MaskOf<T> m) {
 
 /// The loop of simulate() over lanes: out[l] for lane l (the lanes of `in` that are active).
 template <class T>
-void run(const Shared& s, const Lanes& in, Sums* out) {
+void run(const Shared& s, const Runs& in, Sums* out) {
   using V3 = Vec3Of<T>;
   using M = MaskOf<T>;
   constexpr bool one = std::is_same_v<T, double>;

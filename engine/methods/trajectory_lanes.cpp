@@ -13,8 +13,8 @@ namespace ks {
 namespace kernel {
 // The instances of run<T> for 4 and 8 lanes, each in its own translation unit built for its vectors
 // (when the compiler takes -mavx2, and -mavx512f -mavx512dq -mfma: engine/CMakeLists.txt).
-void run_x4(const Shared& s, const Lanes& in, Sums* out);
-void run_x8(const Shared& s, const Lanes& in, Sums* out);
+void run_x4(const Shared& s, const Runs& in, Sums* out);
+void run_x8(const Shared& s, const Runs& in, Sums* out);
 }  // namespace kernel
 
 namespace {
@@ -67,12 +67,12 @@ void simulate_lanes(int lanes, const PlanarArm3& arm, const SampledPath& sampled
   if (b.any_active) {
     // supported_lanes() admits only the widths this build has
 #if defined(KS_LANES_X8)
-    if (lanes == 8) kernel::run_x8(b.shared, b.lanes, sums);
+    if (lanes == 8) kernel::run_x8(b.shared, b.runs, sums);
 #endif
 #if defined(KS_LANES_X4)
-    if (lanes == 4) kernel::run_x4(b.shared, b.lanes, sums);
+    if (lanes == 4) kernel::run_x4(b.shared, b.runs, sums);
 #endif
-    if (lanes == 1) kernel::run<double>(b.shared, b.lanes, sums);
+    if (lanes == 1) kernel::run<double>(b.shared, b.runs, sums);
   }
   for (int i = 0; i < count; ++i) results[i] = kernel::finish(b, i, sums[i]);
 }

@@ -3,6 +3,6 @@
 
 namespace ks::kernel {
 
-void run_x4(const Shared& s, const Lanes& in, Sums* out) { run<F64x4>(s, in, out); }
+void run_x4(const Shared& s, const Runs& in, Sums* out) { run<Lanes<4>>(s, in, out); }
 
 }  // namespace ks::kernel

@@ -7,6 +7,6 @@
 
 namespace ks::kernel {
 
-void run_x8(const Shared& s, const Lanes& in, Sums* out) { run<F64x8>(s, in, out); }
+void run_x8(const Shared& s, const Runs& in, Sums* out) { run<Lanes<8>>(s, in, out); }
 
 }  // namespace ks::kernel

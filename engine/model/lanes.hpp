@@ -158,6 +158,29 @@ inline void low_bits(F64x8 x, M64x8& bit0, M64x8& bit1) {
 }
 #endif
 
+/// The lane type of N lanes: Lanes<1> = double, Lanes<4> = F64x4 (where __AVX2__), Lanes<8> = F64x8
+/// (where __AVX512F__ and __AVX512DQ__).
+template <int N>
+struct LaneType;
+template <>
+struct LaneType<1> {
+  using type = double;
+};
+#if defined(__AVX2__)
+template <>
+struct LaneType<4> {
+  using type = F64x4;
+};
+#endif
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
+template <>
+struct LaneType<8> {
+  using type = F64x8;
+};
+#endif
+template <int N>
+using Lanes = typename LaneType<N>::type;
+
 /// The number of lanes of lane type T.
 template <class T>
 inline constexpr int lanes_of = sizeof(T) / sizeof(double);
