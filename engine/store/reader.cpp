@@ -16,11 +16,7 @@ namespace {
 std::string read_text_dataset(hid_t group, const char* name, const std::string& path) {
   const std::string what = std::string("/study/") + name;
   Hid d(check(H5Dopen2(group, name, H5P_DEFAULT), path, "open " + what));
-  Hid t(utf8_vlen_type());
-  Hid s(H5Dget_space(d));
-  VlenStrings p(t, s, 1);
-  check(H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, p.data()), path, "read " + what);
-  return p.ptrs[0] ? p.ptrs[0] : "";
+  return read_vlen_strings(d, H5S_ALL, H5S_ALL, 1, path, "read " + what)[0];
 }
 }  // namespace
 
@@ -89,12 +85,7 @@ struct ResultsReader::Impl {
     Hid fs(H5Dget_space(d));
     H5Sselect_hyperslab(fs, H5S_SELECT_SET, &first, nullptr, &count, nullptr);
     Hid ms(H5Screate_simple(1, &count, nullptr));
-    Hid t(utf8_vlen_type());
-    VlenStrings strs(t, ms, count);
-    check(H5Dread(d, t, ms, fs, H5P_DEFAULT, strs.data()), path, "read /runs/" + name);
-    out.reserve(count);
-    for (char* p : strs.ptrs) out.emplace_back(p ? p : "");
-    return out;
+    return read_vlen_strings(d, ms, fs, count, path, "read /runs/" + name);
   }
 };
 
