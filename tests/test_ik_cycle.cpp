@@ -1,9 +1,9 @@
-// The IK solvers' cycle check (ik/cycle_watch.hpp) against the plain form it replaced, kept below as
-// the oracle: the same verdict at every iterate, on random iterate sequences (exact returns,
-// 2-cycles, near misses at the distance and path boundaries and at the 0.1 % error filter, NaN and
-// infinite values, revolute and prismatic joints, 1 to 8 joints, every window) and on the iterates
-// of real solves (the SCARA problem of studies/ik_basins.toml and studies/ik_scara.toml, the planar
-// 3R arm), replayed exactly as the solver feeds the check.
+// The IK solvers' cycle check (ik/cycle_watch.hpp) against the plain form it replaced, kept in
+// ik_cycle_oracle.hpp as the oracle: the same verdict at every iterate, on random iterate sequences
+// (exact returns, 2-cycles, near misses at the distance and path boundaries and at the 0.1 % error
+// filter, NaN and infinite values, revolute and prismatic joints, 1 to 8 joints, every window) and on
+// the iterates of real solves (the SCARA problem of studies/ik_basins.toml and studies/ik_scara.toml,
+// the planar 3R arm), replayed exactly as the solver feeds the check.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +17,7 @@
 #include "common/angles.hpp"
 #include "ik/cycle_watch.hpp"
 #include "ik/solve.hpp"
+#include "ik_cycle_oracle.hpp"
 #include "space/space.hpp"
 
 using namespace ks;
@@ -27,51 +28,10 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// ------------------------------------------------------------------------------ the oracle
-
-/// The cycle check as it was before ik/cycle_watch.hpp, verbatim: every lag within the window, the
-/// 0.1 % error filter, then the wrapped distance's norm against tol and the path.
-template <int N>
-struct PlainCycleWatch {
-  static constexpr int kCapacity = 17;
-  std::array<Vec<N>, kCapacity> q;
-  std::array<double, kCapacity> path;
-  std::array<double, kCapacity> error;
-  int window = 0;
-  int newest = -1;
-  long count = 0;
-  double travelled = 0.0;
-  double best_error = std::numeric_limits<double>::infinity();
-
-  void push(const Vec<N>& qk, double step, double e) {
-    travelled += step;
-    newest = newest + 1 == kCapacity ? 0 : newest + 1;
-    q[newest] = qk;
-    path[newest] = travelled;
-    error[newest] = e;
-    ++count;
-  }
-  bool returned(const std::array<bool, N>& revolute, double tolerance) {
-    const double e = error[newest];
-    const bool progress = e < 0.5 * best_error;
-    best_error = std::min(best_error, e);
-    if (progress) return false;
-    const Vec<N>& qk = q[newest];
-    const double tol = tolerance * std::max(1.0, qk.norm());
-    for (int p = 2; p <= window && p < count; ++p) {
-      const int i = newest - p < 0 ? newest - p + kCapacity : newest - p;
-      if (!(std::abs(e - error[i]) <= 1e-3 * error[i])) continue;
-      const double d = joint_difference<N>(qk, q[i], revolute).norm();
-      if (d <= tol && travelled - path[i] > 1000.0 * d) return true;
-    }
-    return false;
-  }
-};
-
 /// Both checks fed the same iterates, started as the solver starts them.
 template <int N>
 struct BothWatches {
-  PlainCycleWatch<N> plain;
+  test::PlainCycleWatch<N> plain;
   ik::detail::CycleWatch<N> fast;
   std::array<bool, N> revolute{};
   double tolerance = 1e-8;
