@@ -1,7 +1,8 @@
 """Before vs after: one study run alternately by two kinesweep binaries, N times each (histories
-none), then each binary's min and median wall time and CPU time (user + system of the run) and the
-ratios B / A. On a shared, noisy machine only such same-script ratios mean anything; the CPU time
-leaves out the waits for a core that other processes' load adds to the wall time.
+none; the pair's order swaps every round), then each binary's min and median wall time and CPU
+time (user + system of the run) and the ratios B / A. On a shared, noisy machine only such
+same-script ratios mean anything; the CPU time leaves out the waits for a core that other
+processes' load adds to the wall time. The results files go to a temporary directory ($TMPDIR).
 
 usage: /usr/bin/python3 tests/bench/compare_builds.py BIN_A BIN_B STUDY.toml [--runs 5] [--threads 1]
 """
@@ -24,8 +25,8 @@ def main():
     times = {"a": [], "b": []}
     cpu = {"a": [], "b": []}
     with tempfile.TemporaryDirectory() as tmp:
-        for _ in range(args.runs):
-            for which in ("a", "b"):
+        for r in range(args.runs):
+            for which in (("a", "b") if r % 2 == 0 else ("b", "a")):  # neither always runs first
                 out = os.path.join(tmp, which + ".h5")
                 cmd = [getattr(args, which), "run", args.study, "-o", out, "--overwrite", "-q",
                        "--threads", str(args.threads), "--histories", "none"]
