@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "store/store.hpp"
+#include "store_checks.hpp"
 #include "store_testgen.hpp"
 
 namespace {
@@ -87,17 +88,6 @@ Snapshot snap(const std::string& p) {
   s.bytes = slurp(p);
   s.ino = st.st_ino;
   return s;
-}
-
-bool opens_with_plain_hdf5(const std::string& path) {
-  H5E_auto2_t f;
-  void* d;
-  H5Eget_auto2(H5E_DEFAULT, &f, &d);
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (id >= 0) H5Fclose(id);
-  H5Eset_auto2(H5E_DEFAULT, f, d);
-  return id >= 0;
 }
 
 /// The number of done runs, each checked against the generator (records only).

@@ -9,38 +9,14 @@
 #include "methods/seed_cases.hpp"
 #include "study/sha256.hpp"
 #include "study/study.hpp"
+#include "study_errors.hpp"
 
 using namespace ks;
+using namespace ks::study_test;
 
 namespace {
 
 std::string studies_dir() { return std::string(KS_SOURCE_DIR) + "/studies/"; }
-
-/// Parse `text` expecting a StudyError; returns it (fails the test when parsing succeeds).
-StudyError error_of(const std::string& text, StudyOptions opt = {}) {
-  try {
-    parse_study(text, "bad.toml", opt);
-  } catch (const StudyError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no StudyError for:\n" << text;
-  return StudyError({});
-}
-
-/// The first diagnostic is at line:col and its message contains `part`.
-void expect_error_at(const std::string& text, int line, int col, const std::string& part,
-                     StudyOptions opt = {}) {
-  const StudyError e = error_of(text, opt);
-  ASSERT_FALSE(e.diagnostics().empty());
-  const auto& d = e.diagnostics().front();
-  EXPECT_EQ(d.file, "bad.toml");
-  EXPECT_EQ(d.line, line) << e.what();
-  EXPECT_EQ(d.column, col) << e.what();
-  EXPECT_NE(d.message.find(part), std::string::npos) << e.what();
-  EXPECT_NE(d.message.find("; expected "), std::string::npos) << e.what();
-  const std::string prefix = "bad.toml:" + std::to_string(line) + ":" + std::to_string(col) + ": error: ";
-  EXPECT_EQ(std::string(e.what()).rfind(prefix, 0), 0u) << e.what();
-}
 
 const std::string kTraj = "[[block]]\nname = \"b\"\nkind = \"trajectory\"\n";  // lines 1-3
 const std::string kIk = "[[block]]\nname = \"b\"\nkind = \"ik\"\n";

@@ -9,31 +9,12 @@
 #include <unistd.h>
 
 #include "study/study.hpp"
+#include "study_errors.hpp"
 
 using namespace ks;
+using namespace ks::study_test;
 
 namespace {
-
-StudyError error_of(const std::string& text, StudyOptions opt = {}) {
-  try {
-    parse_study(text, "bad.toml", opt);
-  } catch (const StudyError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "no StudyError for:\n" << text;
-  return StudyError({});
-}
-
-/// The first diagnostic is at line:col, says "; expected " and contains `part`.
-void expect_error_at(const std::string& text, int line, int col, const std::string& part, StudyOptions opt = {}) {
-  const StudyError e = error_of(text, opt);
-  ASSERT_FALSE(e.diagnostics().empty());
-  const auto& d = e.diagnostics().front();
-  EXPECT_EQ(d.line, line) << e.what();
-  EXPECT_EQ(d.column, col) << e.what();
-  EXPECT_NE(d.message.find(part), std::string::npos) << e.what();
-  EXPECT_NE(d.message.find("; expected "), std::string::npos) << e.what();
-}
 
 const std::string kTraj = "[[block]]\nname = \"b\"\nkind = \"trajectory\"\n";  // lines 1-3
 

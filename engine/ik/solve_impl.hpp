@@ -9,6 +9,7 @@
 #include <limits>
 #include <ostream>
 
+#include "ik/cycle_watch.hpp"
 #include "ik/solve.hpp"
 
 namespace ks::ik {
@@ -72,48 +73,6 @@ template <int N, int M>
 inline bool all_finite(const Vec<N>& q, const Vec<M>& F) {
   return q.allFinite() && F.allFinite();
 }
-
-/// The last few iterates, for the cycle check: q and the path length travelled up to it.
-template <int N>
-struct CycleWatch {
-  static constexpr int kCapacity = 17;  // window of at most 16 earlier iterates
-  std::array<Vec<N>, kCapacity> q;
-  std::array<double, kCapacity> path;
-  std::array<double, kCapacity> error;
-  int window = 0;
-  int newest = -1;  // slot of the newest iterate
-  long count = 0;
-  double travelled = 0.0;
-  double best_error = std::numeric_limits<double>::infinity();  // min ||F|| before the newest
-
-  void push(const Vec<N>& qk, double step, double e) {
-    travelled += step;
-    newest = newest + 1 == kCapacity ? 0 : newest + 1;
-    q[newest] = qk;
-    path[newest] = travelled;
-    error[newest] = e;
-    ++count;
-  }
-  /// Does the newest iterate return to one of the `window` iterates before its predecessor?
-  /// Returning within d puts ||F|| back within |J| d of the earlier value, so only earlier iterates
-  /// with ||F|| within 0.1 % are compared, and none when the newest halves the best ||F|| so far
-  /// (cheap filters: converging runs do no distance computations).
-  bool returned(const std::array<bool, N>& revolute, double tolerance) {
-    const double e = error[newest];
-    const bool progress = e < 0.5 * best_error;
-    best_error = std::min(best_error, e);
-    if (progress) return false;
-    const Vec<N>& qk = q[newest];
-    const double tol = tolerance * std::max(1.0, qk.norm());
-    for (int p = 2; p <= window && p < count; ++p) {
-      const int i = newest - p < 0 ? newest - p + kCapacity : newest - p;
-      if (!(std::abs(e - error[i]) <= 1e-3 * error[i])) continue;
-      const double d = joint_difference<N>(qk, q[i], revolute).norm();
-      if (d <= tol && travelled - path[i] > 1000.0 * d) return true;
-    }
-    return false;
-  }
-};
 
 }  // namespace detail
 

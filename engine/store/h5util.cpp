@@ -1,7 +1,9 @@
 #include "store/h5util.hpp"
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <unordered_set>
 
 namespace ks::store {
 
@@ -42,6 +44,60 @@ hid_t utf8_vlen_type() {
   H5Tset_size(t, H5T_VARIABLE);
   H5Tset_cset(t, H5T_CSET_UTF8);
   return t;
+}
+
+namespace {
+/// The blocks HDF5 allocated through one transfer property list (H5Pset_vlen_mem_manager) and has
+/// not freed; all freed when this goes out of scope.
+struct VlenBlocks {
+  std::unordered_set<void*> live;
+  VlenBlocks() = default;
+  VlenBlocks(const VlenBlocks&) = delete;
+  VlenBlocks& operator=(const VlenBlocks&) = delete;
+  ~VlenBlocks() {
+    for (void* p : live) std::free(p);
+  }
+};
+
+void* vlen_alloc(std::size_t size, void* info) {
+  void* p = std::malloc(size);
+  if (!p) return nullptr;
+  try {
+    static_cast<VlenBlocks*>(info)->live.insert(p);
+  } catch (...) {  // no exception crosses HDF5's C frames: the read fails as out of memory
+    std::free(p);
+    return nullptr;
+  }
+  return p;
+}
+
+void vlen_free(void* p, void* info) {
+  if (!p) return;
+  static_cast<VlenBlocks*>(info)->live.erase(p);
+  std::free(p);
+}
+}  // namespace
+
+std::vector<std::string> read_vlen_strings(hid_t dset, hid_t mem_space, hid_t file_space, std::size_t n,
+                                           const std::string& path, const std::string& what) {
+  std::vector<std::string> out;
+  {  // the memory dataspace (the dataset's own with H5S_ALL) must fit the buffer of n pointers
+    Hid ds(mem_space == H5S_ALL ? H5Dget_space(dset) : H5Scopy(mem_space));
+    const hssize_t extent = H5Sget_simple_extent_npoints(check(ds, path, what));
+    if (extent < 0 || static_cast<std::size_t>(extent) != n)
+      throw StoreError(path, what + ": " + std::to_string(extent) + " strings where " + std::to_string(n) +
+                                 " were expected");
+  }
+  if (n == 0) return out;
+  VlenBlocks blocks;  // outlives the transfer list that allocates into it
+  Hid xfer(check(H5Pcreate(H5P_DATASET_XFER), path, what));
+  check(H5Pset_vlen_mem_manager(xfer, vlen_alloc, &blocks, vlen_free, &blocks), path, what);
+  Hid type(utf8_vlen_type());
+  std::vector<char*> ptrs(n, nullptr);
+  check(H5Dread(dset, type, mem_space, file_space, xfer, ptrs.data()), path, what);
+  out.reserve(n);
+  for (char* p : ptrs) out.emplace_back(p ? p : "");
+  return out;
 }
 
 void write_str_attr(hid_t obj, const char* name, const std::string& value) {

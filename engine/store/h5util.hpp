@@ -56,10 +56,10 @@ struct QuietHdf5 {
   ~QuietHdf5() { H5Eset_auto2(H5E_DEFAULT, func, data); }
 };
 
-/// Owns the strings HDF5 allocates when it reads variable-length strings into `ptrs` (memory type
-/// `type`, `space` the memory dataspace of the read): frees them (H5Dvlen_reclaim) when it goes out
-/// of scope, also when the read or the copy into std::string throws. Null pointers are skipped by
-/// HDF5, so a read that failed half-way is reclaimed too.
+/// Owns the strings HDF5 allocates when H5Aread reads variable-length strings into `ptrs` (memory
+/// type `type`, `space` the attribute's dataspace): frees them (H5Dvlen_reclaim) when it goes out of
+/// scope, also when the copy into std::string throws. H5Aread takes no transfer property list, so
+/// attribute reads cannot use read_vlen_strings' allocator; dataset reads use read_vlen_strings.
 class VlenStrings {
  public:
   VlenStrings(hid_t type, hid_t space, std::size_t n) : type_(type), space_(space), ptrs(n, nullptr) {}
@@ -76,6 +76,15 @@ class VlenStrings {
  public:
   std::vector<char*> ptrs;
 };
+
+/// Reads the `n` variable-length UTF-8 strings that `file_space` selects in dataset `dset` into a
+/// memory dataspace of `n` elements (`mem_space`; H5S_ALL for both: the whole dataset, which then
+/// holds `n`; another size is a StoreError). A null string reads as "". Every
+/// string HDF5 allocates goes through an allocator of this call that frees them all at its end, also
+/// when H5Dread fails half-way: HDF5 then drops strings it converted but never copied into the
+/// output buffer. Throws StoreError(path, what + HDF5's error text) when the read fails.
+std::vector<std::string> read_vlen_strings(hid_t dset, hid_t mem_space, hid_t file_space, std::size_t n,
+                                           const std::string& path, const std::string& what);
 
 /// The current HDF5 error stack as one line (and clears it).
 std::string h5_error_text();

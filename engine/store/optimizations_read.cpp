@@ -46,13 +46,9 @@ struct In {
   std::vector<std::string> str(hid_t g, const std::string& name) const {
     Hid d(check(H5Dopen2(g, name.c_str(), H5P_DEFAULT), path, "open " + where + "/" + name));
     Hid s(H5Dget_space(d));
-    Hid t(utf8_vlen_type());
-    VlenStrings p(t, s, static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
-    std::vector<std::string> v;
-    if (p.ptrs.empty()) return v;
-    check(H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, p.data()), path, "read " + where + "/" + name);
-    for (char* c : p.ptrs) v.emplace_back(c ? c : "");
-    return v;
+    const hssize_t n = H5Sget_simple_extent_npoints(s);
+    return read_vlen_strings(d, H5S_ALL, H5S_ALL, n > 0 ? static_cast<std::size_t>(n) : 0, path,
+                             "read " + where + "/" + name);
   }
 };
 }  // namespace

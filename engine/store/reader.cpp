@@ -18,11 +18,7 @@ namespace {
 std::string read_text_dataset(hid_t group, const char* name, const std::string& path) {
   const std::string what = std::string("/study/") + name;
   Hid d(check(H5Dopen2(group, name, H5P_DEFAULT), path, "open " + what));
-  Hid t(utf8_vlen_type());
-  Hid s(H5Dget_space(d));
-  VlenStrings p(t, s, 1);
-  check(H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, p.data()), path, "read " + what);
-  return p.ptrs[0] ? p.ptrs[0] : "";
+  return read_vlen_strings(d, H5S_ALL, H5S_ALL, 1, path, "read " + what)[0];
 }
 }  // namespace
 

@@ -29,16 +29,10 @@ void read_runs_numbers(hid_t file, const std::string& path, const std::string& n
 
 std::vector<std::string> read_runs_strings(hid_t file, const std::string& path, const std::string& name,
                                            const RowSelection& sel) {
-  std::vector<std::string> out;
-  if (sel.size() == 0) return out;
+  if (sel.size() == 0) return {};
   Hid d(check(H5Dopen2(file, ("runs/" + name).c_str(), H5P_DEFAULT), path, "open /runs/" + name));
   auto [fs, ms] = row_spaces(d, sel);
-  Hid t(utf8_vlen_type());
-  VlenStrings strs(t, ms, sel.size());
-  check(H5Dread(d, t, ms, fs, H5P_DEFAULT, strs.data()), path, "read /runs/" + name);
-  out.reserve(sel.size());
-  for (char* p : strs.ptrs) out.emplace_back(p ? p : "");
-  return out;
+  return read_vlen_strings(d, ms, fs, sel.size(), path, "read /runs/" + name);
 }
 
 std::vector<Record> read_runs_rows(hid_t file, const std::string& path, const std::vector<ColumnSpec>& columns,

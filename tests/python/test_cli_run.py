@@ -193,7 +193,10 @@ class CrashAndResume(Base):
         out = os.path.join(self.dir, "int.h5")
         p = subprocess.Popen([KS, "run", study, "-o", out, "-q", "--histories", "full", "--threads", "1"],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        time.sleep(0.3)
+        # The handlers are installed before anything is created: signal once the results file (or its
+        # hidden temporary .int.h5.tmp-PID-N) exists, not after a guessed start-up time.
+        while p.poll() is None and not any(n == "int.h5" or n.startswith(".int.h5.tmp-") for n in os.listdir(self.dir)):
+            time.sleep(0.01)
         p.send_signal(signal.SIGINT)
         stdout, _ = p.communicate()
         if p.returncode == 130:

@@ -71,6 +71,13 @@ def tearDownModule():
     TMP.cleanup()
 
 
+def engine_compilers():
+    """-D options naming the compilers the engine was built with (tests/CMakeLists.txt passes them): a
+    program linking the engine's static libraries is built with the same toolchain."""
+    return [f"-DCMAKE_{lang}_COMPILER={os.environ[var]}"
+            for lang, var in (("CXX", "KINESWEEP_CXX_COMPILER"), ("C", "KINESWEEP_C_COMPILER")) if os.environ.get(var)]
+
+
 def python_dir():
     return os.path.join(PREFIX, "lib", "python3", "dist-packages")
 
@@ -95,7 +102,8 @@ class Install(unittest.TestCase):
         with open(os.path.join(src, "main.cpp"), "w") as f:
             f.write(APP_MAIN)
         b = os.path.join(TMP.name, "app-build")
-        run(["cmake", "-S", src, "-B", b, "-DCMAKE_BUILD_TYPE=Release", f"-DCMAKE_PREFIX_PATH={PREFIX}"])
+        run(["cmake", "-S", src, "-B", b, "-DCMAKE_BUILD_TYPE=Release", f"-DCMAKE_PREFIX_PATH={PREFIX}",
+             *engine_compilers()])
         run(["cmake", "--build", b, "-j2"])
         out = json.loads(run([os.path.join(b, "ks_user"),
                               os.path.join(PREFIX, "share/kinesweep/studies/thesis_table4.toml")]).stdout)
