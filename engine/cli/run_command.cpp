@@ -130,6 +130,9 @@ RunArgs& add_run_command(CLI::App& app) {
   c->add_option("study", a.study, "study file (TOML)")->required();
   c->add_option("-o,--output", a.output, "results file (default: the study's output, results/<name>.h5)");
   c->add_option("--threads", a.threads, "worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  c->add_option("--lanes", a.lanes, "trajectory runs computed side by side in SIMD lanes: 1, 4 (AVX2) or 8 (AVX-512) "
+                "(default: the widest this processor runs; the results are the same bit for bit)")
+      ->check(CLI::IsMember({1, 4, 8}));
   c->add_flag("--resume", a.resume, "complete only the runs missing from an existing results file");
   c->add_flag("--overwrite", a.overwrite, "replace an existing results file");
   c->add_flag("--dry-run", a.dry_run, "print the output path, runs per block, estimated size and time (from sample runs); write nothing");
@@ -185,6 +188,7 @@ int run_command(const RunArgs& a) {
   r.overwrite = a.overwrite;
   r.quiet = a.quiet;
   r.options.threads = a.threads;
+  r.options.lanes = a.lanes;
   r.options.histories = histories;
   r.options.compression = a.compression;
   r.options.stop = &g_stop;

@@ -14,6 +14,7 @@ struct RunArgs {
   std::string study;
   std::string output;      ///< empty: the study's output
   int threads = 0;         ///< 0: all cores
+  int lanes = 0;           ///< runs per SIMD batch: 1, 4 or 8 (0: the widest the processor runs)
   bool resume = false, overwrite = false, dry_run = false;
   std::string histories;   ///< empty: the study's policy
   bool quiet = false;      ///< no progress display

@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <optional>
 #include <vector>
@@ -10,6 +12,7 @@
 #include "ik/solve.hpp"
 #include "methods/chain_trajectory.hpp"
 #include "methods/trajectory.hpp"
+#include "methods/trajectory_lanes.hpp"
 
 namespace ks {
 
@@ -32,6 +35,7 @@ struct RunWorkspace::Impl {
   std::vector<SampledPath> paths;  // the study's path sampled at the last few dt asked for
   std::vector<ChainTask> chain_tasks;  // the same for chains
   TrajectoryHistory history;
+  std::array<TrajectoryHistory, 8> lane_histories;  // one per lane of a batch
   ChainHistory chain_history;
   ik::Summary<3, 3> s33;
   ik::Summary<3, 2> s32;
@@ -136,6 +140,30 @@ RunOutcome run_chain_trajectory(const Scenario& sc, const TrajectoryRun& run, in
   return out;
 }
 
+/// A closed-form 3R run's outcome: its metrics and (when `h` holds samples) its history arrays.
+RunOutcome trajectory_outcome(const TrajectoryMetrics& metrics, const TrajectoryHistory* h) {
+  RunOutcome out;
+  out.result = metrics;
+  if (h && h->size > 0) {
+    const Eigen::Index n = h->size;
+    auto& a = out.history.arrays;
+    a.push_back({"t", "s", static_cast<std::size_t>(n), 1, std::vector<double>(h->t.data(), h->t.data() + n)});
+    a.push_back(array_of("q", "rad", h->q, n));
+    a.push_back(array_of("qd", "rad/s", h->qd, n));
+    a.push_back(array_of("qdd", "rad/s^2", h->qdd, n));
+    a.push_back(array_of("tau", "Nm", h->tau, n));
+    a.push_back(array_of("x", "m", h->x, n));
+    a.push_back({"alpha", "rad", static_cast<std::size_t>(n), 1, std::vector<double>(h->alpha.data(), h->alpha.data() + n)});
+  }
+  return out;
+}
+
+/// Whether a run may share SIMD lanes: a closed-form 3R trajectory run that samples its path.
+const TrajectoryRun* lane_run(const Scenario& sc, const RunSpec& run) {
+  const auto* t = std::get_if<TrajectoryRun>(&run);
+  return t && !sc.chain && samples_path(sc.task->durations, t->options.dt) ? t : nullptr;
+}
+
 RunOutcome run_trajectory(const Scenario& sc, const TrajectoryRun& run, int stride, RunWorkspace::Impl& ws) {
   if (!samples_path(sc.task->durations, run.options.dt)) {  // a swept dt too coarse for the path
     RunOutcome out;
@@ -151,20 +179,7 @@ RunOutcome run_trajectory(const Scenario& sc, const TrajectoryRun& run, int stri
     ws.history.stride = stride;
     h = &ws.history;
   }
-  RunOutcome out;
-  out.result = simulate(arm, path, run.options, h);
-  if (h && h->size > 0) {
-    const Eigen::Index n = h->size;
-    auto& a = out.history.arrays;
-    a.push_back({"t", "s", static_cast<std::size_t>(n), 1, std::vector<double>(h->t.data(), h->t.data() + n)});
-    a.push_back(array_of("q", "rad", h->q, n));
-    a.push_back(array_of("qd", "rad/s", h->qd, n));
-    a.push_back(array_of("qdd", "rad/s^2", h->qdd, n));
-    a.push_back(array_of("tau", "Nm", h->tau, n));
-    a.push_back(array_of("x", "m", h->x, n));
-    a.push_back({"alpha", "rad", static_cast<std::size_t>(n), 1, std::vector<double>(h->alpha.data(), h->alpha.data() + n)});
-  }
-  return out;
+  return trajectory_outcome(simulate(arm, path, run.options, h), h);
 }
 
 template <class P, int M>
@@ -273,6 +288,53 @@ RunOutcome execute(const Scenario& scenario, const RunSpec& run, int history_str
   if (const auto* t = std::get_if<TrajectoryRun>(&run))
     return run_trajectory(scenario, *t, history_stride, workspace.impl());
   return run_ik(scenario, std::get<IkRun>(run), history_stride, workspace.impl());
+}
+
+void execute_batch(const Scenario& scenario, const RunSpec* runs, std::size_t n, int history_stride, int lanes,
+                   RunWorkspace& workspace, RunOutcome* out, double* wall_s) {
+  using Clock = std::chrono::steady_clock;
+  RunWorkspace::Impl& ws = workspace.impl();
+  lanes = std::clamp(lanes, 1, std::min(8, max_lanes()));
+  std::vector<char> taken(n, 0);
+  std::array<std::size_t, 8> group{};
+  std::array<TrajectoryOptions, 8> options;
+  std::array<TrajectoryMetrics, 8> results;
+  std::array<TrajectoryHistory*, 8> histories{};
+  for (std::size_t i = 0; i < n; ++i) {
+    if (taken[i]) continue;
+    const TrajectoryRun* first = lanes > 1 ? lane_run(scenario, runs[i]) : nullptr;
+    const auto t0 = Clock::now();
+    if (!first) {  // one run alone
+      out[i] = execute(scenario, runs[i], history_stride, workspace);
+      wall_s[i] = std::chrono::duration<double>(Clock::now() - t0).count();
+      continue;
+    }
+    // The later runs of the batch that can share lanes with run i, in run order.
+    int count = 0;
+    for (std::size_t j = i; j < n && count < lanes; ++j) {
+      const TrajectoryRun* r = taken[j] ? nullptr : lane_run(scenario, runs[j]);
+      if (!r || r->inertia != first->inertia || !lane_compatible(first->options, r->options)) continue;
+      taken[j] = 1;
+      group[count] = j;
+      options[count] = r->options;
+      if (history_stride > 0) {
+        ws.lane_histories[count].stride = history_stride;
+        histories[count] = &ws.lane_histories[count];
+      } else {
+        histories[count] = nullptr;
+      }
+      ++count;
+    }
+    PlanarArm3 arm = *scenario.robot;
+    arm.inertia_form = first->inertia;
+    const SampledPath& path = ws.path_of(*scenario.task, first->options.dt);
+    simulate_lanes(count == 1 ? 1 : lanes, arm, path, options.data(), count, results.data(), histories.data());
+    const double each = std::chrono::duration<double>(Clock::now() - t0).count() / count;
+    for (int k = 0; k < count; ++k) {
+      out[group[k]] = trajectory_outcome(results[k], histories[k]);
+      wall_s[group[k]] = each;
+    }
+  }
 }
 
 }  // namespace ks

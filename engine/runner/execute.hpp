@@ -36,4 +36,12 @@ class RunWorkspace {
 /// iteration (ik). Never throws on bad numbers: trouble is the outcome's status.
 RunOutcome execute(const Scenario& scenario, const RunSpec& run, int history_stride, RunWorkspace& workspace);
 
+/// Execute runs[0..n) into out[0..n), wall_s[i] the seconds spent on run i (runs that share lanes
+/// share their time equally). Closed-form 3R trajectory runs that can share SIMD lanes (the same
+/// inertia form, dt, method and integrator: lane_compatible) run up to `lanes` at a time
+/// (simulate_lanes; `lanes` is capped at max_lanes()); every other run as execute(). Each out[i]
+/// equals execute(scenario, runs[i], ...) bit for bit, whatever `lanes` and whatever the other runs.
+void execute_batch(const Scenario& scenario, const RunSpec* runs, std::size_t n, int history_stride, int lanes,
+                   RunWorkspace& workspace, RunOutcome* out, double* wall_s);
+
 }  // namespace ks

@@ -14,6 +14,7 @@
 #include <ostream>
 
 #include "methods/seed_cases.hpp"
+#include "methods/trajectory_lanes.hpp"
 #include "runner/landscape.hpp"
 
 namespace ks {
@@ -193,6 +194,10 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
                      : options.histories.mode == HistoryPolicy::Mode::every ? options.histories.stride
                                                                               : 1;
   tbb::enumerable_thread_specific<RunWorkspace> workspaces;
+  // Lanes: runs per SIMD batch (results do not depend on it); a pipeline token holds enough runs to
+  // fill two batches of the widest lanes.
+  const int lanes = options.lanes > 0 ? std::min(options.lanes, max_lanes()) : max_lanes();
+  const std::size_t batch = std::max<std::size_t>(options.batch, 2 * static_cast<std::size_t>(lanes));
   const auto start = Clock::now();
   auto last_progress = start;
   std::uint64_t next = 0, written = 0;
@@ -211,10 +216,10 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
               auto b = std::make_shared<Batch>();
               if (options.source) {
                 std::vector<std::uint64_t> ids;
-                if (!interrupted && options.source(ids, options.batch))
+                if (!interrupted && options.source(ids, batch))
                   for (std::uint64_t id : ids) b->jobs.push_back(Job{id, study.locate(id), {}, {}});
               } else {
-                while (!interrupted && next < total && b->jobs.size() < options.batch) {
+                while (!interrupted && next < total && b->jobs.size() < batch) {
                   const std::uint64_t id = next++;
                   if (!is_done(id)) b->jobs.push_back(Job{id, study.locate(id), {}, {}});
                 }
@@ -230,14 +235,18 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
                 [&](std::shared_ptr<Batch> b) {
                   RunWorkspace& ws = workspaces.local();
                   const Scenario scenario = Scenario::of(study);
-                  for (Job& j : b->jobs) {
-                    const Block& block = study.blocks[j.ref.block];
-                    const RunSpec run = block.run(j.ref.local);
-                    const auto t0 = Clock::now();
-                    RunOutcome o = execute(scenario, run, stride, ws);
-                    const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+                  const std::size_t n = b->jobs.size();
+                  std::vector<RunSpec> runs;
+                  runs.reserve(n);
+                  for (const Job& j : b->jobs) runs.push_back(study.blocks[j.ref.block].run(j.ref.local));
+                  std::vector<RunOutcome> outcomes(n);
+                  std::vector<double> wall(n);
+                  execute_batch(scenario, runs.data(), n, stride, lanes, ws, outcomes.data(), wall.data());
+                  for (std::size_t i = 0; i < n; ++i) {
+                    Job& j = b->jobs[i];
+                    const RunOutcome& o = outcomes[i];
                     if (!o.history.arrays.empty()) j.history = store::encode_history(o.history, options.compression);
-                    j.row = schema.row(j.id, j.ref.block, block, run, o, wall);
+                    j.row = schema.row(j.id, j.ref.block, study.blocks[j.ref.block], runs[i], o, wall[i]);
                   }
                   return b;
                 }) &

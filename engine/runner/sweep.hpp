@@ -29,7 +29,10 @@ struct SweepOptions {
   int threads = 0;                   ///< worker threads (0: all cores)
   HistoryPolicy histories;           ///< what to keep of each run's history
   int compression = 1;               ///< deflate level of the histories (1..9; 0: raw, no filter)
-  std::size_t batch = 8;             ///< runs per pipeline token
+  std::size_t batch = 8;             ///< runs per pipeline token (at least twice `lanes`)
+  /// Runs computed side by side in SIMD lanes (1: one at a time; 0: the widest this processor runs,
+  /// max_lanes()). Results are the same bit for bit whatever the value.
+  int lanes = 0;
   const std::atomic<bool>* stop = nullptr;  ///< set (e.g. by SIGINT): finish the runs in flight and return
   std::function<void(const SweepProgress&)> on_progress;  ///< called by the writer after each batch
   /// Where run ids come from: fill `ids` with up to `max` ids to run next (ascending within a call)
