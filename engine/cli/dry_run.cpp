@@ -21,6 +21,7 @@
 #include <ostream>
 #include <thread>
 
+#include "methods/trajectory_lanes.hpp"
 #include "runner/execute.hpp"
 #include "runner/run_study.hpp"
 #include "store/store.hpp"
@@ -121,6 +122,7 @@ int dry_run(const Study& study, const StudySchema& schema, const DryRunOptions& 
   const int stride = h.mode == HistoryPolicy::Mode::none ? 0 : h.stride;
   const Scenario scenario = Scenario::of(study);
   RunWorkspace ws;
+  const int lanes = opt.lanes > 0 ? std::min(opt.lanes, max_lanes()) : max_lanes();
   std::vector<Sample> samples;
   std::vector<BlockEstimate> est(study.blocks.size());
   for (std::size_t b = 0; b < study.blocks.size(); ++b) {
@@ -131,21 +133,31 @@ int dry_run(const Study& study, const StudySchema& schema, const DryRunOptions& 
     for (std::size_t d = 0; d < shape.size(); ++d) out << (d ? " x " : " ") << shape[d];
     out << '\n';
     est[b].runs = block.run_count();
+    // The samples run in batches of `lanes`, as the sweep's workers run them (execute_batch).
     const auto start = Clock::now();
     double compute = 0;
-    for (const std::uint64_t local : spread_indices(block.run_count(), 64)) {
+    const std::vector<std::uint64_t> picks = spread_indices(block.run_count(), 64);
+    for (std::size_t first = 0; first < picks.size(); first += static_cast<std::size_t>(lanes)) {
       if (est[b].sampled >= 4 && std::chrono::duration<double>(Clock::now() - start).count() > opt.seconds_per_block)
         break;
-      const RunSpec run = block.run(local);
-      const auto t0 = Clock::now();
-      const RunOutcome o = execute(scenario, run, stride, ws);
-      store::EncodedHistory hist;
-      if (!o.history.arrays.empty()) hist = store::encode_history(o.history, opt.compression);
-      const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
-      compute += wall;
-      est[b].history_bytes += history_bytes(hist);
-      samples.push_back({b, local, schema.row(study.first_run(b) + local, b, block, run, o, wall), std::move(hist)});
-      ++est[b].sampled;
+      const std::size_t n = std::min(picks.size() - first, static_cast<std::size_t>(lanes));
+      std::vector<RunSpec> runs;
+      for (std::size_t i = 0; i < n; ++i) runs.push_back(block.run(picks[first + i]));
+      std::vector<RunOutcome> outcomes(n);
+      std::vector<double> wall(n);
+      execute_batch(scenario, runs.data(), n, stride, lanes, ws, outcomes.data(), wall.data());
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto t0 = Clock::now();
+        store::EncodedHistory hist;
+        if (!outcomes[i].history.arrays.empty()) hist = store::encode_history(outcomes[i].history, opt.compression);
+        wall[i] += std::chrono::duration<double>(Clock::now() - t0).count();
+        compute += wall[i];
+        est[b].history_bytes += history_bytes(hist);
+        samples.push_back({b, picks[first + i],
+                           schema.row(study.first_run(b) + picks[first + i], b, block, runs[i], outcomes[i], wall[i]),
+                           std::move(hist)});
+        ++est[b].sampled;
+      }
     }
     est[b].compute_s = est[b].sampled ? compute / static_cast<double>(est[b].sampled) : 0;
     if (est[b].sampled) est[b].history_bytes /= static_cast<double>(est[b].sampled);

@@ -12,6 +12,7 @@ namespace ks::cli {
 struct DryRunOptions {
   HistoryPolicy histories;  ///< the policy the run would use
   int threads = 0;          ///< 0: all cores
+  int lanes = 0;            ///< runs per SIMD batch as the sweep would use them (0: the widest)
   int compression = 1;      ///< history deflate level
   std::string output;       ///< the results file the run would write
   double seconds_per_block = 0.25;  ///< sampling budget per block (at least 4 runs each, at most 64)

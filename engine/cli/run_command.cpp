@@ -174,7 +174,7 @@ int run_command(const RunArgs& a) {
     return 2;
   }
   if (a.dry_run) {  // a few seconds at most; its temporary file is removed before it returns
-    const int code = dry_run(study, make_schema(study), {histories, a.threads, a.compression, output}, std::cout, std::cerr);
+    const int code = dry_run(study, make_schema(study), {histories, a.threads, a.lanes, a.compression, output}, std::cout, std::cerr);
     if (!g_stop.load()) return code;
     std::cerr << "kinesweep run: --dry-run interrupted; nothing written\n";
     return 130;
