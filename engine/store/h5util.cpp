@@ -1,5 +1,6 @@
 #include "store/h5util.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -90,7 +91,7 @@ std::vector<std::string> read_vlen_strings(hid_t dset, hid_t mem_space, hid_t fi
   }
   if (n == 0) return out;
   VlenBlocks blocks;  // outlives the transfer list that allocates into it
-  Hid xfer(check(H5Pcreate(H5P_DATASET_XFER), path, what));
+  Hid xfer(check(string_transfer(n), path, what));
   check(H5Pset_vlen_mem_manager(xfer, vlen_alloc, &blocks, vlen_free, &blocks), path, what);
   Hid type(utf8_vlen_type());
   std::vector<char*> ptrs(n, nullptr);
@@ -99,6 +100,20 @@ std::vector<std::string> read_vlen_strings(hid_t dset, hid_t mem_space, hid_t fi
   for (char* p : ptrs) out.emplace_back(p ? p : "");
   return out;
 }
+
+hid_t conversion_transfer(std::size_t n, std::size_t element_bytes) {
+  const hid_t xfer = H5Pcreate(H5P_DATASET_XFER);
+  if (xfer < 0) return xfer;
+  // HDF5 strip-mines a transfer larger than the buffer; the cap keeps a huge read's buffer at the default
+  const std::size_t bytes = std::min<std::size_t>(std::max<std::size_t>(n, 1) * element_bytes, std::size_t{1} << 20);
+  if (H5Pset_buffer(xfer, bytes, nullptr, nullptr) < 0) {
+    H5Pclose(xfer);
+    return -1;
+  }
+  return xfer;
+}
+
+hid_t string_transfer(std::size_t n) { return conversion_transfer(n, 16); }
 
 void write_str_attr(hid_t obj, const char* name, const std::string& value) {
   if (H5Aexists(obj, name) > 0) H5Adelete(obj, name);

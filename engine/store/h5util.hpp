@@ -92,6 +92,13 @@ std::string h5_error_text();
 hid_t check(hid_t id, const std::string& path, const std::string& what);
 
 hid_t utf8_vlen_type();  // caller closes
+/// A dataset-transfer property list (caller closes; negative on failure) whose type-conversion
+/// buffer holds `n` converted elements of at most `element_bytes` each. Without it every H5Dread or
+/// H5Dwrite that converts (variable-length strings do) allocates and zeroes HDF5's default 1 MiB,
+/// whatever the number of elements.
+hid_t conversion_transfer(std::size_t n, std::size_t element_bytes);
+/// conversion_transfer() for `n` variable-length strings (16 bytes each in memory and in the file).
+hid_t string_transfer(std::size_t n);
 void write_str_attr(hid_t obj, const char* name, const std::string& value);
 void write_i64_attr(hid_t obj, const char* name, std::int64_t value);
 void write_str_list_attr(hid_t obj, const char* name, const std::vector<std::string>& values);

@@ -364,7 +364,9 @@ void ResultsWriter::Impl::write_rows() {
         std::vector<const char*> v;
         for (auto& [id, rec] : pending) v.push_back(std::get<std::string>(rec.cells[c]).c_str());
         Hid t(utf8_vlen_type());
-        rc = H5Dwrite(col_dsets[c], t, mspace, fs, H5P_DEFAULT, v.data());
+        Hid xfer(string_transfer(v.size()));
+        if (!xfer.ok()) fail("cannot write column " + columns[c].name);
+        rc = H5Dwrite(col_dsets[c], t, mspace, fs, xfer, v.data());
         break;
       }
     }
