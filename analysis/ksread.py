@@ -6,9 +6,10 @@
     runs["E"], runs.units["E"]           # array, "Nm"
     r.parameters(), r.metrics("ik")      # column names by role (and run kind), from the file's attributes
     r.row_kinds()                        # each (done) row's run kind: "trajectory", "ik"
-    df = r.runs(pandas=True)             # a pandas.DataFrame when pandas is installed (units in df.attrs)
+    df = r.to_pandas()                   # the same as a pandas.DataFrame (units in df.attrs)
     h = r.history(3)                     # dict of 2-D arrays (rows x components) with .units
     ls = r.landscape("local")            # axes (name, unit, values, labels) and gridded metrics
+    ds = r.to_xarray("local")            # the same as an xarray.Dataset: named dimensions, coordinates, units
     o = r.optimization("1h", degrees=True)   # an [[optimize]] block: evaluations, stages, local paths, best
     o.evaluations["x"], o.units          # n x d points, one unit per variable ("deg" for angles here)
 
@@ -25,6 +26,7 @@ import h5py
 import numpy as np
 
 from kssolutions import cluster_solutions  # noqa: F401 (part of this module's interface)
+from kstypes import IK_STATUSES, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s  # noqa: F401 (the same)
 
 RAD2DEG = 180.0 / np.pi
 FORMAT_VERSION = 2  # the results format this module reads (engine/store/FORMAT.md)
@@ -62,80 +64,8 @@ THESIS_OPTIMA = {
     "local_unweighted": {"global": "2h", "partial": ["2d", "2f", "2g"]},
 }
 
-TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged", "undersampled"]
-IK_STATUSES = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution",
-               "out_of_limits"]
-
-
-def _s(v):
-    return v.decode() if isinstance(v, bytes) else str(v)
-
-
 class FormatVersionError(ValueError):
     """A results file of a format_version this module does not read."""
-
-
-class Table(dict):
-    """dict of column name -> 1-D numpy array, with .units and .descriptions dicts (runs(): also .roles,
-    column -> "parameter" | "metric" | "bookkeeping", and .kinds, column -> list of run kinds, [] = all)."""
-
-    def __init__(self, *a, **kw):
-        super().__init__(*a, **kw)
-        self.units = {}
-        self.descriptions = {}
-        self.roles = {}
-        self.kinds = {}
-
-    def __len__(self):  # number of rows, as for a DataFrame
-        return len(next(iter(self.values()))) if dict.__len__(self) else 0
-
-    def columns(self):
-        return list(self.keys())
-
-    def to_pandas(self):
-        import pandas as pd  # optional dependency
-        df = pd.DataFrame(dict(self))
-        df.attrs["units"] = dict(self.units)
-        return df
-
-
-class Axis:
-    def __init__(self, name, unit, values, labels=None):
-        self.name, self.unit, self.values, self.labels = name, unit, values, labels
-
-    @property
-    def categorical(self):
-        return self.labels is not None
-
-    def __repr__(self):
-        return f"Axis({self.name!r}, {self.unit!r}, {len(self.values)} values)"
-
-
-class Landscape:
-    """A block's gridded metrics: .axes (list of Axis), .metrics (name -> N-D array, NaN = no value),
-    .units / .descriptions (name -> str), .kind (the block's run kind, from its /runs rows).
-    metrics[m][i, j, ...] is at axes[0].values[i], ..."""
-
-    def __init__(self, block, axes, metrics, units, descriptions, kind=""):
-        self.block, self.axes, self.metrics, self.units, self.descriptions = block, axes, metrics, units, descriptions
-        self._kind = kind
-
-    def axis(self, name):
-        for a in self.axes:
-            if a.name == name:
-                return a
-        raise KeyError(f"landscape {self.block} has no axis {name!r}; axes: {', '.join(a.name for a in self.axes)}")
-
-    def axis_index(self, name):
-        return [a.name for a in self.axes].index(self.axis(name).name)
-
-    @property
-    def kind(self):
-        return self._kind
-
-    @property
-    def statuses(self):
-        return IK_STATUSES if self.kind == "ik" else TRAJECTORY_STATUSES
 
 
 class Optimization:
@@ -364,6 +294,14 @@ class Results:
             t.units["done"] = ""
             t.roles["done"], t.kinds["done"] = "bookkeeping", []
         return t.to_pandas() if pandas else t
+
+    def to_pandas(self, columns=None, done_only=True, degrees=False):
+        """The /runs table as a pandas.DataFrame (units in df.attrs["units"]): runs(..., pandas=True)."""
+        return self.runs(columns, done_only=done_only, degrees=degrees, pandas=True)
+
+    def to_xarray(self, block=None, degrees=False):
+        """A block's landscape (default: the first) as an xarray.Dataset (Landscape.to_xarray)."""
+        return self.landscape(block, degrees=degrees).to_xarray()
 
     def has_history(self, run_id):
         return "histories" in self.f and history_group_name(run_id, self.n_runs) in self.f["histories"]

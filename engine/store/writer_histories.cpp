@@ -1,5 +1,6 @@
 // ResultsWriter's histories and landscapes, and encode_history (see store.hpp, FORMAT.md:
 // "/histories", "/landscapes"): the compression runs in worker threads, the writer thread only stores.
+#include <hdf5_hl.h>  // H5DS: dimension scales
 #include <libdeflate.h>
 
 #include <algorithm>
@@ -179,6 +180,9 @@ void ResultsWriter::write_landscape(const LandscapeSpec& spec) {
   if (!g.ok()) m.fail("cannot create /landscapes/" + spec.block);
   write_str_list_attr(g, "axes", axis_names);
   write_str_list_attr(g, "metrics", metric_names);
+  // Each axis is an HDF5 dimension scale attached to its dimension of every metric, so that netCDF
+  // readers (xarray with h5netcdf) see named dimensions with these values as coordinates.
+  std::vector<Hid> axis_dsets;
   for (auto& a : spec.axes) {
     hsize_t n = a.values.size();
     Hid space(H5Screate_simple(1, &n, nullptr));
@@ -186,7 +190,10 @@ void ResultsWriter::write_landscape(const LandscapeSpec& spec) {
     if (!d.ok() || (n > 0 && H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.values.data()) < 0))
       m.fail("cannot write landscape axis " + a.name);
     write_str_attr(d, "unit", a.unit);
+    write_str_attr(d, "units", a.unit);  // the CF name, which xarray's plots label axes with
     write_str_attr(d, "kind", "axis");
+    if (H5DSset_scale(d, a.name.c_str()) < 0) m.fail("cannot make landscape axis " + a.name + " a dimension scale");
+    axis_dsets.push_back(std::move(d));
   }
   for (auto& mt : spec.metrics) {
     Hid space(dims.empty() ? H5Screate(H5S_SCALAR)
@@ -196,9 +203,14 @@ void ResultsWriter::write_landscape(const LandscapeSpec& spec) {
         (cells > 0 && H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, mt.grid.data()) < 0))
       m.fail("cannot write landscape metric " + mt.name);
     write_str_attr(d, "unit", mt.unit);
+    write_str_attr(d, "units", mt.unit);
     write_str_attr(d, "description", mt.description);
+    write_str_attr(d, "long_name", mt.description);
     write_str_attr(d, "kind", "metric");
     write_str_list_attr(d, "axes", axis_names);
+    for (std::size_t i = 0; i < axis_dsets.size(); ++i)
+      if (H5DSattach_scale(d, axis_dsets[i], static_cast<unsigned>(i)) < 0)
+        m.fail("cannot attach landscape axis " + axis_names[i] + " to metric " + mt.name);
   }
   m.do_flush();
 }

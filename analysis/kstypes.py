@@ -1,0 +1,92 @@
+"""The plain data types ksread returns: Table (a /runs table or a history), Axis and Landscape (a
+block's gridded metrics), with their conversions to pandas and xarray (each an optional dependency,
+imported when asked for). Run with Debian's interpreter: /usr/bin/python3.
+"""
+import numpy as np
+
+TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged", "undersampled"]
+IK_STATUSES = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution",
+               "out_of_limits"]
+
+
+def _s(v):
+    return v.decode() if isinstance(v, bytes) else str(v)
+
+
+class Table(dict):
+    """dict of column name -> 1-D numpy array, with .units and .descriptions dicts (runs(): also .roles,
+    column -> "parameter" | "metric" | "bookkeeping", and .kinds, column -> list of run kinds, [] = all)."""
+
+    def __init__(self, *a, **kw):
+        super().__init__(*a, **kw)
+        self.units = {}
+        self.descriptions = {}
+        self.roles = {}
+        self.kinds = {}
+
+    def __len__(self):  # number of rows, as for a DataFrame
+        return len(next(iter(self.values()))) if dict.__len__(self) else 0
+
+    def columns(self):
+        return list(self.keys())
+
+    def to_pandas(self):
+        import pandas as pd  # optional dependency
+        df = pd.DataFrame(dict(self))
+        df.attrs["units"] = dict(self.units)
+        return df
+
+
+class Axis:
+    def __init__(self, name, unit, values, labels=None):
+        self.name, self.unit, self.values, self.labels = name, unit, values, labels
+
+    @property
+    def categorical(self):
+        return self.labels is not None
+
+    def __repr__(self):
+        return f"Axis({self.name!r}, {self.unit!r}, {len(self.values)} values)"
+
+
+class Landscape:
+    """A block's gridded metrics: .axes (list of Axis), .metrics (name -> N-D array, NaN = no value),
+    .units / .descriptions (name -> str), .kind (the block's run kind, from its /runs rows).
+    metrics[m][i, j, ...] is at axes[0].values[i], ..."""
+
+    def __init__(self, block, axes, metrics, units, descriptions, kind=""):
+        self.block, self.axes, self.metrics, self.units, self.descriptions = block, axes, metrics, units, descriptions
+        self._kind = kind
+
+    def axis(self, name):
+        for a in self.axes:
+            if a.name == name:
+                return a
+        raise KeyError(f"landscape {self.block} has no axis {name!r}; axes: {', '.join(a.name for a in self.axes)}")
+
+    def axis_index(self, name):
+        return [a.name for a in self.axes].index(self.axis(name).name)
+
+    @property
+    def kind(self):
+        return self._kind
+
+    @property
+    def statuses(self):
+        return IK_STATUSES if self.kind == "ik" else TRAJECTORY_STATUSES
+
+    @staticmethod
+    def _coordinate(a):
+        """An axis' coordinate values: its values, or the label each value (0 .. n-1) indexes."""
+        return np.array([a.labels[int(v)] for v in a.values], dtype=object) if a.categorical else a.values
+
+    def to_xarray(self):
+        """The landscape as an xarray.Dataset: one data variable per metric over the dimensions named
+        after the axes, each axis a coordinate (its labels for a string axis such as `method`); units
+        and descriptions in the variables' attrs ("units", "long_name"), block and kind in the Dataset's."""
+        import xarray as xr  # optional dependency
+        dims = [a.name for a in self.axes]
+        coords = {a.name: (a.name, self._coordinate(a), {"units": a.unit}) for a in self.axes}
+        data = {m: (dims, v, {"units": self.units.get(m, ""), "long_name": self.descriptions.get(m, "")})
+                for m, v in self.metrics.items()}
+        return xr.Dataset(data, coords=coords, attrs={"block": self.block, "kind": self.kind})
