@@ -25,6 +25,7 @@ import os
 import h5py
 import numpy as np
 
+import kslive
 from kssolutions import cluster_solutions  # noqa: F401 (part of this module's interface)
 from kstypes import IK_STATUSES, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s  # noqa: F401 (the same)
 
@@ -155,15 +156,27 @@ class Optimization:
 
 
 class Results:
-    """An open results file (read-only). Safe on a file a sweep is writing: it sees the last commit."""
+    """An open results file (read-only). Safe on a file a sweep is writing: every call reads one
+    committed state, the newest when it starts (kslive: retried from a fresh open when a commit lands
+    under it), so run counts never go backwards."""
 
     def __init__(self, path):
         if not os.path.exists(path):
             raise FileNotFoundError(path)
         self.path = path
-        self.f = h5py.File(path, "r")
+        self.f, self._stamp = kslive.open_snapshot(path, self._open_file)
+
+    def _reopen(self):
+        """A fresh handle on the file's newest committed state (kslive.consistent calls it)."""
+        self.f.close()
+        self.f, self._stamp = kslive.open_snapshot(self.path, lambda: h5py.File(self.path, "r"))
+
+    def _open_file(self):
+        """Open the file and read what every call needs (format, roles and kinds of the columns)."""
+        path = self.path
+        f = h5py.File(path, "r")
         try:
-            a = self.f.attrs
+            a = f.attrs
             if _s(a.get("format", "")) != "kinesweep-results":
                 raise ValueError(f"{path}: not a kinesweep results file")
             self.meta = {k: (_s(v) if isinstance(v, (bytes, str)) else v.item() if hasattr(v, "item") else v)
@@ -178,18 +191,19 @@ class Results:
                              "and `kinesweep info` still read this file; to use it here, rerun its study: "
                              "kinesweep run STUDY.toml --overwrite")
                 raise FormatVersionError(what)
-            self.study_text = _s(self.f["study"]["text"][()])
+            self.study_text = _s(f["study"]["text"][()])
             self._roles, self._kinds = {}, {}
-            for c in self.columns():
-                attrs = self.f["runs"][c].attrs
+            for c in (_s(x) for x in f["runs"].attrs["columns"]):
+                attrs = f["runs"][c].attrs
                 role = _s(attrs.get("role", ""))
                 if role not in ROLES or "kinds" not in attrs:
                     raise ValueError(f"{path}: /runs/{c} has no valid role/kinds attributes (role {role!r})")
                 self._roles[c] = role
                 self._kinds[c] = [k for k in _s(attrs["kinds"]).split(",") if k]
         except Exception:
-            self.f.close()
+            f.close()
             raise
+        return f
 
     def close(self):
         self.f.close()
@@ -201,12 +215,15 @@ class Results:
         self.close()
 
     @property
+    @kslive.consistent
     def n_runs(self):
         return int(self.f["runs"].attrs.get("n_runs", len(self.f["runs"]["done"])))
 
+    @kslive.consistent
     def columns(self):
         return [_s(c) for c in self.f["runs"].attrs["columns"]]
 
+    @kslive.consistent
     def units(self):
         return {c: _s(self.f["runs"][c].attrs.get("unit", "")) for c in self.columns()}
 
@@ -241,6 +258,7 @@ class Results:
         """The bookkeeping columns (run_id, block, status, wall_time)."""
         return self._by_role("bookkeeping", None)
 
+    @kslive.consistent
     def row_kinds(self, done_only=True):
         """Each row's run kind, an object array aligned with runs(done_only=...): the kind of the
         single-kind parameter (else metric) columns that hold a value in the row; "" when none does
@@ -268,6 +286,7 @@ class Results:
         """The run kind of one row (see row_kinds)."""
         return self.row_kinds(done_only=False)[int(run_id)]
 
+    @kslive.consistent
     def runs(self, columns=None, done_only=True, degrees=False, pandas=False):
         """The /runs table: Table (dict of arrays; strings as str objects) or a pandas DataFrame."""
         g = self.f["runs"]
@@ -303,9 +322,11 @@ class Results:
         """A block's landscape (default: the first) as an xarray.Dataset (Landscape.to_xarray)."""
         return self.landscape(block, degrees=degrees).to_xarray()
 
+    @kslive.consistent
     def has_history(self, run_id):
         return "histories" in self.f and history_group_name(run_id, self.n_runs) in self.f["histories"]
 
+    @kslive.consistent
     def history(self, run_id, degrees=False):
         """One run's history: Table of name -> 2-D array (rows x components), .units per array
         (IK q: "rad, rad, mm" -- one unit per component)."""
@@ -335,6 +356,7 @@ class Results:
             h.units[a] = unit
         return h
 
+    @kslive.consistent
     def blocks(self):
         """The block names in file order: order of first appearance in the /runs `block` column."""
         if "block" not in self.f["runs"]:
@@ -342,6 +364,7 @@ class Results:
         names = [_s(x) for x in self.f["runs"]["block"][()]]
         return [b for b in dict.fromkeys(names) if b]
 
+    @kslive.consistent
     def landscapes(self):
         """The /landscapes groups in block order (blocks()), any other after them."""
         if "landscapes" not in self.f:
@@ -350,6 +373,7 @@ class Results:
         order = [b for b in self.blocks() if b in have]
         return order + [b for b in have if b not in order]
 
+    @kslive.consistent
     def landscape(self, block=None, degrees=False):
         names = self.landscapes()
         if not names:
@@ -387,10 +411,12 @@ class Results:
         return kinds[0] if kinds else ""
 
 
+    @kslive.consistent
     def optimizations(self):
         """Names of the /optimizations groups (empty when the file has none)."""
         return list(self.f["optimizations"]) if "optimizations" in self.f else []
 
+    @kslive.consistent
     def optimization(self, name=None, degrees=False):
         """One /optimizations group as an Optimization (default: the first)."""
         names = self.optimizations()
