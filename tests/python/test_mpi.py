@@ -186,8 +186,12 @@ class SignalBeforeTheSweep(Base):
             pids = [pid for pid in (rank_pid(p.pid, 0), rank_pid(p.pid, 1)) if pid]
             time.sleep(0.05)
         self.assertEqual(len(pids), 2, "ranks not found")
-        lines = [p.stderr.readline(), p.stderr.readline()]  # both ranks validated the study and wait
-        self.assertTrue(all("paused before the sweep" in line for line in lines), lines)
+        # both ranks validated the study and wait; their two lines may reach the pipe interleaved
+        said = ""
+        while said.count("paused before the sweep") < 2:
+            line = p.stderr.readline()
+            self.assertNotEqual(line, "", f"the ranks ended before pausing: {said!r}")
+            said += line
         os.kill(pids[1], signal.SIGTERM)  # one rank's signal stops every rank
         os.kill(pids[0], signal.SIGTERM)
         _, stderr = p.communicate(timeout=120)
