@@ -30,10 +30,15 @@ LandscapeGrid::LandscapeGrid(const Block& block) : block_(block) {
   sources_.push_back(Source::status_code);
   metric_index_.push_back(ms.size());
   enabled_ = block.run_count() <= kMaxLandscapeCells && !block.overflowed();
-  if (enabled_) grids_.assign(names_.size(), std::vector<double>(block.run_count(), kNaN));
+  cell_.assign(names_.size(), kNaN);
 }
 
-void LandscapeGrid::add(std::uint64_t local, const Record& row, const StudySchema& schema, std::size_t b) {
+void LandscapeGrid::begin(store::ResultsWriter& writer) {
+  if (enabled_) handle_ = writer.begin_landscape(spec());
+}
+
+void LandscapeGrid::add(std::uint64_t local, const Record& row, const StudySchema& schema, std::size_t b,
+                        store::ResultsWriter& writer) {
   if (!enabled_) return;
   const std::string& status = std::get<std::string>(row.cells[schema.status]);
   const auto names = statuses(block_.kind());
@@ -51,11 +56,12 @@ void LandscapeGrid::add(std::uint64_t local, const Record& row, const StudySchem
           v = kNaN;  // the missing integer (solution -1: none reached)
         break;
     }
-    grids_[m][local] = v;
+    cell_[m] = v;
   }
+  writer.write_landscape_cell(handle_, local, cell_.data());
 }
 
-store::LandscapeSpec LandscapeGrid::take_spec() {
+store::LandscapeSpec LandscapeGrid::spec() const {
   store::LandscapeSpec s;
   s.block = block_.name();
   for (const Dim& d : block_.dims()) {
@@ -79,7 +85,6 @@ store::LandscapeSpec LandscapeGrid::take_spec() {
   for (std::size_t m = 0; m < names_.size(); ++m) {
     store::LandscapeMetric lm;
     lm.name = names_[m];
-    lm.grid = std::move(grids_[m]);
     if (sources_[m] == Source::column) lm.unit = ms[metric_index_[m]].unit, lm.description = ms[metric_index_[m]].description;
     if (sources_[m] == Source::is_ok) lm.description = "1 where the run's status is " + lm.name + ", else 0";
     if (sources_[m] == Source::status_code) {

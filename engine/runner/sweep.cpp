@@ -44,12 +44,14 @@ const std::string& as_str(const Cell& c) {
   return s ? *s : empty;
 }
 
-/// The writer-side bookkeeping: landscapes, status counts, best rows, seed rows.
+/// The writer-side bookkeeping: landscape cells, status counts, best rows, seed rows.
 class Accumulator {
  public:
-  Accumulator(const Study& study, const StudySchema& schema) : study_(study), schema_(schema) {
+  Accumulator(const Study& study, const StudySchema& schema, store::ResultsWriter& writer)
+      : study_(study), schema_(schema), writer_(writer) {
     for (std::size_t b = 0; b < study.blocks.size(); ++b) {
       grids_.emplace_back(study.blocks[b]);
+      grids_.back().begin(writer);
       BlockReport r;
       r.name = study.blocks[b].name();
       r.kind = study.blocks[b].kind();
@@ -84,7 +86,7 @@ class Accumulator {
     BlockReport& br = report_.blocks[ref.block];
     const std::string& status = as_str(row.cells[schema_.status]);
     ++br.by_status[status];
-    grids_[ref.block].add(ref.local, row, schema_, ref.block);
+    grids_[ref.block].add(ref.local, row, schema_, ref.block, writer_);
     const bool traj = block.kind() == BlockKind::trajectory;
     const bool good = status == statuses(block.kind()).front();
     const Columns& c = columns_[ref.block];
@@ -103,9 +105,7 @@ class Accumulator {
     }
   }
 
-  SweepReport finish(store::ResultsWriter& writer) {
-    for (std::size_t b = 0; b < grids_.size(); ++b)
-      if (grids_[b].enabled()) writer.write_landscape(grids_[b].take_spec());
+  SweepReport finish() {
     for (auto& [id, s] : seed_) report_.seed_rows.push_back(s);
     return std::move(report_);
   }
@@ -144,6 +144,7 @@ class Accumulator {
 
   const Study& study_;
   const StudySchema& schema_;
+  store::ResultsWriter& writer_;  // the landscapes' cells go there with their rows
   std::vector<LandscapeGrid> grids_;
   SweepReport report_;
   std::map<std::uint64_t, SeedRow> seed_;
@@ -187,7 +188,7 @@ std::uint64_t add_previous(const Study& study, const PreviousRuns& previous, sto
 SweepReport run_sweep(const Study& study, const StudySchema& schema, store::ResultsWriter& writer,
                       const SweepOptions& options, const PreviousRuns* previous) {
   const std::uint64_t total = study.run_count();
-  Accumulator acc(study, schema);
+  Accumulator acc(study, schema, writer);
   const std::uint64_t skipped = previous ? add_previous(study, *previous, writer, acc) : 0;
   const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
   const int stride = options.histories.mode == HistoryPolicy::Mode::none ? 0
@@ -269,7 +270,7 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
   if (options.on_progress) options.on_progress({written, todo, std::chrono::duration<double>(Clock::now() - start).count()});
   SweepReport report;
   if (!interrupted) {
-    report = acc.finish(writer);
+    report = acc.finish();
   } else {
     report = std::move(acc.report());
   }

@@ -176,7 +176,16 @@ class ResultsWriter {
   /// Commit everything written so far (atomic: after a crash the file holds exactly the runs done
   /// at the last completed flush).
   void flush();
-  /// Write /landscapes/<block>/ (replacing an existing one) and flush.
+  /// Create /landscapes/<spec.block>/ (replacing an existing one) with the axes of `spec` and its
+  /// metrics' names, units and descriptions (their grids are not read): every cell NaN until
+  /// write_landscape_cell sets it. Returns the landscape's handle. The group is written at once
+  /// (committed at the next flush), so a file of an interrupted sweep has its partial landscapes.
+  std::size_t begin_landscape(const LandscapeSpec& spec);
+  /// Set one cell (row-major index into the axes' grid) of a begun landscape to `values` (one per
+  /// metric, in the spec's order). Written with the rows and committed with them; a cell set twice
+  /// keeps its last values. Memory: only cells not yet written are held.
+  void write_landscape_cell(std::size_t landscape, std::uint64_t cell, const double* values);
+  /// Write /landscapes/<block>/ with every cell of `spec` (replacing an existing one) and flush.
   void write_landscape(const LandscapeSpec& spec);
   /// Write /optimizations/<record.name>/ (replacing an existing one) and flush (optimizations.cpp).
   void write_optimization(const OptimizationRecord& record);

@@ -337,6 +337,7 @@ Hid select_rows(hid_t dset, const std::vector<hsize_t>& ids) {
 }  // namespace
 
 void ResultsWriter::Impl::write_rows() {
+  write_landscape_cells();
   if (pending.empty()) return;
   std::vector<hsize_t> ids;
   ids.reserve(pending.size());
@@ -412,6 +413,7 @@ void ResultsWriter::close() {
     m.closed = true;
     // the driver refuses to commit after an I/O error; the file keeps its last committed state
     m.col_dsets.clear();
+    m.landscape_streams.clear();
     m.done_dset.reset(); m.runs.reset(); m.histories.reset(); m.landscapes.reset();
     H5Fclose(m.file.release());
     H5Eclear2(H5E_DEFAULT);
@@ -419,6 +421,7 @@ void ResultsWriter::close() {
   }
   m.do_flush();
   m.col_dsets.clear();
+  m.landscape_streams.clear();
   m.done_dset.reset(); m.runs.reset(); m.histories.reset(); m.landscapes.reset();
   m.closed = true;
   if (H5Fclose(m.file.release()) < 0) {

@@ -1,6 +1,5 @@
-// ResultsWriter's histories and landscapes, and encode_history (see store.hpp, FORMAT.md:
-// "/histories", "/landscapes"): the compression runs in worker threads, the writer thread only stores.
-#include <hdf5_hl.h>  // H5DS: dimension scales
+// ResultsWriter's histories and encode_history (see store.hpp, FORMAT.md: "/histories"): the
+// compression runs in worker threads, the writer thread only stores.
 #include <libdeflate.h>
 
 #include <algorithm>
@@ -148,71 +147,6 @@ void ResultsWriter::Impl::write_history(std::int64_t id, const EncodedHistory& h
     write_str_attr(d, "unit", a.unit);
   }
   write_str_list_attr(g, "arrays", names);
-}
-
-void ResultsWriter::write_landscape(const LandscapeSpec& spec) {
-  QuietHdf5 quiet;
-  Impl& m = *impl_;
-  m.usable();
-  validate_name(m.path, spec.block, "landscape block");
-  std::size_t cells = 1;
-  std::vector<hsize_t> dims;
-  std::set<std::string> names;
-  std::vector<std::string> axis_names, metric_names;
-  for (auto& a : spec.axes) {
-    validate_name(m.path, a.name, "landscape axis");
-    if (!names.insert(a.name).second) throw StoreError(m.path, "landscape " + spec.block + ": duplicate name " + a.name);
-    dims.push_back(a.values.size());
-    cells *= a.values.size();
-    axis_names.push_back(a.name);
-  }
-  for (auto& mt : spec.metrics) {
-    validate_name(m.path, mt.name, "landscape metric");
-    if (!names.insert(mt.name).second) throw StoreError(m.path, "landscape " + spec.block + ": duplicate name " + mt.name);
-    if (mt.grid.size() != cells)
-      throw StoreError(m.path, "landscape " + spec.block + ": metric " + mt.name + " has " +
-                                   std::to_string(mt.grid.size()) + " values, the axes span " + std::to_string(cells));
-    metric_names.push_back(mt.name);
-  }
-  if (link_exists(m.landscapes, spec.block) && H5Ldelete(m.landscapes, spec.block.c_str(), H5P_DEFAULT) < 0)
-    m.fail("cannot replace /landscapes/" + spec.block);
-  Hid g(H5Gcreate2(m.landscapes, spec.block.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-  if (!g.ok()) m.fail("cannot create /landscapes/" + spec.block);
-  write_str_list_attr(g, "axes", axis_names);
-  write_str_list_attr(g, "metrics", metric_names);
-  // Each axis is an HDF5 dimension scale attached to its dimension of every metric, so that netCDF
-  // readers (xarray with h5netcdf) see named dimensions with these values as coordinates.
-  std::vector<Hid> axis_dsets;
-  for (auto& a : spec.axes) {
-    hsize_t n = a.values.size();
-    Hid space(H5Screate_simple(1, &n, nullptr));
-    Hid d(H5Dcreate2(g, a.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-    if (!d.ok() || (n > 0 && H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.values.data()) < 0))
-      m.fail("cannot write landscape axis " + a.name);
-    write_str_attr(d, "unit", a.unit);
-    write_str_attr(d, "units", a.unit);  // the CF name, which xarray's plots label axes with
-    write_str_attr(d, "kind", "axis");
-    if (H5DSset_scale(d, a.name.c_str()) < 0) m.fail("cannot make landscape axis " + a.name + " a dimension scale");
-    axis_dsets.push_back(std::move(d));
-  }
-  for (auto& mt : spec.metrics) {
-    Hid space(dims.empty() ? H5Screate(H5S_SCALAR)
-                           : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr));
-    Hid d(H5Dcreate2(g, mt.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-    if (!d.ok() ||
-        (cells > 0 && H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, mt.grid.data()) < 0))
-      m.fail("cannot write landscape metric " + mt.name);
-    write_str_attr(d, "unit", mt.unit);
-    write_str_attr(d, "units", mt.unit);
-    write_str_attr(d, "description", mt.description);
-    write_str_attr(d, "long_name", mt.description);
-    write_str_attr(d, "kind", "metric");
-    write_str_list_attr(d, "axes", axis_names);
-    for (std::size_t i = 0; i < axis_dsets.size(); ++i)
-      if (H5DSattach_scale(d, axis_dsets[i], static_cast<unsigned>(i)) < 0)
-        m.fail("cannot attach landscape axis " + axis_names[i] + " to metric " + mt.name);
-  }
-  m.do_flush();
 }
 
 }  // namespace ks::store

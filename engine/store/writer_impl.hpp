@@ -23,6 +23,16 @@ struct ResultsWriter::Impl {
   std::vector<std::uint8_t> done;       // committed or pending
   std::map<std::int64_t, Record> pending;   // rows not yet in the datasets
   std::vector<hsize_t> unflagged;           // rows in the datasets, not yet committed with done = 1
+  /// A landscape whose cells are streamed in (writer_landscapes.cpp): its metric datasets and the
+  /// cells set since the last write_rows (values cell-major, one per metric).
+  struct LandscapeStream {
+    std::string block;
+    std::vector<hsize_t> dims;
+    std::vector<detail::Hid> metrics;
+    std::vector<std::uint64_t> cells;
+    std::vector<double> values;
+  };
+  std::vector<LandscapeStream> landscape_streams;
   static constexpr std::size_t kRowBatch = 512;
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false, broken = false;
@@ -40,7 +50,8 @@ struct ResultsWriter::Impl {
   }
   void open_objects();
   void write_history(std::int64_t id, const EncodedHistory& h);
-  void write_rows();  // pending rows into the datasets (no commit)
+  void write_rows();  // pending rows and landscape cells into the datasets (no commit)
+  void write_landscape_cells();  // the pending landscape cells (writer_landscapes.cpp)
   void do_flush();    // write_rows, commit, set done flags, commit
 };
 

@@ -1,0 +1,207 @@
+// ResultsWriter's landscapes (store.hpp, FORMAT.md "/landscapes"): the group, its axes as dimension
+// scales, and metric datasets whose cells are streamed in with the rows of their runs.
+#include <hdf5_hl.h>  // H5DS: dimension scales
+
+#include <algorithm>
+#include <limits>
+#include <numeric>
+#include <set>
+
+#include "store/h5util.hpp"
+#include "store/store.hpp"
+#include "store/writer_impl.hpp"
+
+namespace ks::store {
+using namespace detail;
+
+namespace {
+constexpr hsize_t kChunkCells = 8192;          // 64 KiB of f64 per chunk
+constexpr std::size_t kPendingCells = 1 << 16;  // cells held before they are written (rows: kRowBatch)
+
+/// Chunk shape of a grid: whole trailing dimensions first, about kChunkCells cells.
+std::vector<hsize_t> chunk_shape(const std::vector<hsize_t>& dims) {
+  std::vector<hsize_t> c(dims.size(), 1);
+  hsize_t room = kChunkCells;
+  for (std::size_t j = dims.size(); j-- > 0 && room > 1;) {
+    c[j] = std::max<hsize_t>(1, std::min(dims[j], room));
+    room /= c[j];
+  }
+  return c;
+}
+
+/// Adds to `space` (op: set for the first block, or) the cells [first, first + count) of a
+/// row-major grid of shape `dims`, as at most 2 * rank - 1 hyperslab blocks: a partial row, whole
+/// slabs, a partial row again, each in row-major order.
+bool select_flat_range(hid_t space, const std::vector<hsize_t>& dims, hsize_t first, hsize_t count, H5S_seloper_t& op) {
+  const std::size_t r = dims.size();
+  std::vector<hsize_t> stride(r + 1, 1);  // stride[k]: cells in the trailing k dimensions
+  for (std::size_t k = 1; k <= r; ++k) stride[k] = stride[k - 1] * dims[r - k];
+  std::vector<hsize_t> start(r), block(r);
+  while (count > 0) {
+    std::size_t k = 0;  // the most trailing dimensions that `first` starts whole and `count` covers
+    while (k < r && first % stride[k + 1] == 0 && count >= stride[k + 1]) ++k;
+    hsize_t rest = first;
+    for (std::size_t j = r; j-- > 0;) start[j] = rest % dims[j], rest /= dims[j];
+    std::fill(block.begin(), block.end(), 1);
+    for (std::size_t j = r - k; j < r; ++j) block[j] = dims[j];
+    hsize_t take = stride[k];
+    if (k < r) {  // several slabs along the next dimension, up to its end
+      const std::size_t d = r - 1 - k;
+      const hsize_t m = std::min(count / stride[k], dims[d] - start[d]);
+      block[d] = m;
+      take *= m;
+    }
+    if (H5Sselect_hyperslab(space, op, start.data(), nullptr, block.data(), nullptr) < 0) return false;
+    op = H5S_SELECT_OR;
+    first += take;
+    count -= take;
+  }
+  return true;
+}
+}  // namespace
+
+std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
+  QuietHdf5 quiet;
+  Impl& m = *impl_;
+  m.usable();
+  validate_name(m.path, spec.block, "landscape block");
+  std::vector<hsize_t> dims;
+  std::set<std::string> names;
+  std::vector<std::string> axis_names, metric_names;
+  for (auto& a : spec.axes) {
+    validate_name(m.path, a.name, "landscape axis");
+    if (!names.insert(a.name).second) throw StoreError(m.path, "landscape " + spec.block + ": duplicate name " + a.name);
+    if (a.values.empty()) throw StoreError(m.path, "landscape " + spec.block + ": axis " + a.name + " has no values");
+    dims.push_back(a.values.size());
+    axis_names.push_back(a.name);
+  }
+  for (auto& mt : spec.metrics) {
+    validate_name(m.path, mt.name, "landscape metric");
+    if (!names.insert(mt.name).second) throw StoreError(m.path, "landscape " + spec.block + ": duplicate name " + mt.name);
+    metric_names.push_back(mt.name);
+  }
+  for (auto& s : m.landscape_streams)  // a landscape begun again (a re-run block) starts afresh
+    if (s.block == spec.block) s = {};
+  if (link_exists(m.landscapes, spec.block) && H5Ldelete(m.landscapes, spec.block.c_str(), H5P_DEFAULT) < 0)
+    m.fail("cannot replace /landscapes/" + spec.block);
+  Hid g(H5Gcreate2(m.landscapes, spec.block.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  if (!g.ok()) m.fail("cannot create /landscapes/" + spec.block);
+  write_str_list_attr(g, "axes", axis_names);
+  write_str_list_attr(g, "metrics", metric_names);
+  // Each axis is an HDF5 dimension scale attached to its dimension of every metric, so that netCDF
+  // readers (xarray with h5netcdf) see named dimensions with these values as coordinates.
+  std::vector<Hid> axis_dsets;
+  for (auto& a : spec.axes) {
+    hsize_t n = a.values.size();
+    Hid space(H5Screate_simple(1, &n, nullptr));
+    Hid d(H5Dcreate2(g, a.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+    if (!d.ok() || H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.values.data()) < 0)
+      m.fail("cannot write landscape axis " + a.name);
+    write_str_attr(d, "unit", a.unit);
+    write_str_attr(d, "units", a.unit);  // the CF name, which xarray's plots label axes with
+    write_str_attr(d, "kind", "axis");
+    if (H5DSset_scale(d, a.name.c_str()) < 0) m.fail("cannot make landscape axis " + a.name + " a dimension scale");
+    axis_dsets.push_back(std::move(d));
+  }
+  // Metrics: chunked (scalar for a block without axes), NaN until a cell is written; chunks are
+  // allocated as cells reach them.
+  Impl::LandscapeStream stream;
+  stream.block = spec.block;
+  stream.dims = dims;
+  Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (!dcpl.ok() || H5Pset_fill_value(dcpl, H5T_NATIVE_DOUBLE, &nan) < 0 ||
+      H5Pset_fill_time(dcpl, H5D_FILL_TIME_IFSET) < 0 ||
+      (!dims.empty() && H5Pset_chunk(dcpl, static_cast<int>(dims.size()), chunk_shape(dims).data()) < 0))
+    m.fail("cannot set up landscape " + spec.block);
+  for (auto& mt : spec.metrics) {
+    Hid space(dims.empty() ? H5Screate(H5S_SCALAR)
+                           : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr));
+    Hid d(H5Dcreate2(g, mt.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT));
+    if (!d.ok()) m.fail("cannot create landscape metric " + mt.name);
+    write_str_attr(d, "unit", mt.unit);
+    write_str_attr(d, "units", mt.unit);
+    write_str_attr(d, "description", mt.description);
+    write_str_attr(d, "long_name", mt.description);
+    write_str_attr(d, "kind", "metric");
+    write_str_list_attr(d, "axes", axis_names);
+    for (std::size_t i = 0; i < axis_dsets.size(); ++i)
+      if (H5DSattach_scale(d, axis_dsets[i], static_cast<unsigned>(i)) < 0)
+        m.fail("cannot attach landscape axis " + axis_names[i] + " to metric " + mt.name);
+    stream.metrics.push_back(std::move(d));
+  }
+  m.landscape_streams.push_back(std::move(stream));
+  return m.landscape_streams.size() - 1;
+}
+
+void ResultsWriter::write_landscape_cell(std::size_t landscape, std::uint64_t cell, const double* values) {
+  Impl& m = *impl_;
+  m.usable();
+  if (landscape >= m.landscape_streams.size() || m.landscape_streams[landscape].metrics.empty())
+    throw StoreError(m.path, "write_landscape_cell: no landscape " + std::to_string(landscape));
+  Impl::LandscapeStream& s = m.landscape_streams[landscape];
+  const hsize_t cells = std::accumulate(s.dims.begin(), s.dims.end(), hsize_t{1}, std::multiplies<>());
+  if (cell >= cells)
+    throw StoreError(m.path, "landscape " + s.block + ": cell " + std::to_string(cell) + " of " + std::to_string(cells));
+  s.cells.push_back(cell);
+  s.values.insert(s.values.end(), values, values + s.metrics.size());
+  if (s.cells.size() >= kPendingCells) {
+    QuietHdf5 quiet;
+    m.write_landscape_cells();
+  }
+}
+
+void ResultsWriter::Impl::write_landscape_cells() {
+  for (LandscapeStream& s : landscape_streams) {
+    if (s.cells.empty()) continue;
+    // ascending cells, the last value written for a cell kept
+    std::vector<std::size_t> order(s.cells.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return s.cells[a] < s.cells[b]; });
+    std::vector<std::size_t> keep;
+    for (std::size_t i = 0; i < order.size(); ++i)
+      if (i + 1 == order.size() || s.cells[order[i + 1]] != s.cells[order[i]]) keep.push_back(order[i]);
+    const std::size_t metrics = s.metrics.size(), n = keep.size();
+    hsize_t k = n;
+    Hid mspace(H5Screate_simple(1, &k, nullptr));
+    Hid fspace(H5Dget_space(s.metrics.front()));
+    bool ok = mspace.ok() && fspace.ok();
+    if (ok && !s.dims.empty()) {
+      H5S_seloper_t op = H5S_SELECT_SET;
+      for (std::size_t i = 0; ok && i < n;) {
+        std::size_t j = i + 1;
+        while (j < n && s.cells[keep[j]] == s.cells[keep[j - 1]] + 1) ++j;
+        ok = select_flat_range(fspace, s.dims, s.cells[keep[i]], j - i, op);
+        i = j;
+      }
+    }
+    if (!ok) fail("select landscape cells of " + s.block);
+    std::vector<double> v(n);
+    for (std::size_t mt = 0; mt < metrics; ++mt) {
+      for (std::size_t i = 0; i < n; ++i) v[i] = s.values[keep[i] * metrics + mt];
+      const hid_t mem = s.dims.empty() ? H5S_ALL : mspace.get(), file = s.dims.empty() ? H5S_ALL : fspace.get();
+      if (H5Dwrite(s.metrics[mt], H5T_NATIVE_DOUBLE, mem, file, H5P_DEFAULT, v.data()) < 0)
+        fail("cannot write landscape cells of " + s.block);
+    }
+    s.cells.clear();
+    s.values.clear();
+  }
+}
+
+void ResultsWriter::write_landscape(const LandscapeSpec& spec) {
+  const std::size_t cells = std::accumulate(spec.axes.begin(), spec.axes.end(), std::size_t{1},
+                                            [](std::size_t n, const LandscapeAxis& a) { return n * a.values.size(); });
+  for (auto& mt : spec.metrics)
+    if (mt.grid.size() != cells)
+      throw StoreError(impl_->path, "landscape " + spec.block + ": metric " + mt.name + " has " +
+                                        std::to_string(mt.grid.size()) + " values, the axes span " + std::to_string(cells));
+  const std::size_t h = begin_landscape(spec);
+  std::vector<double> values(spec.metrics.size());
+  for (std::size_t c = 0; c < cells; ++c) {
+    for (std::size_t mt = 0; mt < values.size(); ++mt) values[mt] = spec.metrics[mt].grid[c];
+    write_landscape_cell(h, c, values.data());
+  }
+  flush();
+}
+
+}  // namespace ks::store

@@ -1,0 +1,125 @@
+// Landscapes streamed cell by cell (begin_landscape, write_landscape_cell): what a reader sees
+// before and after each commit, cells in any order and rewritten, grids of one to four dimensions
+// whose sizes do not divide the chunk. The oracle is a plain array filled with the same writes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <numeric>
+#include <random>
+
+#include "store/store.hpp"
+#include "store_testgen.hpp"
+
+namespace {
+using namespace ks;
+using namespace ks::store;
+using namespace ks::store_test;
+
+LandscapeSpec spec_of(const std::vector<std::size_t>& shape) {
+  LandscapeSpec s;
+  s.block = "B";
+  for (std::size_t d = 0; d < shape.size(); ++d) {
+    LandscapeAxis a{"x" + std::to_string(d), "m", {}};
+    for (std::size_t i = 0; i < shape[d]; ++i) a.values.push_back(0.5 * static_cast<double>(i) - 1.0);
+    s.axes.push_back(a);
+  }
+  s.metrics = {{"E", "Nm", "energy", {}}, {"ok", "", "1 where ok", {}}};
+  return s;
+}
+
+/// Bitwise equal grids (NaN == NaN).
+void expect_grid(const LandscapeSpec& got, const std::vector<std::vector<double>>& want, const std::string& what) {
+  ASSERT_EQ(got.metrics.size(), want.size()) << what;
+  for (std::size_t m = 0; m < want.size(); ++m) {
+    ASSERT_EQ(got.metrics[m].grid.size(), want[m].size()) << what;
+    for (std::size_t c = 0; c < want[m].size(); ++c)
+      ASSERT_EQ(0, std::memcmp(&got.metrics[m].grid[c], &want[m][c], sizeof(double)))
+          << what << ": metric " << m << " cell " << c << " = " << got.metrics[m].grid[c] << ", want " << want[m][c];
+  }
+}
+
+TEST(StoreLandscapes, CellsInAnyOrderReadBackAtTheirPlacesAndUnwrittenCellsAreNaN) {
+  std::mt19937_64 rng(11);
+  for (const std::vector<std::size_t>& shape : std::vector<std::vector<std::size_t>>{
+           {}, {1}, {37}, {3, 5}, {241, 21}, {2, 7, 13}, {3, 4, 5, 6}, {1, 1, 9000}}) {
+    TempDir td;
+    const std::string path = td.file("l.h5");
+    const LandscapeSpec spec = spec_of(shape);
+    const std::size_t cells = std::accumulate(shape.begin(), shape.end(), std::size_t{1}, std::multiplies<>());
+    std::vector<std::vector<double>> want(2, std::vector<double>(cells, std::nan("")));
+    auto w = ResultsWriter::create(path, test_meta(), test_columns(), 4);
+    const std::size_t h = w->begin_landscape(spec);
+    // runs of consecutive cells, single cells, cells twice (the last values stay), in a shuffled order
+    std::vector<std::uint64_t> order(cells);
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), rng);
+    order.resize(cells * 2 / 3);
+    std::sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(order.size() / 2));
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      const std::uint64_t c = order[i];
+      const double v[2] = {static_cast<double>(c) + 0.25 * static_cast<double>(i % 3), static_cast<double>(i % 2)};
+      w->write_landscape_cell(h, c, v);
+      want[0][c] = v[0], want[1][c] = v[1];
+      if (i % 5 == 0) {  // again, later values
+        const double again[2] = {-v[0], 7.0};
+        w->write_landscape_cell(h, c, again);
+        want[0][c] = again[0], want[1][c] = again[1];
+      }
+      if (i == order.size() / 3) w->flush();
+    }
+    w->close();
+    ResultsReader r(path);
+    const LandscapeSpec got = r.read_landscape("B");
+    ASSERT_EQ(got.axes.size(), shape.size());
+    for (std::size_t d = 0; d < shape.size(); ++d) EXPECT_EQ(got.axes[d].values, spec.axes[d].values);
+    expect_grid(got, want, "shape of " + std::to_string(shape.size()) + " dimensions, " + std::to_string(cells) + " cells");
+  }
+}
+
+TEST(StoreLandscapes, AReaderSeesTheCellsOfCommittedRunsOnly) {
+  TempDir td;
+  const std::string path = td.file("l.h5");
+  const LandscapeSpec spec = spec_of({4, 3});
+  auto w = ResultsWriter::create(path, test_meta(), test_columns(), 12);
+  const std::size_t h = w->begin_landscape(spec);
+  w->flush();
+  std::vector<std::vector<double>> want(2, std::vector<double>(12, std::nan("")));
+  {
+    ResultsReader r(path);  // the landscape exists before any cell
+    expect_grid(r.read_landscape("B"), want, "begun");
+  }
+  for (std::uint64_t c = 0; c < 5; ++c) {
+    const double v[2] = {c * 1.5, 1.0};
+    w->write_landscape_cell(h, c, v);
+    if (c < 3) want[0][c] = v[0], want[1][c] = v[1];
+    if (c == 2) w->flush();
+  }
+  {
+    ResultsReader r(path);  // cells 3 and 4 are not committed
+    expect_grid(r.read_landscape("B"), want, "after the first commit");
+  }
+  w->flush();
+  want[0][3] = 4.5, want[0][4] = 6.0, want[1][3] = want[1][4] = 1.0;
+  ResultsReader r(path);
+  expect_grid(r.read_landscape("B"), want, "after the second commit");
+}
+
+TEST(StoreLandscapes, BeginningALandscapeAgainStartsItAfresh) {
+  TempDir td;
+  const std::string path = td.file("l.h5");
+  auto w = ResultsWriter::create(path, test_meta(), test_columns(), 4);
+  const double v[2] = {1.0, 1.0};
+  const std::size_t first = w->begin_landscape(spec_of({3}));
+  w->write_landscape_cell(first, 0, v);
+  const std::size_t again = w->begin_landscape(spec_of({3}));
+  EXPECT_THROW(w->write_landscape_cell(first, 1, v), StoreError);  // the old handle is gone
+  EXPECT_THROW(w->write_landscape_cell(again, 3, v), StoreError);  // past the grid
+  w->write_landscape_cell(again, 2, v);
+  w->close();
+  ResultsReader r(path);
+  const double nan = std::nan("");
+  expect_grid(r.read_landscape("B"), {{nan, nan, 1.0}, {nan, nan, 1.0}}, "begun twice");
+}
+
+}  // namespace
