@@ -77,6 +77,27 @@ TEST(StoreLandscapes, CellsInAnyOrderReadBackAtTheirPlacesAndUnwrittenCellsAreNa
   }
 }
 
+TEST(StoreLandscapes, AGridOfMillionsOfCellsStreamsInBatchesWithCommits) {
+  // 3e6 cells in batches of 512 with a commit every 64 batches: a chunked layout of this file's
+  // two-entry chunk B-tree nodes failed here ("unable to encode node level": over 255 levels)
+  TempDir td;
+  const std::string path = td.file("l.h5");
+  LandscapeSpec spec = spec_of({3000, 1000});
+  spec.metrics.resize(1);
+  auto w = ResultsWriter::create(path, test_meta(), test_columns(), 4);
+  const std::size_t h = w->begin_landscape(spec);
+  for (std::uint64_t c = 0; c < 3000000; ++c) {
+    const double v = static_cast<double>(c % 7919);
+    w->write_landscape_cell(h, c, &v);
+    if (c % (512 * 64) == 0) w->flush();
+  }
+  w->close();
+  ResultsReader r(path);
+  const LandscapeSpec got = r.read_landscape("B");
+  ASSERT_EQ(got.metrics.at(0).grid.size(), 3000000u);
+  for (std::uint64_t c = 0; c < 3000000; c += 997) ASSERT_EQ(got.metrics[0].grid[c], static_cast<double>(c % 7919)) << c;
+}
+
 TEST(StoreLandscapes, AReaderSeesTheCellsOfCommittedRunsOnly) {
   TempDir td;
   const std::string path = td.file("l.h5");

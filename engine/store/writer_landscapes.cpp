@@ -15,44 +15,32 @@ namespace ks::store {
 using namespace detail;
 
 namespace {
-constexpr hsize_t kChunkCells = 8192;          // 64 KiB of f64 per chunk
 constexpr std::size_t kPendingCells = 1 << 16;  // cells held before they are written (rows: kRowBatch)
 
-/// Chunk shape of a grid: whole trailing dimensions first, about kChunkCells cells.
-std::vector<hsize_t> chunk_shape(const std::vector<hsize_t>& dims) {
-  std::vector<hsize_t> c(dims.size(), 1);
-  hsize_t room = kChunkCells;
-  for (std::size_t j = dims.size(); j-- > 0 && room > 1;) {
-    c[j] = std::max<hsize_t>(1, std::min(dims[j], room));
-    room /= c[j];
-  }
-  return c;
-}
-
-/// Adds to `space` (op: set for the first block, or) the cells [first, first + count) of a
-/// row-major grid of shape `dims`, as at most 2 * rank - 1 hyperslab blocks: a partial row, whole
-/// slabs, a partial row again, each in row-major order.
-bool select_flat_range(hid_t space, const std::vector<hsize_t>& dims, hsize_t first, hsize_t count, H5S_seloper_t& op) {
+/// Calls block(start, shape, cells) for each hyperslab block that makes up the cells [first, first +
+/// count) of a row-major grid of shape `dims`, in row-major order: at most 2 * rank - 1 blocks (a
+/// partial row, whole slabs, a partial row again). Stops and returns false when block() does.
+template <class F>
+bool for_each_block(const std::vector<hsize_t>& dims, hsize_t first, hsize_t count, F&& block) {
   const std::size_t r = dims.size();
   std::vector<hsize_t> stride(r + 1, 1);  // stride[k]: cells in the trailing k dimensions
   for (std::size_t k = 1; k <= r; ++k) stride[k] = stride[k - 1] * dims[r - k];
-  std::vector<hsize_t> start(r), block(r);
+  std::vector<hsize_t> start(r), shape(r);
   while (count > 0) {
     std::size_t k = 0;  // the most trailing dimensions that `first` starts whole and `count` covers
     while (k < r && first % stride[k + 1] == 0 && count >= stride[k + 1]) ++k;
     hsize_t rest = first;
     for (std::size_t j = r; j-- > 0;) start[j] = rest % dims[j], rest /= dims[j];
-    std::fill(block.begin(), block.end(), 1);
-    for (std::size_t j = r - k; j < r; ++j) block[j] = dims[j];
+    std::fill(shape.begin(), shape.end(), 1);
+    for (std::size_t j = r - k; j < r; ++j) shape[j] = dims[j];
     hsize_t take = stride[k];
     if (k < r) {  // several slabs along the next dimension, up to its end
       const std::size_t d = r - 1 - k;
       const hsize_t m = std::min(count / stride[k], dims[d] - start[d]);
-      block[d] = m;
+      shape[d] = m;
       take *= m;
     }
-    if (H5Sselect_hyperslab(space, op, start.data(), nullptr, block.data(), nullptr) < 0) return false;
-    op = H5S_SELECT_OR;
+    if (!block(start, shape, take)) return false;
     first += take;
     count -= take;
   }
@@ -103,16 +91,17 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
     if (H5DSset_scale(d, a.name.c_str()) < 0) m.fail("cannot make landscape axis " + a.name + " a dimension scale");
     axis_dsets.push_back(std::move(d));
   }
-  // Metrics: chunked (scalar for a block without axes), NaN until a cell is written; chunks are
-  // allocated as cells reach them.
+  // Metrics: contiguous, allocated (and filled with NaN) when their first cell is written, so a
+  // block never reached takes no space. Not chunked: the file's chunk B-trees have nodes of two
+  // entries (H5Pset_istore_k(1), sized for the histories' one-chunk arrays), and such a tree grows
+  // about one level per chunk, past HDF5's limit of 255 levels at a few hundred chunks.
   Impl::LandscapeStream stream;
   stream.block = spec.block;
   stream.dims = dims;
   Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  if (!dcpl.ok() || H5Pset_fill_value(dcpl, H5T_NATIVE_DOUBLE, &nan) < 0 ||
-      H5Pset_fill_time(dcpl, H5D_FILL_TIME_IFSET) < 0 ||
-      (!dims.empty() && H5Pset_chunk(dcpl, static_cast<int>(dims.size()), chunk_shape(dims).data()) < 0))
+  if (!dcpl.ok() || H5Pset_layout(dcpl, H5D_CONTIGUOUS) < 0 || H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_LATE) < 0 ||
+      H5Pset_fill_value(dcpl, H5T_NATIVE_DOUBLE, &nan) < 0 || H5Pset_fill_time(dcpl, H5D_FILL_TIME_ALLOC) < 0)
     m.fail("cannot set up landscape " + spec.block);
   for (auto& mt : spec.metrics) {
     Hid space(dims.empty() ? H5Screate(H5S_SCALAR)
@@ -162,26 +151,34 @@ void ResultsWriter::Impl::write_landscape_cells() {
     for (std::size_t i = 0; i < order.size(); ++i)
       if (i + 1 == order.size() || s.cells[order[i + 1]] != s.cells[order[i]]) keep.push_back(order[i]);
     const std::size_t metrics = s.metrics.size(), n = keep.size();
-    hsize_t k = n;
-    Hid mspace(H5Screate_simple(1, &k, nullptr));
-    Hid fspace(H5Dget_space(s.metrics.front()));
-    bool ok = mspace.ok() && fspace.ok();
-    if (ok && !s.dims.empty()) {
-      H5S_seloper_t op = H5S_SELECT_SET;
-      for (std::size_t i = 0; ok && i < n;) {
-        std::size_t j = i + 1;
-        while (j < n && s.cells[keep[j]] == s.cells[keep[j - 1]] + 1) ++j;
-        ok = select_flat_range(fspace, s.dims, s.cells[keep[i]], j - i, op);
-        i = j;
-      }
-    }
-    if (!ok) fail("select landscape cells of " + s.block);
     std::vector<double> v(n);
     for (std::size_t mt = 0; mt < metrics; ++mt) {
       for (std::size_t i = 0; i < n; ++i) v[i] = s.values[keep[i] * metrics + mt];
-      const hid_t mem = s.dims.empty() ? H5S_ALL : mspace.get(), file = s.dims.empty() ? H5S_ALL : fspace.get();
-      if (H5Dwrite(s.metrics[mt], H5T_NATIVE_DOUBLE, mem, file, H5P_DEFAULT, v.data()) < 0)
-        fail("cannot write landscape cells of " + s.block);
+      if (s.dims.empty()) {  // the one cell of a block without axes
+        if (H5Dwrite(s.metrics[mt], H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
+          fail("cannot write landscape cells of " + s.block);
+        continue;
+      }
+      // one write per hyperslab block of each run of consecutive cells (simple selections only)
+      Hid fspace(H5Dget_space(s.metrics[mt]));
+      if (!fspace.ok()) fail("cannot write landscape cells of " + s.block);
+      std::size_t done = 0;
+      for (std::size_t i = 0; i < n;) {
+        std::size_t j = i + 1;
+        while (j < n && s.cells[keep[j]] == s.cells[keep[j - 1]] + 1) ++j;
+        const bool ok = for_each_block(s.dims, s.cells[keep[i]], j - i,
+                                       [&](const std::vector<hsize_t>& start, const std::vector<hsize_t>& shape, hsize_t cells) {
+          Hid mspace(H5Screate_simple(1, &cells, nullptr));
+          const bool written =
+              mspace.ok() &&
+              H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start.data(), nullptr, shape.data(), nullptr) >= 0 &&
+              H5Dwrite(s.metrics[mt], H5T_NATIVE_DOUBLE, mspace, fspace, H5P_DEFAULT, v.data() + done) >= 0;
+          done += cells;
+          return written;
+        });
+        if (!ok) fail("cannot write landscape cells of " + s.block);
+        i = j;
+      }
     }
     s.cells.clear();
     s.values.clear();

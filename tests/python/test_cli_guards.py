@@ -120,7 +120,8 @@ class ResumeMemory(TempDirTest):
             log.seek(0)
             self.assertEqual(os.waitstatus_to_exitcode(status), 0, err.read())
             self.assertIn("2000000 runs (0 computed now, 2000000 already in the file)", log.read())
-        self.assertLess(usage.ru_maxrss * 1024, 300 * 2**20)
+        if not SANITIZED:  # AddressSanitizer's shadow memory and quarantine of freed blocks come on top
+            self.assertLess(usage.ru_maxrss * 1024, 300 * 2**20)
         with h5py.File(out, "r") as f:  # the landscape rewritten from the rows read back
             grid = f["landscapes/b/iterations"][()]
             self.assertEqual(grid.shape, (2000, 1000))
