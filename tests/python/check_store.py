@@ -19,6 +19,9 @@ import time
 import h5py
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
+from kslive import stamp  # noqa: E402  FORMAT.md, "Reading while a sweep runs"
+
 STATUSES = ["ok", "diverged", "singular", "ok-\u00f1"]
 COLUMNS = [("alpha", "f", "rad"), ("E", "f", "Nm"), ("iters", "i", ""), ("status", "O", ""), ("method", "O", "")]
 # The ColumnSpecs of tests/store_testgen.cpp (test_columns) beyond name and unit: description, role, kinds.
@@ -159,20 +162,6 @@ def check_column_specs(runs):
     got = tuple(as_str(runs["done"].attrs.get(k, "?")) for k in ("role", "kinds"))
     check(got == ("bookkeeping", ""), f"/runs/done role/kinds {got}")
     check(sorted(runs) == sorted([c[0] for c in COLUMNS] + ["done"]), f"/runs datasets {sorted(runs)}")
-
-
-def stamp(path):
-    """FORMAT.md, "Reading while a sweep runs": the journal header (commit sequence + writer session)
-    while a writer lives, else the file's size and mtime; None while a commit is being applied."""
-    try:
-        with open(path + ".journal", "rb") as fh:
-            head = fh.read()
-    except FileNotFoundError:
-        st = os.stat(path)
-        return ("static", st.st_size, st.st_mtime_ns)
-    if (head[:8], len(head)) not in ((b"KSJRNL02", 56), (b"KSJRNL01", 48)):
-        return None
-    return ("journal", head)
 
 
 def concurrent_read(helper, path, n):
