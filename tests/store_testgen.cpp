@@ -33,19 +33,21 @@ Record test_record(std::int64_t id) {
 RunHistory test_history(std::int64_t id) {
   RunHistory h;
   if (id % 5 == 4) return h;  // some runs have no history
-  const std::size_t n = 10 + static_cast<std::size_t>(id % 7) * 40;
+  const std::size_t n = id % 7 == 6 ? 0 : 10 + static_cast<std::size_t>(id % 7) * 40;  // some have 0 rows
   HistoryArray t{"t", "s", n, 1, {}};
   HistoryArray q{"q", "rad", n, 3, {}};
+  HistoryArray tau{"tau", "Nm", n, 2, {}};
+  const double special[] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(), -0.0,
+                            1e-310 * static_cast<double>(id + 1)};
   for (std::size_t i = 0; i < n; ++i) {
     t.data.push_back(static_cast<double>(i) / 8.0 + static_cast<double>(id));
     for (std::size_t j = 0; j < 3; ++j)
       q.data.push_back(static_cast<double>(id) + static_cast<double>(i) * 0.25 - static_cast<double>(j) / 3.0);
+    for (std::size_t j = 0; j < 2; ++j)
+      tau.data.push_back(i < 2 ? special[2 * i + j] : std::sin(static_cast<double>(id * 100 + i * 2 + j)));
   }
-  HistoryArray tau{"tau", "Nm", 2, 2,
-                   {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(), -0.0,
-                    1e-310 * static_cast<double>(id + 1)}};
-  HistoryArray empty{"empty", "", 0, 3, {}};
-  h.arrays = {t, q, tau, empty};
+  HistoryArray none{"none", "", n, 0, {}};  // an array of no columns
+  h.arrays = {t, q, tau, none};
   return h;
 }
 

@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
     std::int64_t written = 0;
     for (auto id : order) {
       if (done[static_cast<std::size_t>(id)]) continue;
-      w->write_run(id, store_test::test_record(id), store::encode_history(store_test::test_history(id), 4));
+      w->write_run(id, store_test::test_record(id), store::encode_history(store_test::test_history(id), 4, w->history_chunk_rows()));
       if (std::find(stop_after.begin(), stop_after.end(), ++written) != stop_after.end()) {
         w->flush();
         raise(SIGSTOP);  // a test reads the committed state, then lets the writer go on (SIGCONT)

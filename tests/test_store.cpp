@@ -31,31 +31,67 @@ using namespace ks::store_test;
 
 
 // ------------------------------------------------------------------------------------------------
-// The bytes are what HDF5's filter pipeline stores: zlib(shuffle(data)); inflating and unshuffling
-// (byte j of element i at j * n + i) gives the array back.
+// The bytes are what HDF5's filter pipeline stores: zlib(shuffle(chunk)) per chunk of chunk_rows
+// rows, the last padded with NaN rows; inflating (zlib's own inflate: an independent decoder) and
+// unshuffling (byte j of element i at j * n + i) gives the rows back.
+std::vector<double> inflate_chunk(const EncodedChunk& c, std::size_t n) {
+  std::vector<double> back(n);
+  if (c.filter_mask == kRawChunk) {
+    EXPECT_EQ(c.bytes.size(), n * 8);
+    std::memcpy(back.data(), c.bytes.data(), std::min(c.bytes.size(), n * 8));
+    return back;
+  }
+  EXPECT_EQ(c.filter_mask, 0u);
+  std::vector<unsigned char> shuffled(n * 8 + 16);
+  uLongf got = static_cast<uLongf>(shuffled.size());
+  EXPECT_EQ(uncompress(shuffled.data(), &got, c.bytes.data(), c.bytes.size()), Z_OK);
+  EXPECT_EQ(got, n * 8);
+  auto* b = reinterpret_cast<unsigned char*>(back.data());
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < 8; ++j) b[i * 8 + j] = shuffled[j * n + i];
+  return back;
+}
+
+/// Checks every chunk of `e` against the array `a` it encodes: the rows, then NaN padding.
+void expect_chunks_hold(const EncodedArray& e, const HistoryArray& a, std::size_t chunk_rows) {
+  ASSERT_EQ(e.rows, a.rows);
+  if (a.rows == 0 || a.cols == 0) { EXPECT_TRUE(e.chunks.empty()); return; }
+  ASSERT_EQ(e.chunk_rows, chunk_rows);
+  ASSERT_EQ(e.chunks.size(), (a.rows + chunk_rows - 1) / chunk_rows);
+  for (std::size_t k = 0; k < e.chunks.size(); ++k) {
+    const auto back = inflate_chunk(e.chunks[k], chunk_rows * a.cols);
+    for (std::size_t i = 0; i < back.size(); ++i) {
+      const std::size_t at = k * chunk_rows * a.cols + i;
+      if (at < a.data.size()) {
+        EXPECT_EQ(0, std::memcmp(&back[i], &a.data[at], 8)) << a.name << " chunk " << k << " value " << i;
+      } else {
+        EXPECT_TRUE(std::isnan(back[i])) << a.name << " padding " << i;
+      }
+    }
+  }
+}
+
 TEST(StoreEncode, DeflateStreamDecodesToTheRawArray) {
-  auto h = test_history(3);
-  auto e = encode_history(h, 6);
-  ASSERT_EQ(e.arrays.size(), h.arrays.size());
-  for (std::size_t k = 0; k < h.arrays.size(); ++k) {
-    const auto& a = h.arrays[k];
-    EXPECT_EQ(e.arrays[k].rows, a.rows);
-    if (a.data.empty()) { EXPECT_TRUE(e.arrays[k].bytes.empty()); continue; }
-    std::vector<unsigned char> shuffled(a.data.size() * sizeof(double));
-    uLongf n = static_cast<uLongf>(shuffled.size());
-    ASSERT_EQ(uncompress(shuffled.data(), &n, e.arrays[k].bytes.data(), e.arrays[k].bytes.size()), Z_OK);
-    EXPECT_EQ(n, a.data.size() * sizeof(double));
-    std::vector<double> back(a.data.size());
-    auto* b = reinterpret_cast<unsigned char*>(back.data());
-    for (std::size_t i = 0; i < back.size(); ++i)
-      for (std::size_t j = 0; j < 8; ++j) b[i * 8 + j] = shuffled[j * back.size() + i];
-    EXPECT_EQ(0, std::memcmp(back.data(), a.data.data(), n));
-    auto raw = encode_history(RunHistory{{a}}, 0);  // level 0: the raw array, no filter
-    ASSERT_EQ(raw.arrays[0].bytes.size(), n);
-    EXPECT_EQ(0, std::memcmp(raw.arrays[0].bytes.data(), a.data.data(), n));
+  for (std::int64_t id : {0, 3, 6, 13}) {
+    auto h = test_history(id);
+    for (int level : {0, 1, 6})
+      for (std::size_t chunk_rows : {std::size_t{0}, std::size_t{7}, std::size_t{64}, std::size_t{1000}}) {
+        auto e = encode_history(h, level, chunk_rows);
+        ASSERT_EQ(e.arrays.size(), h.arrays.size());
+        for (std::size_t k = 0; k < h.arrays.size(); ++k)
+          expect_chunks_hold(e.arrays[k], h.arrays[k], chunk_rows ? chunk_rows : h.arrays[k].rows);
+        const RunHistory back = decode_history(e);  // the store's own decoder agrees with zlib's
+        ASSERT_EQ(back.arrays.size(), h.arrays.size());
+        for (std::size_t k = 0; k < h.arrays.size(); ++k) {
+          ASSERT_EQ(back.arrays[k].data.size(), h.arrays[k].data.size());
+          EXPECT_EQ(0, std::memcmp(back.arrays[k].data.data(), h.arrays[k].data.data(), 8 * h.arrays[k].data.size()));
+        }
+      }
   }
   HistoryArray bad{"x", "", 3, 2, {1.0, 2.0}};
   EXPECT_THROW(encode_history(RunHistory{{bad}}), StoreError);
+  HistoryArray a{"a", "", 3, 1, {1.0, 2.0, 3.0}}, b{"b", "", 2, 1, {1.0, 2.0}};
+  EXPECT_THROW(encode_history(RunHistory{{a, b}}), StoreError);  // a run's arrays share their rows
 }
 
 // The same oracle (zlib's own inflate) on sizes around the 65535-byte stored-block limit of the
@@ -67,16 +103,8 @@ TEST(StoreEncode, StoredAndDeflatedPartsDecodeAtEverySize) {
     for (int level : {1, 9}) {
       HistoryArray a{"x", "m", rows, 3, std::vector<double>(rows * 3)};
       for (std::size_t i = 0; i < a.data.size(); ++i) a.data[i] = i % 2 ? u(rng) : std::sin(0.001 * i);
-      const auto e = encode_history(RunHistory{{a}}, level);
-      std::vector<unsigned char> shuffled(a.data.size() * 8 + 16);
-      uLongf n = static_cast<uLongf>(shuffled.size());
-      ASSERT_EQ(uncompress(shuffled.data(), &n, e.arrays[0].bytes.data(), e.arrays[0].bytes.size()), Z_OK) << rows;
-      ASSERT_EQ(n, a.data.size() * 8);
-      std::vector<double> back(a.data.size());
-      auto* b = reinterpret_cast<unsigned char*>(back.data());
-      for (std::size_t i = 0; i < back.size(); ++i)
-        for (std::size_t j = 0; j < 8; ++j) b[i * 8 + j] = shuffled[j * back.size() + i];
-      EXPECT_EQ(0, std::memcmp(back.data(), a.data.data(), n)) << rows << " rows, level " << level;
+      expect_chunks_hold(encode_history(RunHistory{{a}}, level).arrays[0], a, rows);
+      expect_chunks_hold(encode_history(RunHistory{{a}}, level, 3641).arrays[0], a, 3641);
     }
 }
 
@@ -88,7 +116,9 @@ TEST(StoreEncode, ThreadSafeInWorkers) {
       for (int i = 0; i < 50; ++i) {
         auto e = encode_history(test_history(t * 50 + i), 4);
         auto again = encode_history(test_history(t * 50 + i), 4);
-        for (std::size_t k = 0; k < e.arrays.size(); ++k) ok[t] += e.arrays[k].bytes == again.arrays[k].bytes ? 0 : 1;
+        for (std::size_t k = 0; k < e.arrays.size(); ++k)
+          for (std::size_t c = 0; c < e.arrays[k].chunks.size(); ++c)
+            ok[t] += e.arrays[k].chunks[c].bytes == again.arrays[k].chunks[c].bytes ? 0 : 1;
       }
     });
   for (auto& x : th) x.join();

@@ -87,7 +87,7 @@ TEST(StoreColumns, EverySpecFieldIsWrittenAndReadBack) {
     w->close();
   }
   ResultsReader r(path);
-  EXPECT_EQ(r.meta().format_version, 2);
+  EXPECT_EQ(r.meta().format_version, kFormatVersion);
   ASSERT_EQ(r.columns().size(), cols.size());
   for (std::size_t i = 0; i < cols.size(); ++i) {
     const ColumnSpec &got = r.columns()[i], &want = cols[i];
@@ -151,7 +151,7 @@ TEST(StoreColumns, ResumeRefusesAVersion1FileAndLeavesItUntouched) {
   const std::string msg = error_of([&] { ResultsWriter::open_for_resume(path, test_meta().study_sha256); });
   EXPECT_NE(msg.find(path), std::string::npos) << msg;
   EXPECT_NE(msg.find("results file format v1 (written by kinesweep " KINESWEEP_VERSION
-                     "); this kinesweep writes v2: rerun with --overwrite"),
+                     "); this kinesweep writes v3: rerun with --overwrite"),
             std::string::npos)
       << msg;
   EXPECT_EQ(slurp(path), before);
@@ -165,22 +165,22 @@ TEST(StoreColumns, ResumeRefusesAVersion1FileAndLeavesItUntouched) {
 
 TEST(StoreColumns, NewerFormatIsRefusedByReaderAndResume) {
   TempDir td;
-  const std::string path = td.file("v3.h5");
+  const std::string path = td.file("v4.h5");
   write_test_file(path, 4);
-  rewrite_as(path, 3, false);
+  rewrite_as(path, 4, false);
   const std::string before = slurp(path);
   const std::string read = error_of([&] { ResultsReader r(path); });
-  EXPECT_NE(read.find("unsupported format_version 3"), std::string::npos) << read;
+  EXPECT_NE(read.find("unsupported format_version 4"), std::string::npos) << read;
   const std::string resume = error_of([&] { ResultsWriter::open_for_resume(path, test_meta().study_sha256); });
-  EXPECT_NE(resume.find("results file format v3"), std::string::npos) << resume;
+  EXPECT_NE(resume.find("results file format v4"), std::string::npos) << resume;
   EXPECT_EQ(slurp(path), before);
 }
 
-TEST(StoreColumns, Version2FileWithoutRolesIsRejected) {
+TEST(StoreColumns, AFileOfFormat2OrLaterWithoutRolesIsRejected) {
   TempDir td;
   const std::string path = td.file("broken.h5");
   write_test_file(path, 4);
-  rewrite_as(path, 2, true);
+  rewrite_as(path, kFormatVersion, true);
   const std::string msg = error_of([&] { ResultsReader r(path); });
   EXPECT_NE(msg.find("role"), std::string::npos) << msg;
   EXPECT_NE(error_of([&] { ResultsWriter::open_for_resume(path, test_meta().study_sha256); }).find("role"),

@@ -78,7 +78,7 @@ double seconds_since_process_start() {
 
 double history_bytes(const store::EncodedHistory& h) {
   double b = 0;
-  for (const auto& a : h.arrays) b += static_cast<double>(a.bytes.size());
+  b += static_cast<double>(store::encoded_bytes(h));
   return b;
 }
 

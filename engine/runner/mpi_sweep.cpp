@@ -11,8 +11,6 @@
 #include "runner/mpi_sweep.hpp"
 
 #include <tbb/info.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -99,28 +97,21 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
   if (missing)
     throw store::StoreError(out, std::to_string(missing) + " runs are in neither the results file nor a shard");
 
-  // Copy the shards' runs in run-id order (the single-process write order): histories are read
-  // serially, re-encoded in parallel (shards hold them raw), written serially.
+  // Copy the shards' runs in run-id order (the single-process write order). Histories are copied
+  // chunk by chunk, as the shards store them (the writer decodes and re-cuts them only when a
+  // shard's chunk size differs from the results file's).
   const int level = run.options.compression;
-  tbb::task_arena arena(threads);
   std::vector<std::uint64_t> ids;
   for (std::uint64_t id = 0; id < total; ++id)
     if (owner[id] >= 0) ids.push_back(id);
   const std::size_t chunk = 64 * static_cast<std::size_t>(threads);
-  std::vector<RunHistory> raw(chunk);
   std::vector<store::EncodedHistory> enc(chunk);
   for (std::size_t at = 0; at < ids.size(); at += chunk) {
     const std::size_t n = std::min(chunk, ids.size() - at);
     for (std::size_t i = 0; i < n; ++i) {
       const auto& r = *readers[owner[ids[at + i]]];
-      const auto id = static_cast<std::int64_t>(ids[at + i]);
-      raw[i] = r.has_history(id) ? r.read_history(id) : RunHistory{};
+      enc[i] = r.read_history_chunks(static_cast<std::int64_t>(ids[at + i]), level);
     }
-    arena.execute([&] {
-      tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
-        enc[i] = raw[i].arrays.empty() ? store::EncodedHistory{} : store::encode_history(raw[i], level);
-      });
-    });
     // The piece's rows, read from each shard that owns some of them (one read per column).
     std::vector<Record> rows(n);
     for (std::size_t s = 0; s < readers.size(); ++s) {
@@ -137,7 +128,6 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
       const std::uint64_t id = ids[at + i];
       const Record& row = rows[i];
       writer->write_run(static_cast<std::int64_t>(id), row, enc[i]);
-      raw[i] = {};
       enc[i] = {};
     }
   }
@@ -306,7 +296,7 @@ SweepResult MpiBackend::sweep(const Study& study, const StudySchema& schema, con
   std::vector<std::uint8_t>().swap(done_);
   SweepOptions o = r.options;
   o.threads = threads_;
-  o.compression = 0;  // shards hold raw histories; the merge compresses them once, in parallel
+  // shards compress as the results file does: the merge copies their chunks without decoding them
   o.source_runs = todo_n;
   std::unique_ptr<WorkPool> pool;
   std::unique_ptr<RemoteSource> remote;

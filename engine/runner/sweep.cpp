@@ -246,7 +246,7 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
                   for (std::size_t i = 0; i < n; ++i) {
                     Job& j = b->jobs[i];
                     const RunOutcome& o = outcomes[i];
-                    if (!o.history.arrays.empty()) j.history = store::encode_history(o.history, options.compression);
+                    if (!o.history.arrays.empty()) j.history = store::encode_history(o.history, options.compression, writer.history_chunk_rows());
                     j.row = schema.row(j.id, j.ref.block, study.blocks[j.ref.block], runs[i], o, wall[i]);
                   }
                   return b;

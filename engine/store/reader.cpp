@@ -198,36 +198,6 @@ Record ResultsReader::read_record(std::int64_t run_id) const {
   return std::move(read_rows(run_id, 1).front());
 }
 
-bool ResultsReader::has_history(std::int64_t run_id) const {
-  QuietHdf5 quiet;
-  return link_exists(impl_->file, "histories/" + history_group_name(run_id, impl_->n_runs));
-}
-
-RunHistory ResultsReader::read_history(std::int64_t run_id) const {
-  QuietHdf5 quiet;
-  RunHistory h;
-  const std::string g = "histories/" + history_group_name(run_id, impl_->n_runs);
-  if (!link_exists(impl_->file, g)) return h;
-  Hid grp(check(H5Gopen2(impl_->file, g.c_str(), H5P_DEFAULT), impl_->path, "open /" + g));
-  for (auto& name : read_str_list_attr(grp, "arrays")) {
-    Hid d(check(H5Dopen2(grp, name.c_str(), H5P_DEFAULT), impl_->path, "open /" + g + "/" + name));
-    Hid s(H5Dget_space(d));
-    hsize_t dims[2] = {0, 1};
-    int rank = H5Sget_simple_extent_dims(s, dims, nullptr);
-    HistoryArray a;
-    a.name = name;
-    a.unit = read_str_attr(d, "unit");
-    a.rows = rank >= 1 ? dims[0] : 1;
-    a.cols = rank >= 2 ? dims[1] : 1;
-    a.data.resize(a.rows * a.cols);
-    if (!a.data.empty())
-      check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.data.data()), impl_->path,
-            "read /" + g + "/" + name);
-    h.arrays.push_back(std::move(a));
-  }
-  return h;
-}
-
 namespace {
 herr_t collect_names(hid_t, const char* name, const H5L_info_t*, void* data) {
   static_cast<std::vector<std::string>*>(data)->emplace_back(name);

@@ -2,7 +2,8 @@
 // The HDF5 results store: the only code in kinesweep that knows HDF5. File layout: FORMAT.md.
 //
 // Threading: encode_history() is thread-safe and HDF5-free (zlib only): call it in worker threads.
-// A ResultsWriter must be used by one thread (the writer thread) only.
+// A ResultsWriter must be used by one thread (the writer thread) only; history_chunk_rows() is the
+// exception (worker threads read it to encode).
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -38,8 +39,9 @@ class StoreError : public std::runtime_error {
 void print_hdf5_error_stack(bool print);
 
 inline constexpr const char* kFormatName = "kinesweep-results";
-/// The format this kinesweep writes (2: /runs columns carry `role` and `kinds` attributes).
-inline constexpr std::int64_t kFormatVersion = 2;
+/// The format this kinesweep writes (3: histories as ragged arrays sharing one row space; 2: one
+/// group per run's history; both: /runs columns carry `role` and `kinds` attributes).
+inline constexpr std::int64_t kFormatVersion = 3;
 /// The oldest format ResultsReader still opens (1: no role/kinds; see ResultsReader's V1ColumnRoles).
 /// Resume (ResultsWriter::open_for_resume) accepts kFormatVersion only.
 inline constexpr std::int64_t kOldestReadableFormatVersion = 1;
@@ -72,21 +74,36 @@ struct StoreOptions {
   bool durable = false;              ///< fsync around commits (power-loss safety; kill -9 safety needs none)
 };
 
-/// One history array encoded for HDF5's filter pipeline (shuffle + deflate of the row-major f64 data;
-/// raw bytes when level is 0).
+/// One HDF5 chunk of a history dataset, as its filter pipeline stores it: shuffle then deflate
+/// (filter_mask 0), or the raw little-endian rows (filter_mask kRawChunk: both filters skipped).
+struct EncodedChunk {
+  std::vector<unsigned char> bytes;
+  std::uint32_t filter_mask = 0;
+};
+inline constexpr std::uint32_t kRawChunk = 0x3;
+/// One history array cut into chunks of chunk_rows rows (the last one padded with NaN rows), each
+/// encoded for the history datasets' filter pipeline (FORMAT.md: /histories).
 struct EncodedArray {
   std::string name, unit;
   std::size_t rows = 0, cols = 1;
-  int level = 0;
-  std::vector<unsigned char> bytes;
+  std::size_t chunk_rows = 0;  ///< rows per chunk (0 when rows is 0)
+  int level = 0;               ///< deflate level the chunks were encoded with (0: raw)
+  std::vector<EncodedChunk> chunks;  ///< ceil(rows / chunk_rows) chunks
 };
 struct EncodedHistory {
   std::vector<EncodedArray> arrays;
 };
-/// Compress a run's history in the calling thread: HDF5's shuffle then deflate (zlib format, by
-/// libdeflate, `level` 1..9), or raw chunks without filters for level 0. Thread-safe,
-/// no HDF5. Throws StoreError when an array's data size is not rows*cols.
-EncodedHistory encode_history(const RunHistory& history, int level = 1);
+/// Compress a run's history in the calling thread, in chunks of `chunk_rows` rows (0: one chunk
+/// holding every row): HDF5's shuffle then deflate (zlib format, by libdeflate, `level` 1..9), or
+/// raw chunks for level 0. Every array of a run must have the same number of rows (the run's
+/// samples or iterations). Thread-safe, no HDF5. Throws StoreError when an array's data size is not
+/// rows*cols or the arrays' row counts differ.
+EncodedHistory encode_history(const RunHistory& history, int level = 1, std::size_t chunk_rows = 0);
+/// The arrays back from their chunks (bit-identical to what was encoded). Throws StoreError on a
+/// chunk that does not decode to chunk_rows * cols values.
+RunHistory decode_history(const EncodedHistory& history);
+/// Total bytes of the encoded chunks.
+std::size_t encoded_bytes(const EncodedHistory& history);
 
 /// One axis of a block's grid, or one gridded metric (row-major over the axes, NaN = no value).
 struct LandscapeAxis {
@@ -173,6 +190,10 @@ class ResultsWriter {
   /// visible (done) at the next flush, automatic or explicit; its history is stored at once.
   void write_run(std::int64_t run_id, const Record& record, const EncodedHistory& history = {});
   void write_run(std::int64_t run_id, const Record& record, const RunHistory& history, int level = 1);
+  /// Rows per chunk of the file's history datasets: what encode_history should be given for
+  /// write_run to store the chunks as they are (others are re-cut). 0 until the first history sets
+  /// it (from that run's rows). Thread-safe: worker threads read it while the writer thread writes.
+  std::size_t history_chunk_rows() const;
   /// Commit everything written so far (atomic: after a crash the file holds exactly the runs done
   /// at the last completed flush).
   void flush();
@@ -259,6 +280,10 @@ class ResultsReader {
   Record read_record(std::int64_t run_id) const;
   bool has_history(std::int64_t run_id) const;
   RunHistory read_history(std::int64_t run_id) const;  ///< empty when the run has none
+  /// The run's history as the file stores it, chunks undecoded (for copying runs between files:
+  /// ResultsWriter::write_run stores them without decompressing when the chunk sizes agree). Empty
+  /// when the run has none. Format 3 files; older ones are read and encoded at `level`.
+  EncodedHistory read_history_chunks(std::int64_t run_id, int level = 1) const;
   std::vector<std::string> landscapes() const;
   LandscapeSpec read_landscape(const std::string& block) const;
   /// Names of the groups under /optimizations (empty when none), and one of them (optimizations_read.cpp).
@@ -272,7 +297,7 @@ class ResultsReader {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Name of run `run_id`'s group under /histories ("000123"; wider when n_runs needs it).
+/// Name of run `run_id`'s group under /histories in format 2 files ("000123"; wider when n_runs needs it).
 std::string history_group_name(std::int64_t run_id, std::int64_t n_runs);
 
 }  // namespace ks::store

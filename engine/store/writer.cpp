@@ -163,6 +163,7 @@ void ResultsWriter::Impl::open_objects() {
   histories = Hid(check(H5Gopen2(file, "histories", H5P_DEFAULT), path, "open /histories"));
   landscapes = Hid(check(H5Gopen2(file, "landscapes", H5P_DEFAULT), path, "open /landscapes"));
   done_dset = Hid(check(H5Dopen2(runs, "done", H5P_DEFAULT), path, "open /runs/done"));
+  open_histories();
   col_dsets.clear();
   for (auto& c : columns)
     col_dsets.emplace_back(check(H5Dopen2(runs, c.name.c_str(), H5P_DEFAULT), path, "open /runs/" + c.name));
@@ -202,7 +203,7 @@ std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, co
   }
   try {
     Hid fcpl(H5Pcreate(H5P_FILE_CREATE));
-    H5Pset_istore_k(fcpl, 1);  // chunk B-tree nodes sized for one-chunk history arrays
+    H5Pset_istore_k(fcpl, 32);  // chunk B-tree nodes of 64 entries (the history datasets' many chunks)
     Hid fapl(H5Pcreate(H5P_FILE_ACCESS));
     set_format(fapl);
     Hid f(check(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, fcpl, fapl), path, "cannot create " + tmp));
@@ -304,7 +305,7 @@ void ResultsWriter::write_run(std::int64_t run_id, const Record& record, const E
       throw StoreError(m.path, "run " + std::to_string(run_id) + ": cell '" + m.columns[i].name +
                                    "' does not hold a " + type_word(want));
   }
-  if (!history.arrays.empty()) m.write_history(run_id, history);
+  m.write_history(run_id, history);
   m.pending[run_id] = record;
   m.done[static_cast<std::size_t>(run_id)] = 1;
   // rows go to the datasets in batches as they come (uncommitted, invisible until the next commit),
@@ -317,7 +318,7 @@ void ResultsWriter::write_run(std::int64_t run_id, const Record& record, const E
   if (by_count || by_time) m.do_flush();
 }
 
-namespace {
+namespace detail {
 /// A file-space selection of the given rows (sorted, unique ids) as a union of hyperslabs, one per
 /// range of consecutive ids (one range when runs arrive in order): HDF5 handles that at a small
 /// fraction of the cost of a point selection of the same rows.
@@ -334,10 +335,11 @@ Hid select_rows(hid_t dset, const std::vector<hsize_t>& ids) {
   }
   return fs;
 }
-}  // namespace
+}  // namespace detail
 
 void ResultsWriter::Impl::write_rows() {
   write_landscape_cells();
+  write_history_index();
   if (pending.empty()) return;
   std::vector<hsize_t> ids;
   ids.reserve(pending.size());
@@ -414,14 +416,17 @@ void ResultsWriter::close() {
     // the driver refuses to commit after an I/O error; the file keeps its last committed state
     m.col_dsets.clear();
     m.landscape_streams.clear();
+    m.hist.close_handles();
     m.done_dset.reset(); m.runs.reset(); m.histories.reset(); m.landscapes.reset();
     H5Fclose(m.file.release());
     H5Eclear2(H5E_DEFAULT);
     return;
   }
+  m.trim_histories();
   m.do_flush();
   m.col_dsets.clear();
   m.landscape_streams.clear();
+  m.hist.close_handles();
   m.done_dset.reset(); m.runs.reset(); m.histories.reset(); m.landscapes.reset();
   m.closed = true;
   if (H5Fclose(m.file.release()) < 0) {

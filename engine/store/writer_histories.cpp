@@ -1,10 +1,9 @@
-// ResultsWriter's histories and encode_history (see store.hpp, FORMAT.md: "/histories"): the
-// compression runs in worker threads, the writer thread only stores.
-#include <libdeflate.h>
-
+// ResultsWriter's histories (see store.hpp, FORMAT.md: "/histories"): every run's arrays go into
+// datasets shared by all runs, one per array, at a chunk-aligned start in one row space, with a
+// per-run index. The chunks come encoded from the worker threads (history_codec.cpp): the writer
+// thread creates no per-run object and compresses nothing.
 #include <algorithm>
-#include <array>
-#include <cstring>
+#include <limits>
 #include <set>
 
 #include "store/h5util.hpp"
@@ -24,129 +23,216 @@ std::string history_group_name(std::int64_t run_id, std::int64_t n_runs) {
 }
 
 namespace {
-/// HDF5's shuffle filter for 8-byte elements: byte j of element i goes to j * n + i.
-void shuffle8(const double* src, std::size_t n, unsigned char* dst) {
-  const unsigned char* s = reinterpret_cast<const unsigned char*>(src);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < 8; ++j) dst[j * n + i] = s[i * 8 + j];
-}
-/// The byte-shuffled array as one zlib stream, the format HDF5's deflate filter reads. The six
-/// low-order byte planes of a history's doubles are close to noise (deflate gains ~4 % on them at
-/// the price of most of its time), so they go into the stream as stored blocks, copied; only the two
-/// high planes (sign, exponent, top of the mantissa: 2.5x and 50x smaller) are deflated, at `level`.
-/// The stream: zlib header, stored blocks (BFINAL = 0, each ending on a byte boundary), libdeflate's
-/// raw deflate of the high planes (its last block final), Adler-32 of all the bytes. Empty on failure.
-std::vector<unsigned char> zlib_stream_high_planes(const unsigned char* shuffled, std::size_t n, int level);
+constexpr const char* kIndex[] = {"start", "rows", "layout"};
 
-/// One libdeflate compressor per thread and level (allocating one costs more than a small array).
-libdeflate_compressor* compressor(int level) {
-  struct Cache {
-    std::array<libdeflate_compressor*, 10> c{};
-    ~Cache() {
-      for (auto* p : c)
-        if (p) libdeflate_free_compressor(p);
-    }
-  };
-  thread_local Cache cache;
-  if (!cache.c[level]) cache.c[level] = libdeflate_alloc_compressor(level);
-  return cache.c[level];
+/// Rows per chunk for a file whose first history comes in chunks of `rows` rows (a new run: all
+/// its rows, so runs like it fill their chunk exactly; a copied run: its file's chunk size) of at
+/// most `cols` columns: at least 64, at most what keeps a chunk of the widest array under 4 MiB.
+std::size_t choose_chunk_rows(std::size_t rows, std::size_t cols) {
+  const std::size_t cap = std::max<std::size_t>(64, (std::size_t{4} << 20) / (8 * std::max<std::size_t>(cols, 1)));
+  return std::clamp<std::size_t>(rows, 64, cap);
 }
 
-std::vector<unsigned char> zlib_stream_high_planes(const unsigned char* shuffled, std::size_t n, int level) {
-  const std::size_t total = 8 * n, low = 6 * n;  // planes 0..5 stored, 6..7 deflated
-  libdeflate_compressor* c = compressor(level);
-  if (!c) return {};
-  const std::size_t stored_blocks = (low + 65534) / 65535;
-  std::vector<unsigned char> out(2 + low + 5 * stored_blocks + libdeflate_deflate_compress_bound(c, total - low) + 4);
-  unsigned char* p = out.data();
-  *p++ = 0x78;  // CMF: deflate, 32 KiB window
-  *p++ = 0x01;  // FLG: no dictionary, (0x78 * 256 + 0x01) % 31 == 0
-  for (std::size_t at = 0; at < low;) {
-    const std::size_t len = std::min<std::size_t>(65535, low - at);
-    *p++ = 0x00;  // BFINAL = 0, BTYPE = 00 (stored), then padding to the byte boundary
-    *p++ = static_cast<unsigned char>(len & 0xff);
-    *p++ = static_cast<unsigned char>(len >> 8);
-    *p++ = static_cast<unsigned char>(~len & 0xff);
-    *p++ = static_cast<unsigned char>((~len >> 8) & 0xff);
-    std::memcpy(p, shuffled + at, len);
-    p += len;
-    at += len;
-  }
-  const std::size_t room = static_cast<std::size_t>(out.data() + out.size() - p) - 4;
-  const std::size_t m = libdeflate_deflate_compress(c, shuffled + low, total - low, p, room);
-  if (m == 0) return {};
-  p += m;
-  const std::uint32_t adler = libdeflate_adler32(1, shuffled, total);
-  *p++ = static_cast<unsigned char>(adler >> 24);
-  *p++ = static_cast<unsigned char>(adler >> 16);
-  *p++ = static_cast<unsigned char>(adler >> 8);
-  *p++ = static_cast<unsigned char>(adler);
-  out.resize(static_cast<std::size_t>(p - out.data()));
-  return out;
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ",") + x;
+  return s;
 }
 }  // namespace
 
-EncodedHistory encode_history(const RunHistory& history, int level) {
-  level = std::clamp(level, 0, 9);
-  EncodedHistory out;
-  out.arrays.reserve(history.arrays.size());
-  std::vector<unsigned char> shuffled;
-  for (const auto& a : history.arrays) {
-    if (a.data.size() != a.rows * a.cols)
-      throw StoreError("", "history array '" + a.name + "' has " + std::to_string(a.data.size()) +
-                               " values, expected rows*cols = " + std::to_string(a.rows * a.cols));
-    EncodedArray e;
-    e.name = a.name; e.unit = a.unit; e.rows = a.rows; e.cols = a.cols; e.level = level;
-    if (!a.data.empty()) {
-      const std::size_t src = a.data.size() * sizeof(double);
-      if (level == 0) {  // no filter: the chunk is the raw little-endian array
-        e.bytes.resize(src);
-        std::memcpy(e.bytes.data(), a.data.data(), src);
-      } else {  // shuffle, then deflate (zlib format, as HDF5's deflate filter writes it)
-        shuffled.resize(src);
-        shuffle8(a.data.data(), a.data.size(), shuffled.data());
-        e.bytes = zlib_stream_high_planes(shuffled.data(), a.data.size(), level);
-        if (e.bytes.empty()) throw StoreError("", "libdeflate failed for history array '" + a.name + "'");
-      }
+std::size_t ResultsWriter::history_chunk_rows() const { return impl_->hist.chunk_rows.load(std::memory_order_acquire); }
+
+void ResultsWriter::Impl::open_histories() {
+  Histories& h = hist;
+  h.chunk_rows = static_cast<std::size_t>(std::max<std::int64_t>(0, read_i64_attr(histories, "chunk_rows", 0)));
+  h.used_rows = h.written_used_rows = static_cast<hsize_t>(std::max<std::int64_t>(0, read_i64_attr(histories, "used_rows", 0)));
+  if (!link_exists(histories, "start")) return;
+  h.start = Hid(check(H5Dopen2(histories, "start", H5P_DEFAULT), path, "open /histories/start"));
+  h.rows = Hid(check(H5Dopen2(histories, "rows", H5P_DEFAULT), path, "open /histories/rows"));
+  h.layout = Hid(check(H5Dopen2(histories, "layout", H5P_DEFAULT), path, "open /histories/layout"));
+  h.layouts = read_str_list_attr(histories, "layouts");
+  std::set<std::string> names;
+  for (const auto& l : h.layouts) {
+    std::size_t at = 0;
+    while (at <= l.size() && !l.empty()) {
+      const std::size_t comma = std::min(l.find(',', at), l.size());
+      names.insert(l.substr(at, comma - at));
+      at = comma + 1;
     }
-    out.arrays.push_back(std::move(e));
   }
-  return out;
+  for (const auto& n : names) {
+    HistoryDataset d;
+    d.name = n;
+    d.dset = Hid(check(H5Dopen2(histories, n.c_str(), H5P_DEFAULT), path, "open /histories/" + n));
+    d.array = read_str_attr(d.dset, "array");
+    hsize_t dims[2] = {0, 0};
+    H5Sget_simple_extent_dims(Hid(H5Dget_space(d.dset)), dims, nullptr);
+    d.extent = dims[0];
+    d.cols = dims[1];
+    h.datasets.push_back(std::move(d));
+  }
 }
 
-void ResultsWriter::Impl::write_history(std::int64_t id, const EncodedHistory& h) {
-  const std::string gname = history_group_name(id, n_runs);
-  if (link_exists(histories, gname) && H5Ldelete(histories, gname.c_str(), H5P_DEFAULT) < 0)
-    fail("cannot replace /histories/" + gname);
-  Hid g(H5Gcreate2(histories, gname.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-  if (!g.ok()) fail("cannot create /histories/" + gname);
+void ResultsWriter::Impl::write_history(std::int64_t id, const EncodedHistory& given) {
+  Histories& h = hist;
+  if (given.arrays.empty()) {  // a run without history (a rewrite may replace one that had)
+    if (h.start.ok()) h.pending[id] = HistoryIndexEntry{};
+    return;
+  }
   std::vector<std::string> names;
-  for (const auto& a : h.arrays) {
+  std::size_t max_cols = 0;
+  for (const auto& a : given.arrays) {
     validate_name(path, a.name, "history array");
+    if (a.name.find(',') != std::string::npos)
+      throw StoreError(path, "invalid history array name '" + a.name + "' (contains ',')");
     if (std::find(names.begin(), names.end(), a.name) != names.end())
       throw StoreError(path, "duplicate history array '" + a.name + "' in run " + std::to_string(id));
+    if (a.rows != given.arrays.front().rows)
+      throw StoreError(path, "run " + std::to_string(id) + ": history arrays of different row counts");
     names.push_back(a.name);
-    hsize_t dims[2] = {a.rows, a.cols};
-    Hid space(H5Screate_simple(2, dims, nullptr));
-    Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
-    const bool empty = a.rows == 0 || a.cols == 0;
-    if (!empty) {
-      H5Pset_chunk(dcpl, 2, dims);  // one chunk = the whole array
-      if (a.level > 0) {            // the pipeline encode_history ran: shuffle, then deflate
-        H5Pset_shuffle(dcpl);
-        H5Pset_deflate(dcpl, static_cast<unsigned>(a.level));
-      }
-    }
-    Hid d(H5Dcreate2(g, a.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT));
-    if (!d.ok()) fail("cannot create /histories/" + gname + "/" + a.name);
-    if (!empty) {
-      hsize_t offset[2] = {0, 0};
-      if (H5Dwrite_chunk(d, H5P_DEFAULT, 0, offset, a.bytes.size(), a.bytes.data()) < 0)
-        fail("cannot write /histories/" + gname + "/" + a.name);
-    }
-    write_str_attr(d, "unit", a.unit);
+    max_cols = std::max(max_cols, a.cols);
   }
-  write_str_list_attr(g, "arrays", names);
+  const std::size_t rows = given.arrays.front().rows;
+  if (h.chunk_rows == 0) {  // the first history's chunks (a copied run's: the source file's C)
+    const std::size_t given_rows = given.arrays.front().chunk_rows ? given.arrays.front().chunk_rows : rows;
+    h.chunk_rows.store(choose_chunk_rows(given_rows, max_cols), std::memory_order_release);
+    write_i64_attr(histories, "chunk_rows", static_cast<std::int64_t>(h.chunk_rows));
+  }
+  const std::size_t C = h.chunk_rows;
+  // Chunks cut to another size (encoded before the chunk size was known) are re-cut here.
+  EncodedHistory recut;
+  const EncodedHistory* enc = &given;
+  for (const auto& a : given.arrays)
+    if (a.rows > 0 && a.chunk_rows != C) {
+      recut = encode_history(decode_history(given), given.arrays.front().level, C);
+      enc = &recut;
+      break;
+    }
+  if (!h.start.ok()) {  // the index datasets, at the first history (FORMAT.md: /histories)
+    hsize_t n = static_cast<hsize_t>(n_runs);
+    Hid space(H5Screate_simple(1, &n, nullptr));
+    const std::int64_t fills[] = {-1, 0, -1};
+    Hid* dsets[] = {&h.start, &h.rows, &h.layout};
+    for (int k = 0; k < 3; ++k) {
+      Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
+      H5Pset_layout(dcpl, H5D_CONTIGUOUS);
+      H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY);
+      H5Pset_fill_time(dcpl, H5D_FILL_TIME_ALLOC);
+      H5Pset_fill_value(dcpl, H5T_NATIVE_INT64, &fills[k]);
+      *dsets[k] = Hid(check(H5Dcreate2(histories, kIndex[k], H5T_STD_I64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT),
+                            path, std::string("create /histories/") + kIndex[k]));
+    }
+    write_str_attr(h.start, "description", "first row of the run's history in every history dataset (-1: none)");
+    write_str_attr(h.rows, "description", "rows of the run's history");
+    write_str_attr(h.layout, "description", "index into the attribute layouts of /histories (-1: none)");
+  }
+  // The datasets of this run's arrays: by array name and column count.
+  std::vector<HistoryDataset*> targets;
+  std::vector<std::string> dnames;
+  for (const auto& a : enc->arrays) {
+    HistoryDataset* found = nullptr;
+    bool name_taken = false;
+    for (auto& d : h.datasets) {
+      if (d.array == a.name && d.cols == a.cols) found = &d;
+      name_taken = name_taken || d.name == a.name;
+    }
+    if (!found) {
+      HistoryDataset d;
+      d.array = a.name;
+      d.cols = a.cols;
+      d.name = name_taken ? a.name + "." + std::to_string(a.cols) : a.name;
+      hsize_t dims[2] = {0, a.cols}, maxdims[2] = {H5S_UNLIMITED, a.cols};
+      Hid space(H5Screate_simple(2, dims, a.cols > 0 ? maxdims : nullptr));
+      Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
+      hsize_t chunk[2] = {C, a.cols};
+      if (a.cols > 0) {  // an array of no columns holds nothing: a fixed empty dataset
+        H5Pset_chunk(dcpl, 2, chunk);
+        H5Pset_shuffle(dcpl);
+        H5Pset_deflate(dcpl, 1);
+      }
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      H5Pset_fill_value(dcpl, H5T_NATIVE_DOUBLE, &nan);
+      d.dset = Hid(H5Dcreate2(histories, d.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT));
+      if (!d.dset.ok()) fail("cannot create /histories/" + d.name);
+      write_str_attr(d.dset, "unit", a.unit);
+      write_str_attr(d.dset, "array", a.name);
+      h.datasets.push_back(std::move(d));
+    }
+    dnames.push_back(found ? found->name : h.datasets.back().name);
+  }
+  for (const auto& dn : dnames)
+    for (auto& d : h.datasets)
+      if (d.name == dn) targets.push_back(&d);
+  const std::string layout = join(dnames);
+  auto li = std::find(h.layouts.begin(), h.layouts.end(), layout);
+  if (li == h.layouts.end()) {
+    h.layouts.push_back(layout);
+    h.layouts_dirty = true;
+    li = h.layouts.end() - 1;
+  }
+  // The run's place: the next chunk boundary; its chunks, written as they are.
+  const hsize_t start = h.used_rows;
+  const hsize_t span = (rows + C - 1) / C * C;
+  for (std::size_t k = 0; k < enc->arrays.size(); ++k) {
+    const EncodedArray& a = enc->arrays[k];
+    HistoryDataset& d = *targets[k];
+    if (a.chunks.empty() || d.cols == 0) continue;
+    if (d.extent < start + span) {
+      hsize_t grow[2] = {std::max<hsize_t>(start + span, std::min<hsize_t>(2 * d.extent, d.extent + (hsize_t{1} << 24))),
+                         d.cols};
+      grow[0] = std::max<hsize_t>(grow[0], 64 * C);
+      if (H5Dset_extent(d.dset, grow) < 0) fail("cannot extend /histories/" + d.name);
+      d.extent = grow[0];
+    }
+    for (std::size_t c = 0; c < a.chunks.size(); ++c) {
+      hsize_t offset[2] = {start + c * C, 0};
+      if (H5Dwrite_chunk(d.dset, H5P_DEFAULT, a.chunks[c].filter_mask, offset, a.chunks[c].bytes.size(),
+                         a.chunks[c].bytes.data()) < 0)
+        fail("cannot write /histories/" + d.name + " for run " + std::to_string(id));
+    }
+  }
+  h.used_rows = start + span;
+  h.pending[id] = HistoryIndexEntry{static_cast<std::int64_t>(start), static_cast<std::int64_t>(rows),
+                                    static_cast<std::int64_t>(li - h.layouts.begin())};
+}
+
+void ResultsWriter::Impl::write_history_index() {
+  Histories& h = hist;
+  if (h.layouts_dirty) {
+    write_str_list_attr(histories, "layouts", h.layouts);
+    h.layouts_dirty = false;
+  }
+  if (h.used_rows != h.written_used_rows) {
+    write_i64_attr(histories, "used_rows", static_cast<std::int64_t>(h.used_rows));
+    h.written_used_rows = h.used_rows;
+  }
+  if (h.pending.empty()) return;
+  std::vector<hsize_t> ids;
+  std::vector<std::int64_t> v[3];
+  for (auto& [id, e] : h.pending) {
+    ids.push_back(static_cast<hsize_t>(id));
+    v[0].push_back(e.start);
+    v[1].push_back(e.rows);
+    v[2].push_back(e.layout);
+  }
+  hsize_t k = ids.size();
+  Hid mspace(H5Screate_simple(1, &k, nullptr));
+  const Hid* dsets[] = {&h.start, &h.rows, &h.layout};
+  for (int i = 0; i < 3; ++i) {
+    Hid fs = select_rows(*dsets[i], ids);
+    if (fs.get() < 0 || H5Dwrite(*dsets[i], H5T_NATIVE_INT64, mspace, fs, H5P_DEFAULT, v[i].data()) < 0)
+      fail(std::string("cannot write /histories/") + kIndex[i]);
+  }
+  h.pending.clear();
+}
+
+void ResultsWriter::Impl::trim_histories() {
+  for (auto& d : hist.datasets)
+    if (d.cols > 0 && d.extent > hist.used_rows) {
+      hsize_t dims[2] = {hist.used_rows, d.cols};
+      if (H5Dset_extent(d.dset, dims) < 0) fail("cannot trim /histories/" + d.name);
+      d.extent = hist.used_rows;
+    }
 }
 
 }  // namespace ks::store

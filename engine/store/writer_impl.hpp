@@ -1,6 +1,7 @@
 #pragma once
 // Internal: the state of a ResultsWriter, shared by writer.cpp, writer_histories.cpp, writer_resume.cpp
 // and optimizations.cpp. Only store/*.cpp.
+#include <atomic>
 #include <chrono>
 #include <map>
 #include <memory>
@@ -33,6 +34,29 @@ struct ResultsWriter::Impl {
     std::vector<double> values;
   };
   std::vector<LandscapeStream> landscape_streams;
+  /// The histories' shared row space (writer_histories.cpp, FORMAT.md: /histories).
+  struct HistoryDataset {
+    std::string name, array;  ///< dataset name (the array name, or "<array>.<cols>") and array name
+    std::size_t cols = 1;
+    detail::Hid dset;
+    hsize_t extent = 0;       ///< rows of the dataset's current extent (>= used_rows once written)
+  };
+  struct HistoryIndexEntry {
+    std::int64_t start = -1, rows = 0, layout = -1;
+  };
+  struct Histories {
+    std::atomic<std::size_t> chunk_rows{0};   ///< 0 until the first history (or the file's attribute)
+    hsize_t used_rows = 0, written_used_rows = 0;
+    std::vector<HistoryDataset> datasets;
+    std::vector<std::string> layouts;
+    detail::Hid start, rows, layout;          ///< the index datasets (absent until the first history)
+    std::map<std::int64_t, HistoryIndexEntry> pending;  ///< index entries not yet in the datasets
+    bool layouts_dirty = false;
+    void close_handles() {
+      datasets.clear();
+      start.reset(); rows.reset(); layout.reset();
+    }
+  } hist;
   static constexpr std::size_t kRowBatch = 512;
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false, broken = false;
@@ -50,6 +74,9 @@ struct ResultsWriter::Impl {
   }
   void open_objects();
   void write_history(std::int64_t id, const EncodedHistory& h);
+  void open_histories();          ///< the history state of an existing file (resume)
+  void write_history_index();     ///< pending index entries and the group's attributes (no commit)
+  void trim_histories();          ///< extents down to used_rows (at close)
   void write_rows();  // pending rows and landscape cells into the datasets (no commit)
   void write_landscape_cells();  // the pending landscape cells (writer_landscapes.cpp)
   void do_flush();    // write_rows, commit, set done flags, commit
@@ -61,6 +88,8 @@ void validate_name(const std::string& path, const std::string& name, const std::
 /// A file-access property list for the store's on-disk format (see FORMAT.md: 1.8 object formats,
 /// superblock v2, which has no "open for write" flag, so readers can open a file being written).
 void set_format(hid_t fapl);
+/// A file-space selection of `dset`'s rows `ids` (sorted, unique) as a union of hyperslabs.
+Hid select_rows(hid_t dset, const std::vector<hsize_t>& ids);
 /// Opens an existing results file for writing through the journal driver (which recovers it first
 /// after a crash). Only path, opt and file are set. Throws StoreError.
 std::unique_ptr<ResultsWriter::Impl> open_writer_impl(const std::string& path, const StoreOptions& opt);
