@@ -8,6 +8,9 @@
     r.row_kinds()                        # each (done) row's run kind: "trajectory", "ik"
     df = r.to_pandas()                   # the same as a pandas.DataFrame (units in df.attrs)
     h = r.history(3)                     # dict of 2-D arrays (rows x components) with .units
+    r.has_history(3)                     # whether run 3 has a history
+    r.history_arrays(3)                  # its array names in the run's order: ["t", "q", "qd", ...]
+    r.history_ids(), r.history_count()   # the run ids that have a history (ascending), how many
     ls = r.landscape("local")            # axes (name, unit, values, labels) and gridded metrics
     ds = r.to_xarray("local")            # the same as an xarray.Dataset: named dimensions, coordinates, units
     o = r.optimization("1h", degrees=True)   # an [[optimize]] block: evaluations, stages, local paths, best
@@ -17,20 +20,23 @@ Angles are stored in radians (unit "rad"); pass degrees=True to runs()/history()
 them in degrees (their unit then reads "deg"). Run with Debian's interpreter: /usr/bin/python3.
 
 Column roles (parameter, metric, bookkeeping) and the run kinds a column applies to are the /runs
-datasets' `role` and `kinds` attributes (FORMAT.md, format_version 2); files of format_version 1 lack
-them and are refused with FormatVersionError (kinesweep info / query still read them).
+datasets' `role` and `kinds` attributes (FORMAT.md, format_version 2 and 3); files of format_version 1
+lack them and are refused with FormatVersionError (kinesweep info / query still read them), as are
+versions newer than 3. Versions 2 and 3 differ in the /histories layout only, which kshistory reads.
 """
 import os
 
 import h5py
 import numpy as np
 
+import kshistory
 import kslive
 from kssolutions import cluster_solutions  # noqa: F401 (part of this module's interface)
+from kstypes import FormatVersionError  # noqa: F401 (the same)
 from kstypes import IK_STATUSES, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s  # noqa: F401 (the same)
 
 RAD2DEG = 180.0 / np.pi
-FORMAT_VERSION = 2  # the results format this module reads (engine/store/FORMAT.md)
+FORMAT_VERSIONS = (2, 3)  # the results formats this module reads (engine/store/FORMAT.md)
 ROLES = ("parameter", "metric", "bookkeeping")
 
 # Seed 000, Table 4 (copied from engine/methods/seed_cases.cpp, checked against it by the tests):
@@ -64,10 +70,6 @@ THESIS_OPTIMA = {
     "local_weighted": {"global": "1h", "partial": ["1d", "1f", "1g"]},
     "local_unweighted": {"global": "2h", "partial": ["2d", "2f", "2g"]},
 }
-
-class FormatVersionError(ValueError):
-    """A results file of a format_version this module does not read."""
-
 
 class Optimization:
     """One /optimizations/<name> group (FORMAT.md). Variables are columns of every n x d array:
@@ -182,11 +184,11 @@ class Results:
             self.meta = {k: (_s(v) if isinstance(v, (bytes, str)) else v.item() if hasattr(v, "item") else v)
                          for k, v in a.items()}
             version = int(self.meta.get("format_version", -1))
-            if version != FORMAT_VERSION:
+            if version not in FORMAT_VERSIONS:
                 engine = self.meta.get("engine_version", "?")
                 what = (f"{path}: results file format v{version} (written by kinesweep {engine}); ksread reads "
-                        f"v{FORMAT_VERSION} only")
-                if version < FORMAT_VERSION:
+                        f"{' and '.join(f'v{v}' for v in FORMAT_VERSIONS)} only")
+                if version < min(FORMAT_VERSIONS):
                     what += (" (v1 files have no role/kinds attributes on their /runs columns). `kinesweep query` "
                              "and `kinesweep info` still read this file; to use it here, rerun its study: "
                              "kinesweep run STUDY.toml --overwrite")
@@ -322,25 +324,40 @@ class Results:
         """A block's landscape (default: the first) as an xarray.Dataset (Landscape.to_xarray)."""
         return self.landscape(block, degrees=degrees).to_xarray()
 
+    def _histories(self):
+        """The kshistory reader of the current handle (a fresh one after each reopen)."""
+        if getattr(self, "_hist", None) is None or self._hist.f is not self.f:
+            self._hist = kshistory.Histories(self.f)
+        return self._hist
+
     @kslive.consistent
     def has_history(self, run_id):
-        return "histories" in self.f and history_group_name(run_id, self.n_runs) in self.f["histories"]
+        """Whether run run_id has a history (one of 0 rows included)."""
+        return self._histories().has(run_id)
+
+    @kslive.consistent
+    def history_arrays(self, run_id):
+        """The names of the run's history arrays in the order the run produced them ([] without one)."""
+        return self._histories().names(run_id)
+
+    @kslive.consistent
+    def history_ids(self):
+        """The run ids that have a history, ascending (int64 array)."""
+        return self._histories().ids()
+
+    @kslive.consistent
+    def history_count(self):
+        """The number of runs that have a history."""
+        return self._histories().count()
 
     @kslive.consistent
     def history(self, run_id, degrees=False):
         """One run's history: Table of name -> 2-D array (rows x components), .units per array
-        (IK q: "rad, rad, mm" -- one unit per component)."""
-        name = history_group_name(run_id, self.n_runs)
+        (IK q: "rad, rad, mm" -- one unit per component). KeyError when the run has none."""
         if not self.has_history(run_id):
             raise KeyError(f"run {run_id} has no history in {self.path}")
-        g = self.f["histories"][name]
         h = Table()
-        order = [_s(x) for x in g.attrs["arrays"]] if "arrays" in g.attrs else list(g)
-        for a in order:
-            v = np.array(g[a][()], dtype=float)
-            if v.ndim == 1:
-                v = v[:, None]
-            unit = _s(g[a].attrs.get("unit", ""))
+        for a, v, unit in self._histories().read(run_id):
             if degrees:
                 parts = [p.strip() for p in unit.split(",")]
                 if len(parts) == v.shape[1] and "rad" in parts:
@@ -451,9 +468,3 @@ def read_landscape(path, block=None, **kw):
 def read_optimization(path, name=None, **kw):
     with Results(path) as r:
         return r.optimization(name, **kw)
-
-
-def history_group_name(run_id, n_runs):
-    """Zero-padded group name under /histories: 6 digits, wider when n_runs needs it."""
-    width = max(6, len(str(max(int(n_runs) - 1, 0))))
-    return str(int(run_id)).zfill(width)

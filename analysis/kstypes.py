@@ -1,12 +1,17 @@
 """The plain data types ksread returns: Table (a /runs table or a history), Axis and Landscape (a
 block's gridded metrics), with their conversions to pandas and xarray (each an optional dependency,
-imported when asked for). Run with Debian's interpreter: /usr/bin/python3.
+imported when asked for), and FormatVersionError (a file of a format_version the readers do not read).
+Run with Debian's interpreter: /usr/bin/python3.
 """
 import numpy as np
 
 TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged", "undersampled"]
 IK_STATUSES = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution",
                "out_of_limits"]
+
+
+class FormatVersionError(ValueError):
+    """A results file of a format_version the reader does not read."""
 
 
 def _s(v):

@@ -50,8 +50,9 @@ def main(argv=None):
             key = (m, float(runs["lambda"][i]) if m in LAMBDA_METHODS else None)
             groups.setdefault(key, []).append(i)
         ids = []
+        have = set(res.history_ids().tolist())
         for key, rows in groups.items():
-            rows = [i for i in rows if res.has_history(int(runs["run_id"][i]))]
+            rows = [i for i in rows if int(runs["run_id"][i]) in have]
             if not rows:
                 continue
             if args.start:

@@ -47,8 +47,13 @@ def main(argv=None):
             ids.append(int(runs["run_id"][m[0]]))
     if not ids:
         # the first three trajectory runs with a history (an IK run's history has no time array)
-        ids = [int(r) for r in runs["run_id"] if res.has_history(int(r)) and "t" in res.f["histories"][
-            ksread.history_group_name(int(r), res.n_runs)]][:3]
+        done = {int(r) for r in runs["run_id"]}
+        ids = []
+        for r in res.history_ids():
+            if int(r) in done and "t" in res.history_arrays(int(r)):
+                ids.append(int(r))
+                if len(ids) == 3:
+                    break
         if not ids:
             raise SystemExit(f"{args.file}: no trajectory run with a history (run the study with histories)")
     whats = [w.strip() for w in args.what.split(",") if w.strip()]

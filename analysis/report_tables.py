@@ -50,7 +50,7 @@ def metadata_section(res, view):
     m = res.meta
     n = len(view.done)
     done = int(view.done.sum())
-    n_hist = len(res.f["histories"]) if "histories" in res.f else 0
+    n_hist = res.history_count()
     items = [("study_name", m.get("study_name", "")), ("study file", res.f["study"].attrs.get("path", "")),
              ("engine_version", m.get("engine_version", "")), ("created", m.get("created", "")),
              ("format_version", m.get("format_version", "")), ("study_sha256", m.get("study_sha256", "")),

@@ -15,12 +15,9 @@ JOINT_COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b
 
 def history_ids(res):
     """The run ids that have a history (a set), or None when there are too many to list cheaply."""
-    if "histories" not in res.f:
-        return set()
-    g = res.f["histories"]
-    if len(g) > 200000:
+    if res.history_count() > 200000:
         return None
-    return {int(k) for k in g}
+    return set(res.history_ids().tolist())
 
 
 def best_with_history(view, block, ids):

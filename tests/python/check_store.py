@@ -5,7 +5,8 @@ usage: check_store.py STORE_WRITER_HELPER WORKDIR
 
 1. Writes a complete file with the C++ helper and checks, with h5py + numpy only, the attributes,
    the /runs table (all columns one length, values recomputed here from the same formulas as
-   tests/store_testgen.cpp), the histories (bit-identical, chunked + deflate) and a landscape.
+   tests/store_testgen.cpp), the histories (bit-identical, chunked + deflate; in the layout of the
+   file's format_version, 2 or 3) and a landscape.
 2. Starts the helper writing slowly and reads the file concurrently, many times, while it grows.
 """
 import math
@@ -93,6 +94,9 @@ def check_table(f, n, require_all_done):
 
 
 def check_history(f, i):
+    if int(f.attrs["format_version"]) == 3:
+        check_history_v3(f, i)
+        return
     want = expected_history(i)
     name = f"{i:06d}"
     if want is None:
@@ -111,11 +115,44 @@ def check_history(f, i):
             check(d.chunks == arr.shape and d.compression == "gzip", f"run {i} {a}: chunks {d.chunks} {d.compression}")
 
 
+def check_history_v3(f, i):
+    """format_version 3: run i is rows [start[i], start[i] + rows[i]) of the datasets named by
+    layouts[layout[i]], starting on a chunk boundary, NaN from its end to the next chunk boundary."""
+    want = expected_history(i)
+    g = f["histories"]
+    start, rows, layout = (int(g[k][i]) for k in ("start", "rows", "layout"))
+    if want is None:
+        check((start, rows, layout) == (-1, 0, -1), f"run {i} should have no history: start, rows, layout = "
+                                                    f"{start}, {rows}, {layout}")
+        return
+    c, used = int(g.attrs["chunk_rows"]), int(g.attrs["used_rows"])
+    check(start >= 0 and layout >= 0 and start % c == 0, f"run {i}: start {start}, layout {layout}, chunk rows {c}")
+    check(rows == 0 or start + rows <= used, f"run {i}: rows [{start}, {start + rows}) beyond used_rows {used}")
+    if start < 0 or layout < 0:
+        return
+    datasets = {as_str(g[d].attrs.get("array", d)): g[d] for d in as_str(g.attrs["layouts"][layout]).split(",")}
+    check(sorted(datasets) == sorted(want), f"run {i} arrays {sorted(datasets)}")
+    for a, (arr, unit) in want.items():
+        if a not in datasets:
+            continue
+        d = datasets[a]
+        check(d.shape[0] >= used and d.maxshape[0] is None, f"run {i} {a}: shape {d.shape}, maxshape {d.maxshape}")
+        check(d.chunks == (c, d.shape[1]) and d.compression == "gzip", f"run {i} {a}: chunks {d.chunks} {d.compression}")
+        check(as_str(d.attrs["unit"]) == unit, f"run {i} {a} unit {d.attrs['unit']!r}")
+        got = d[start:start + rows]
+        check(got.shape == arr.shape, f"run {i} {a} shape {got.shape} != {arr.shape}")
+        check(got.dtype == np.dtype("<f8"), f"run {i} {a} dtype {got.dtype}")
+        check(got.tobytes() == arr.astype("<f8").tobytes(), f"run {i} {a} not bit-identical")
+        if rows:
+            pad = d[start + rows:min(-(-(start + rows) // c) * c, d.shape[0])]
+            check(bool(np.all(np.isnan(pad))), f"run {i} {a}: padding after its rows is not NaN")
+
+
 def check_complete(path, n):
     with h5py.File(path, "r") as f:
         a = f.attrs
         check(as_str(a["format"]) == "kinesweep-results", "format attribute")
-        check(int(a["format_version"]) == 2, "format_version attribute")
+        check(int(a["format_version"]) in (2, 3), "format_version attribute")
         check(len(as_str(a["engine_version"])) > 0, "engine_version attribute")
         check(re.fullmatch(r"[0-9a-f]{64}", as_str(a["study_sha256"])) is not None, "study_sha256 is 64 hex digits")
         check(re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", as_str(a["created"])) is not None, "created ISO 8601")

@@ -3,11 +3,15 @@ Run with Debian's /usr/bin/python3 (h5py, numpy)."""
 import os
 import subprocess
 import shutil
+import sys
 import tempfile
 import unittest
 
 import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
+from kshistory import Histories  # noqa: E402  the /histories layouts (format_version 1 to 3)
 
 # A trajectory landscape (561 runs) and an IK basin (441 runs): about a second on 2 cores.
 SWEEP = """
@@ -69,6 +73,24 @@ def bitwise_equal(x, y):
     if x.dtype.kind == "f":
         return np.array_equal(x.view(np.uint64), y.view(np.uint64))
     return np.array_equal(x, y)
+
+
+def history(f, run_id):
+    """One run's history in an open results file, whatever its /histories layout: {array name: 2-D
+    float64 array} in the order the run produced them. KeyError when the run has none."""
+    return {name: a for name, a, _unit in Histories(f).read(run_id)}
+
+
+def same_histories(test, fa, fb):
+    """Assert that two open results files hold the same histories, bit for bit (NaN payloads included):
+    the same runs, each with the same arrays in the same order."""
+    ha, hb = Histories(fa), Histories(fb)
+    test.assertEqual(ha.ids().tolist(), hb.ids().tolist())
+    for i in ha.ids():
+        a, b = ha.read(i), hb.read(i)
+        test.assertEqual([(n, u) for n, _, u in a], [(n, u) for n, _, u in b], f"run {i}")
+        for (name, x, _), (_, y, _) in zip(a, b):
+            test.assertTrue(bitwise_equal(x, y), f"run {i} {name}")
 
 
 def runs_table(path):

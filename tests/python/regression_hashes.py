@@ -19,7 +19,8 @@ Items (one manifest entry each, with the dtype class f/i/s and the shape or row 
   hashed.
 --record writes MANIFEST; otherwise the hashes are compared with it, every mismatch, missing or extra
 item is printed, and the exit status is 1 if there is any. Only the storage-specific reading lives in
-decode_text() and history_arrays(): adapt those when the file format changes.
+decode_text() and history_arrays() (which reads through analysis/kshistory.py, the one reader of the
+/histories layouts): adapt those when the file format changes.
 """
 import argparse
 import glob
@@ -34,6 +35,9 @@ import time
 
 import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
+from kshistory import Histories  # noqa: E402  the /histories layouts of format_version 1 to 3
 
 # --histories per study; every other study runs with "none".
 FULL_HISTORIES = {"thesis_table4", "ik_scara", "examples_convergence"}
@@ -62,15 +66,14 @@ def decode_text(values, source=None):
 
 
 def history_arrays(f):
-    """Yield (run_id, array name, 2-D float64 array) for every history in run-id order.
-    Layout v1: /histories/<zero-padded run id>/<array name>."""
-    if "histories" not in f:
-        return
-    runs = f["histories"]
-    for key in sorted(runs, key=int):
-        for name, ds in runs[key].items():
-            a = np.asarray(ds[()], dtype="<f8")
-            yield int(key), name, a.reshape(a.shape[0], -1) if a.ndim == 1 else a
+    """Yield (run_id, array name, 2-D float64 array) for every history in run-id order, whatever the
+    layout, so that equal histories hash equal in every format version:
+      v1, v2: /histories/<zero-padded run id>/<array name> (a 1-D dataset is one column);
+      v3: one row space; run i is rows [start[i], start[i] + rows[i]) of the datasets its layout
+          names, each dataset's `array` attribute naming its array (dataset F.2 holds array F)."""
+    for run_id, arrays in Histories(f).items():
+        for name, a, _unit in arrays:
+            yield run_id, name, a
 
 
 # --- canonical encoding ---------------------------------------------------------------------

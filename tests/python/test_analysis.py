@@ -16,7 +16,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import OPTIMIZE as OPTIMIZE_COMMON
+from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, history
 
 KS = None
 ROOT = None
@@ -243,13 +243,13 @@ class AnalysisTest(unittest.TestCase):
             preset = [h5str(x) for x in f["runs"]["preset"][()]]
             for case in ("1a", "2d"):
                 run = preset.index(case)
-                g = f["histories"][str(run).zfill(6)]
+                h = history(f, run)
                 got = d["runs"][str(run)]
                 self.assertIn(case, got["label"])
-                np.testing.assert_array_equal(got["t"], g["t"][()][:, 0])
-                np.testing.assert_array_equal(got["tau"], g["tau"][()])
-                np.testing.assert_array_equal(got["qd"], g["qd"][()])  # rad/s, not converted
-                np.testing.assert_allclose(got["q"], g["q"][()] * D, rtol=1e-13)
+                np.testing.assert_array_equal(got["t"], h["t"][:, 0])
+                np.testing.assert_array_equal(got["tau"], h["tau"])
+                np.testing.assert_array_equal(got["qd"], h["qd"])  # rad/s, not converted
+                np.testing.assert_allclose(got["q"], h["q"] * D, rtol=1e-13)
 
     def test_cases(self):
         d = self.plot("plot_cases.py", self.files["table4"])
@@ -292,9 +292,9 @@ class AnalysisTest(unittest.TestCase):
             lam = f["runs"]["lambda"][()]
             self.assertEqual(len(d["runs"]), len(method))  # one line per (method, lambda)
             for run, got in d["runs"].items():
-                g = f["histories"][run.zfill(6)]
-                np.testing.assert_array_equal(got["norm_F"], g["norm_F"][()][:, 0])
-                np.testing.assert_array_equal(got["k"], g["k"][()][:, 0])
+                h = history(f, int(run))
+                np.testing.assert_array_equal(got["norm_F"], h["norm_F"][:, 0])
+                np.testing.assert_array_equal(got["k"], h["k"][:, 0])
                 self.assertEqual(got["method"], method[int(run)])
                 if got["lambda"] is not None:
                     self.assertEqual(got["lambda"], lam[int(run)])

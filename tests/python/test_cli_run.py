@@ -16,7 +16,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import SWEEP, TempDirTest, runs_table, same_tables
+from e2e_common import SWEEP, TempDirTest, history, runs_table, same_tables
 
 KS = None
 STUDIES = None
@@ -135,9 +135,11 @@ class Reproducibility(Base):
         self.assertEqual(run("run", study, "-o", b, "--threads", "2", "-q").returncode, 0)
         self.assertTrue(same_tables(runs_table(a), runs_table(b)))
         with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
-            for g in ["000000", "000300", "000700"]:
-                for k in fa["histories"][g]:
-                    self.assertTrue(np.array_equal(fa["histories"][g][k][()], fb["histories"][g][k][()]))
+            for run_id in (0, 300, 700):
+                ha, hb = history(fa, run_id), history(fb, run_id)
+                self.assertEqual(list(ha), list(hb))
+                for k in ha:
+                    self.assertTrue(np.array_equal(ha[k], hb[k]))
             self.assertEqual(fa.attrs["study_sha256"], hashlib.sha256(SWEEP.encode()).hexdigest())
 
     def test_pandas_style_load_and_study_inside(self):

@@ -19,7 +19,7 @@ import numpy as np
 
 import hashlib
 
-from e2e_common import SWEEP as SWEEP_COMMON, TempDirTest, bitwise_equal, make_v1, runs_table
+from e2e_common import SWEEP as SWEEP_COMMON, TempDirTest, bitwise_equal, make_v1, runs_table, same_histories
 
 KS = None
 MPIRUN = ["mpirun", "--oversubscribe", "--allow-run-as-root", "--bind-to", "none", "-np", "2"]
@@ -80,11 +80,7 @@ class Base(TempDirTest):
             self.assertTrue(bitwise_equal(ta[k], tb[k]), k)
         with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
             self.assertTrue(np.all(fb["runs"]["done"][()] == 1))
-            self.assertEqual(set(fa["histories"]), set(fb["histories"]))
-            for g in fa["histories"]:
-                self.assertEqual(list(fa["histories"][g].attrs["arrays"]), list(fb["histories"][g].attrs["arrays"]))
-                for k in fa["histories"][g]:
-                    self.assertTrue(bitwise_equal(fa["histories"][g][k][()], fb["histories"][g][k][()]), g + "/" + k)
+            same_histories(self, fa, fb)
             self.assertEqual(set(fa["landscapes"]), set(fb["landscapes"]))
             for l in fa["landscapes"]:
                 self.assertEqual(set(fa["landscapes"][l]), set(fb["landscapes"][l]))

@@ -24,6 +24,7 @@ import unittest
 import h5py
 import numpy as np
 
+from e2e_common import Histories
 from regression_hashes import FULL_HISTORIES
 
 KS = None
@@ -240,9 +241,9 @@ class PlotStudiesTest(unittest.TestCase):
             self.assertNotEqual(rc, 0)
             self.assertIn("IK landscape", err)
         # plot_histories / plot_convergence: trajectory (time) and IK (norm_F) histories.
-        hist = f["histories"] if "histories" in f else {}
-        traj = [int(k) for k in hist if "t" in hist[k]]
-        ikh = [int(k) for k in hist if "norm_F" in hist[k]]
+        hist = Histories(f)
+        traj = [int(i) for i in hist.ids() if "t" in hist.names(i)]
+        ikh = [int(i) for i in hist.ids() if "norm_F" in hist.names(i)]
         rc, d, err = self.plot("plot_histories.py", h5, expect_ok=bool(traj))
         if traj:
             self.assertEqual(sorted(int(r) for r in d["runs"]), sorted(traj)[:3])

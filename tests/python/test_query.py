@@ -18,7 +18,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, make_v1
+from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, history, make_v1
 
 KS = None
 ROOT = None
@@ -304,9 +304,6 @@ class QueryTest(unittest.TestCase):
             self.assertEqual(runs.roles["block"], "bookkeeping")
             self.assertEqual((r.landscape("weighted").kind, r.landscape("basin").kind), ("trajectory", "ik"))
 
-    def _group(self, f, run):
-        return f["histories"][str(run).zfill(max(6, len(str(len(f["runs"]["done"]) - 1))))]
-
     def test_trajectory_history_csv(self):
         t = self.t
         run = int(np.nonzero((t["block"] == "weighted") & (t["status"] == "ok"))[0][3])
@@ -316,10 +313,10 @@ class QueryTest(unittest.TestCase):
         self.assertEqual(head, ["t", "tau_1", "tau_2", "tau_3", "q_1 [deg]", "q_2 [deg]", "q_3 [deg]"])
         a = np.array(rows, dtype=float)
         with h5py.File(self.h5, "r") as f:
-            g = self._group(f, run)
-            np.testing.assert_array_equal(a[:, 0], g["t"][()][:, 0])
-            np.testing.assert_array_equal(a[:, 1:4], g["tau"][()])
-            np.testing.assert_allclose(a[:, 4:7], g["q"][()] * D, rtol=1e-14, atol=1e-12)
+            h = history(f, run)
+            np.testing.assert_array_equal(a[:, 0], h["t"][:, 0])
+            np.testing.assert_array_equal(a[:, 1:4], h["tau"])
+            np.testing.assert_allclose(a[:, 4:7], h["q"] * D, rtol=1e-14, atol=1e-12)
 
     def test_ik_history_json(self):
         t = self.t
@@ -329,9 +326,9 @@ class QueryTest(unittest.TestCase):
         j = json.loads(r.stdout)
         self.assertEqual(j["columns"], ["k", "norm_F"])
         with h5py.File(self.h5, "r") as f:
-            g = self._group(f, run)
-            self.assertEqual([row["k"] for row in j["rows"]], g["k"][()][:, 0].astype(int).tolist())
-            np.testing.assert_array_equal([row["norm_F"] for row in j["rows"]], g["norm_F"][()][:, 0])
+            h = history(f, run)
+            self.assertEqual([row["k"] for row in j["rows"]], h["k"][:, 0].astype(int).tolist())
+            np.testing.assert_array_equal([row["norm_F"] for row in j["rows"]], h["norm_F"][:, 0])
         r = ks("query", self.h5, "--run", str(run), "--history", "tau")
         self.assertEqual(r.returncode, 2)
         self.assertIn("valid arrays", r.stderr)

@@ -20,7 +20,7 @@ from html.parser import HTMLParser
 import h5py
 import numpy as np
 
-from e2e_common import OPTIMIZE, run_study_text
+from e2e_common import OPTIMIZE, Histories, run_study_text
 
 KS = None
 ROOT = None
@@ -211,7 +211,7 @@ class ReportTest(unittest.TestCase):
                 done = f["runs"]["done"][()]
                 self.assertEqual(int(p.meta["runs"]), len(done))
                 self.assertEqual(int(p.meta["done"]), int(done.sum()))
-                self.assertEqual(int(p.meta["histories"]), len(f["histories"]) if "histories" in f else 0)
+                self.assertEqual(int(p.meta["histories"]), Histories(f).count())
                 self.assertEqual(int(p.meta["optimizations"]),
                                  len(f["optimizations"]) if "optimizations" in f else 0)
                 self.assertEqual(p.study_text, s(f["study"]["text"][()]))

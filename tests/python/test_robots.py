@@ -13,7 +13,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import TempDirTest
+from e2e_common import Histories, TempDirTest, history
 
 KS = None
 STUDIES = None
@@ -113,10 +113,9 @@ class ChainStudies(TempDirTest):
             self.assertGreater(len(good), 20)
             # the tip follows the 3-D path (RK4): open-loop drift small against the 0.2 m square
             self.assertLess(np.max(runs["max_tracking_error"][()][good]), 1e-3)
-            hist = f["histories"]
-            name = sorted(hist)[0]
-            self.assertEqual(hist[name]["q"].shape[1], 7)
-            self.assertEqual(hist[name]["x"].shape[1], 3)
+            h = history(f, Histories(f).ids()[0])
+            self.assertEqual(h["q"].shape[1], 7)
+            self.assertEqual(h["x"].shape[1], 3)
 
     def test_arm7_ik_basins_run(self):
         study = os.path.join(STUDIES, "arm7_ik_basins.toml")
