@@ -7,7 +7,7 @@ format_version 1 and 2: one group per run with a history, /histories/<zero-padde
 format_version 3: one row space shared by every history dataset. /histories/start, /rows, /layout
   (int64, indexed by run id): run i's arrays are rows [start[i], start[i] + rows[i]) of the datasets
   named in the group attribute layouts[layout[i]] (comma-separated); layout -1 = no history. A
-  dataset's `array` attribute names its array (`F.2` holds an array F of 2 columns).
+  dataset's `array` attribute names its array (`q.2` holds an array q of another column count or unit).
 
     h = Histories(f)                    # f: an open h5py.File
     h.has(3), h.names(3)                # ["t", "q", ...] in the run's order ([] without a history)
@@ -47,6 +47,8 @@ class Histories:
                                      f"unknown to this reader (it reads v1 to v{NEWEST_VERSION})")
         self.ragged = self.version in RAGGED_VERSIONS
         self.g = f["histories"] if "histories" in f else None
+        if self.ragged and self.g is not None and "layout" not in self.g:
+            self.g = None  # v3 without the index datasets: no run has a history
         self._layouts = None   # ragged: list of dataset-name lists, from the `layouts` attribute
         self._datasets = {}    # ragged: dataset name -> (array name, unit)
 
@@ -94,6 +96,10 @@ class Histories:
         out = []
         for name in self._layout(layout):
             ds = self.g[name]
+            if ds.ndim == 2 and ds.shape[1] == 0:  # an array of no columns: a fixed (0 x 0) dataset
+                array, unit = self._dataset(name)
+                out.append((array, np.zeros((rows, 0)), unit))
+                continue
             if start < 0 or start + rows > ds.shape[0]:
                 raise ValueError(f"{self.f.filename}: run {run_id}'s history rows [{start}, {start + rows}) "
                                  f"are outside /histories/{name} ({ds.shape[0]} rows)")

@@ -65,6 +65,7 @@ void ResultsWriter::Impl::open_histories() {
     d.name = n;
     d.dset = Hid(check(H5Dopen2(histories, n.c_str(), H5P_DEFAULT), path, "open /histories/" + n));
     d.array = read_str_attr(d.dset, "array");
+    d.unit = read_str_attr(d.dset, "unit");
     hsize_t dims[2] = {0, 0};
     H5Sget_simple_extent_dims(Hid(H5Dget_space(d.dset)), dims, nullptr);
     d.extent = dims[0];
@@ -126,21 +127,25 @@ void ResultsWriter::Impl::write_history(std::int64_t id, const EncodedHistory& g
     write_str_attr(h.rows, "description", "rows of the run's history");
     write_str_attr(h.layout, "description", "index into the attribute layouts of /histories (-1: none)");
   }
-  // The datasets of this run's arrays: by array name and column count.
+  // The datasets of this run's arrays: by array name, column count and unit (a trajectory's q in
+  // rad and a SCARA IK run's in rad, rad, mm are two datasets).
   std::vector<HistoryDataset*> targets;
   std::vector<std::string> dnames;
+  const auto taken = [&](const std::string& n) {
+    return std::any_of(h.datasets.begin(), h.datasets.end(), [&](const HistoryDataset& d) { return d.name == n; }) ||
+           n == "start" || n == "rows" || n == "layout";
+  };
   for (const auto& a : enc->arrays) {
     HistoryDataset* found = nullptr;
-    bool name_taken = false;
-    for (auto& d : h.datasets) {
-      if (d.array == a.name && d.cols == a.cols) found = &d;
-      name_taken = name_taken || d.name == a.name;
-    }
+    for (auto& d : h.datasets)
+      if (d.array == a.name && d.cols == a.cols && d.unit == a.unit) found = &d;
     if (!found) {
       HistoryDataset d;
       d.array = a.name;
       d.cols = a.cols;
-      d.name = name_taken ? a.name + "." + std::to_string(a.cols) : a.name;
+      d.unit = a.unit;
+      d.name = a.name;
+      for (int k = 2; taken(d.name); ++k) d.name = a.name + "." + std::to_string(k);
       hsize_t dims[2] = {0, a.cols}, maxdims[2] = {H5S_UNLIMITED, a.cols};
       Hid space(H5Screate_simple(2, dims, a.cols > 0 ? maxdims : nullptr));
       Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));

@@ -36,7 +36,7 @@ struct ResultsWriter::Impl {
   std::vector<LandscapeStream> landscape_streams;
   /// The histories' shared row space (writer_histories.cpp, FORMAT.md: /histories).
   struct HistoryDataset {
-    std::string name, array;  ///< dataset name (the array name, or "<array>.<cols>") and array name
+    std::string name, array, unit;  ///< dataset name (the array name, or "<array>.<n>"), array name, unit
     std::size_t cols = 1;
     detail::Hid dset;
     hsize_t extent = 0;       ///< rows of the dataset's current extent (>= used_rows once written)

@@ -11,7 +11,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
-from kshistory import Histories  # noqa: E402  the /histories layouts (format_version 1 to 3)
+from kshistory import Histories, group_name  # noqa: E402  the /histories layouts (format_version 1 to 3)
 
 # A trajectory landscape (561 runs) and an IK basin (441 runs): about a second on 2 cores.
 SWEEP = """
@@ -104,12 +104,22 @@ def same_tables(a, b):
 
 
 def make_v1(src, dst):
-    """A format_version 1 copy of a results file: no role / kinds attributes on /runs, version 1."""
+    """A format_version 1 copy of a results file: no role / kinds attributes on /runs, histories in
+    the group layout (one group per run), version 1."""
     shutil.copyfile(src, dst)
     with h5py.File(dst, "r+") as f:
         for k in f["runs"]:
             for a in ("role", "kinds"):
                 del f["runs"][k].attrs[a]
+        hist = list(Histories(f).items())
+        n = len(f["runs"]["done"])
+        del f["histories"]
+        g = f.create_group("histories")
+        for run_id, arrays in hist:
+            r = g.create_group(group_name(run_id, n))
+            r.attrs["arrays"] = [name for name, _, _ in arrays]
+            for name, a, unit in arrays:
+                r.create_dataset(name, data=a).attrs["unit"] = unit
         f.attrs.modify("format_version", np.int64(1))
 
 
