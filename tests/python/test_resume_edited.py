@@ -4,7 +4,7 @@ computed, and the file comes out equal to a fresh run of the edited study (the o
 wall_time, every history and every landscape compared bit for bit with h5py). A change of the robot,
 the task or the settings is refused with the old file left byte for byte as it was.
 
-usage: /usr/bin/python3 test_resume_edited.py KINESWEEP_BINARY
+usage: /usr/bin/python3 test_resume_edited.py KINESWEEP_BINARY ROBOTS_DIR (studies/robots)
 """
 import hashlib
 import os
@@ -20,7 +20,7 @@ import numpy as np
 
 from e2e_common import TempDirTest, bitwise_equal, runs_table, same_tables
 
-KS = None
+KS = ROBOTS = None
 
 # 15 trajectory runs (histories every 50th sample) and 15 IK runs: well under a second.
 BASE = """[study]
@@ -282,6 +282,66 @@ k = { from = 0, to = 1, count = 10 }
         self.assertEqual([n for n in os.listdir(self.dir) if ".tmp-" in n], [])
 
 
+URDF_STUDY = """[study]
+name = "urdf"
+histories = "full"
+
+[robot]
+urdf = "robot.urdf"
+base = "base_link"
+tip = "tool"
+
+[[block]]
+name = "position"
+kind = "ik"
+problem = "position"
+method = "lm"
+[block.axes]
+q0_1 = [0, 30, 60]
+q0_2 = [10, 20]
+"""
+
+
+class ResumeEditedUrdf(TempDirTest):
+    """A URDF robot: what counts is the chain the file gives, not its text."""
+
+    def setUp(self):
+        super().setUp()
+        with open(os.path.join(ROBOTS, "planar4r.urdf")) as f:
+            self.urdf = f.read()
+        self.study = self.write("s.toml", URDF_STUDY)
+        self.write("robot.urdf", self.urdf)
+        self.out = os.path.join(self.dir, "s.h5")
+        r = run("run", self.study, "-o", self.out, "-q")
+        self.assertEqual(r.returncode, 0, r.stderr)
+
+    def test_urdf_comment_and_new_axis_values_reuse_the_runs(self):
+        self.write("robot.urdf", self.urdf.replace("<link name=\"tool\"/>", "<!-- the tool --><link name=\"tool\"/>"))
+        edited = self.write("s.toml", URDF_STUDY.replace("q0_2 = [10, 20]", "q0_2 = [10, 20, 40]"))
+        r = run("run", edited, "-o", self.out, "-q", "--resume")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(computed(r.stdout), (3, 6))
+        ref = os.path.join(self.dir, "ref.h5")
+        self.assertEqual(run("run", edited, "-o", ref, "-q").returncode, 0)
+        self.assertTrue(same_tables(runs_table(self.out), runs_table(ref)))
+        got, want = datasets(self.out, "histories"), datasets(ref, "histories")
+        self.assertEqual(sorted(got), sorted(want))
+        for k in want:
+            self.assertTrue(bitwise_equal(got[k], want[k]), k)
+        with h5py.File(self.out, "r") as f:  # the edited URDF text is the one stored
+            self.assertIn("the tool", f["study/robot"][()].decode())
+
+    def test_urdf_mass_changed_is_refused(self):
+        before = file_sha(self.out)
+        self.write("robot.urdf", self.urdf.replace('<mass value="3.2"/>', '<mass value="3.3"/>'))
+        self.write("s.toml", "# edited\n" + URDF_STUDY)
+        r = run("run", self.study, "-o", self.out, "-q", "--resume")
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn("the robot changed: [robot] joint 3 mass: 3.2 -> 3.3", r.stderr)
+        self.assertEqual(file_sha(self.out), before)
+
+
 if __name__ == "__main__":
     KS = sys.argv.pop(1)
+    ROBOTS = sys.argv.pop(1)
     unittest.main()
