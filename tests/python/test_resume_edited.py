@@ -259,7 +259,10 @@ k = { from = 0, to = 1, count = 10 }
         time.sleep(0.2)
         p.send_signal(signal.SIGKILL)
         p.wait()
-        self.assertEqual(file_sha(out), file_sha(old))
+        if file_sha(out) != file_sha(old):  # it finished before the kill: then it is the complete file
+            self.assert_equal_to_fresh(out, edited)
+            self.skipTest("finished before the kill")
+        self.assertTrue(any(".tmp-" in n for n in os.listdir(self.dir)))  # killed mid-way: its staged file
         r = run("run", study, "-o", out, "-q", "--resume")
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertEqual(computed(r.stdout), (2000, 30))
