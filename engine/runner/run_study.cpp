@@ -7,6 +7,7 @@
 
 #include "common/shell_word.hpp"
 #include "runner/optimize_blocks.hpp"
+#include "runner/resume_edited.hpp"
 #include "runner/sweep_backend.hpp"
 
 namespace ks {
@@ -111,17 +112,31 @@ class LocalBackend final : public SweepBackend {
     }
     store::StoreOptions so;  // commits every second (see StoreOptions)
     so.overwrite = r.overwrite;
+    if (r.resume && exists && holds_edited_study(out, study)) {  // a new file, replacing `out` when complete
+      EditedResumeOptions eo;
+      eo.histories = r.options.histories;
+      eo.compression = r.options.compression;
+      eo.store = so;
+      edited_ = begin_edited_resume(study, schema, out, eo);
+      writer_ = std::move(edited_->writer);
+      previous_ = std::move(edited_->previous);
+      return 0;
+    }
     OpenedResults o = open_results(study, schema, out, r.resume, so);
     writer_ = std::move(o.writer);
     previous_ = std::move(o.previous);
     return 0;
   }
 
-  SweepResult sweep(const Study& study, const StudySchema& schema, const RunRequest& r, std::ostream&,
+  SweepResult sweep(const Study& study, const StudySchema& schema, const RunRequest& r, std::ostream& out,
                     std::ostream&) override {
     SweepResult res;
     SweepOptions o = r.options;
     if (r.quiet) o.on_progress = nullptr;
+    if (edited_)
+      out << "the study differs from the one in " << r.output << ": " << edited_->reused << " of its "
+          << edited_->old_done << " done runs are runs of this study and are reused; a new file replaces it when "
+          << "complete\n" << std::flush;
     res.report = run_sweep(study, schema, *writer_, o, previous_ ? &*previous_ : nullptr);
     previous_.reset();
     res.code = res.report.interrupted ? 130 : 0;
@@ -130,12 +145,30 @@ class LocalBackend final : public SweepBackend {
   }
 
   std::string kept_in(const RunRequest& r) const override { return r.output; }
+  std::string kept(const RunRequest& r, const std::string& done) const override {
+    if (!edited_) return SweepBackend::kept(r, done);
+    return r.output + " is unchanged: the new file of the edited study (" + done +
+           ") would replace it only once complete, and is deleted";
+  }
   std::string resume_command(const RunRequest& r) const override {
     return r.program + " run " + shell_word(r.study_arg) + " -o " + shell_word(r.output) + " --resume";
   }
-  int finish(int code) override { return code; }
+  void publish(const RunRequest& r) override {
+    if (!edited_) return;
+    store::replace_results_file(edited_->staging, r.output);
+    edited_.reset();
+  }
+  int finish(int code) override {
+    if (edited_) {  // ended early: the old file stays as it was
+      writer_.reset();
+      store::remove_results_file(edited_->staging);
+      edited_.reset();
+    }
+    return code;
+  }
 
  private:
+  std::optional<EditedResume> edited_;  // a resume of an edited study: the new file, beside the old one
   std::optional<PreviousRuns> previous_;
   std::unique_ptr<store::ResultsWriter> writer_;
 };
@@ -146,16 +179,16 @@ int conclude(const Study& study, const RunRequest& r, SweepBackend& backend, Swe
   if (res.code != 0) {
     if (res.writer) res.writer->close();
     if (res.code == 130) print_report(out, study, report);
-    out << (res.code == 130 ? "interrupted" : "failed") << ": " << report.written + report.skipped << " of "
-        << report.total << " runs are kept in " << backend.kept_in(r) << "\nresume with: " << backend.resume_command(r)
-        << '\n';
+    out << (res.code == 130 ? "interrupted" : "failed") << ": "
+        << backend.kept(r, std::to_string(report.written + report.skipped) + " of " + std::to_string(report.total) + " runs")
+        << "\nresume with: " << backend.resume_command(r) << '\n';
     return res.code;
   }
   print_report(out, study, report);
   if (!study.optimizations.empty()) {
     std::optional<store::ResultsReader> cells;  // the landscape cells for polish_from, as just written
     try {
-      cells.emplace(r.output);
+      cells.emplace(res.writer->path());
     } catch (const store::StoreError&) {
     }
     OptimizeRunOptions oo;
@@ -167,13 +200,16 @@ int conclude(const Study& study, const RunRequest& r, SweepBackend& backend, Swe
     if (partial || done.size() < study.optimizations.size()) {
       res.writer->close();
       const std::size_t complete = done.size() - (partial ? 1 : 0);
-      out << "interrupted: the sweep's " << report.total << " runs, " << complete << " of "
-          << study.optimizations.size() << " optimisation blocks" << (partial ? " and the evaluations of the next" : "")
-          << " are kept in " << backend.kept_in(r) << "\nresume with: " << backend.resume_command(r) << '\n';
+      out << "interrupted: "
+          << backend.kept(r, "the sweep's " + std::to_string(report.total) + " runs, " + std::to_string(complete) +
+                                 " of " + std::to_string(study.optimizations.size()) + " optimisation blocks" +
+                                 (partial ? " and the evaluations of the next" : ""))
+          << "\nresume with: " << backend.resume_command(r) << '\n';
       return 130;
     }
   }
   res.writer->close();
+  backend.publish(r);
   out << "results: " << r.output << '\n' << std::flush;
   return 0;
 }

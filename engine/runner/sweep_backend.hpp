@@ -32,6 +32,13 @@ class SweepBackend {
   virtual int threads(const RunRequest& request) const { return request.options.threads; }
   /// Where an interrupted sweep keeps its runs, and the command that resumes it.
   virtual std::string kept_in(const RunRequest& request) const = 0;
+  /// What an early end keeps, given what is done (`done`: "N of M runs"): "N of M runs are kept in F".
+  virtual std::string kept(const RunRequest& request, const std::string& done) const {
+    return done + " are kept in " + kept_in(request);
+  }
+  /// The leader, once the final file is complete and closed: put it in place (a resume of an edited
+  /// study builds it beside the file it replaces). May throw store::StoreError.
+  virtual void publish(const RunRequest&) {}
   virtual std::string resume_command(const RunRequest& request) const = 0;
   /// The exit code every process returns, given the leader's `code` (MPI: broadcast, finalise).
   virtual int finish(int code) = 0;

@@ -297,6 +297,21 @@ class ResultsReader {
   std::unique_ptr<Impl> impl_;
 };
 
+// ------------------------------------------------------------------------------------------------
+// A results file built beside the one it replaces (resume of an edited study, FORMAT.md "Creation,
+// overwrite, resume").
+
+/// A path beside `path` to build its replacement under: `.<name>.tmp-<pid>-staged-<n>.h5`, a name the
+/// store deletes (with its journal) as an orphan once process <pid> is gone. Deletes such orphans of
+/// killed processes first.
+std::string staging_path(const std::string& path);
+/// Replace the results file `path` by the closed results file `from` (an atomic rename), holding
+/// `path`'s writer lock meanwhile (a live writer of `path` refuses it: StoreError, both files kept)
+/// and deleting the journal a crashed writer of `path` left. Throws StoreError.
+void replace_results_file(const std::string& from, const std::string& path, const StoreOptions& options = {});
+/// Delete a closed results file and its journal (a staged file given up). Errors are ignored.
+void remove_results_file(const std::string& path);
+
 /// Name of run `run_id`'s group under /histories in format 2 files ("000123"; wider when n_runs needs it).
 std::string history_group_name(std::int64_t run_id, std::int64_t n_runs);
 

@@ -182,14 +182,18 @@ void Parser::parse_urdf_robot(const toml::table& t, Study& s) {
   std::filesystem::path path(*file);
   if (path.is_relative() && !file_.empty() && file_.front() != '<')
     path = std::filesystem::path(file_).parent_path() / path;
-  std::ifstream in(path, std::ios::binary);
-  if (!in || std::filesystem::is_directory(path)) {
-    error(at, "cannot read the URDF file '" + path.string() + "'; expected a readable URDF file (relative paths start "
-              "at the study file's folder)");
-    return;
-  }
   std::ostringstream text;
-  text << in.rdbuf();
+  if (options_.robot_text) {
+    text << *options_.robot_text;
+  } else {
+    std::ifstream in(path, std::ios::binary);
+    if (!in || std::filesystem::is_directory(path)) {
+      error(at, "cannot read the URDF file '" + path.string() + "'; expected a readable URDF file (relative paths "
+                "start at the study file's folder)");
+      return;
+    }
+    text << in.rdbuf();
+  }
   try {
     // gravity: as given; else the seed's -y when the chain moves in the base xy plane, else -z
     Chain c = parse_urdf(text.str(), *base, *tip, gravity.value_or(Eigen::Vector3d(0, -9.81, 0)), path.string());

@@ -150,6 +150,9 @@ struct Study {
 struct StudyOptions {
   /// Total runs allowed (kinesweep run --max-runs); a [study] max_runs key may only lower it.
   std::uint64_t max_runs = 50'000'000;
+  /// The text of the URDF file the study names, used instead of reading that file (a study stored
+  /// in a results file is parsed again with the robot stored with it). Unset: the file is read.
+  std::optional<std::string> robot_text;
 };
 
 /// Parse a study from text. `file` names it in diagnostics. Throws StudyError.

@@ -236,9 +236,12 @@ class CrashAndResume(Base):
         study = self.write("ok.toml", SWEEP)
         out = os.path.join(self.dir, "r.h5")
         self.assertEqual(run("run", study, "-o", out, "-q").returncode, 0)
-        other = self.write("other.toml", SWEEP.replace("count = 11", "count = 12"))
+        # another robot: none of the file's runs is a run of this study (an edit that keeps the robot,
+        # task and settings reuses the file's runs instead: test_resume_edited.py)
+        other = self.write("other.toml", SWEEP + "\n[robot]\nm = [5.0, 2.0, 1.5]\n")
         r = run("run", other, "-o", out, "--resume", "-q")
-        self.assertNotEqual(r.returncode, 0)
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn("the robot changed", r.stderr)
 
 
 class ShippedStudies(Base):

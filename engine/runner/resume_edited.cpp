@@ -1,0 +1,176 @@
+// Resume of an edited study into a new file (see resume_edited.hpp).
+#include "runner/resume_edited.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <limits>
+
+#include "runner/run_identity.hpp"
+#include "runner/run_study.hpp"
+
+namespace ks {
+
+namespace {
+
+constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+[[noreturn]] void refuse(const std::string& out, const std::string& why) {
+  throw store::StoreError(out, why + "; refusing to resume: rerun with --overwrite");
+}
+
+/// The study stored in a results file, parsed again with the URDF text stored with it.
+Study stored_study(const store::ResultsReader& file, const std::string& out) {
+  const store::StoreMeta& meta = file.meta();
+  StudyOptions so;
+  so.max_runs = std::max<std::uint64_t>(so.max_runs, static_cast<std::uint64_t>(file.n_runs()));
+  so.robot_text = meta.robot_text;
+  try {
+    return parse_study(meta.study_text, meta.study_path.empty() ? "<stored study>" : meta.study_path, so);
+  } catch (const StudyError& e) {
+    refuse(out, "the study stored in the file cannot be read by this kinesweep (" +
+                    (e.diagnostics().empty() ? std::string(e.what()) : e.diagnostics().front().headline()) + ")");
+  }
+}
+
+/// Per block of `study`: the file column of each of its parameters (by name and type).
+std::vector<std::vector<std::size_t>> parameter_columns(const Study& study, const std::vector<ColumnSpec>& file,
+                                                        const std::string& out) {
+  std::vector<std::vector<std::size_t>> cols;
+  for (const Block& b : study.blocks) {
+    std::vector<std::size_t> c;
+    for (const ColumnSpec& p : b.columns()) {
+      std::size_t at = npos;
+      for (std::size_t i = 0; i < file.size(); ++i)
+        if (file[i].name == p.name && file[i].type == p.type) at = i;
+      if (at == npos)
+        refuse(out, "its /runs has no column '" + p.name + "' of the right type for block '" + b.name() +
+                        "' of its study (written by another kinesweep)");
+      c.push_back(at);
+    }
+    cols.push_back(std::move(c));
+  }
+  return cols;
+}
+
+using Entry = std::pair<Digest, std::int64_t>;  // identity, run id in the old file
+
+/// The identities of the done runs of the old file, sorted (the first run id of equal identities).
+std::vector<Entry> done_identities(const store::ResultsReader& file, const Study& before, const Digest& context,
+                                   const std::string& out, std::uint64_t& done) {
+  const auto cols = parameter_columns(before, file.columns(), out);
+  std::vector<BlockIdentity> ids;
+  for (const Block& b : before.blocks) ids.emplace_back(context, b);
+  constexpr std::int64_t kPiece = 8192;  // rows read at a time: memory bounded whatever the run count
+  std::vector<Entry> entries;
+  for (std::int64_t first = 0; first < file.n_runs(); first += kPiece) {
+    const std::vector<std::uint8_t> mask = file.done_mask(first, kPiece);
+    if (std::none_of(mask.begin(), mask.end(), [](auto d) { return d != 0; })) continue;
+    const std::vector<Record> rows = file.read_rows(first, kPiece);
+    for (std::size_t i = 0; i < mask.size() && i < rows.size(); ++i) {
+      if (!mask[i]) continue;
+      const std::int64_t id = first + static_cast<std::int64_t>(i);
+      const RunRef ref = before.locate(static_cast<std::uint64_t>(id));
+      entries.emplace_back(ids[ref.block].row(rows[i], cols[ref.block]), id);
+    }
+  }
+  done = entries.size();
+  std::stable_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.first < b.first; });
+  return entries;
+}
+
+/// Copies the old file's runs `pairs` (new run id, old run id; ascending new ids) into `writer`:
+/// each row with the edited study's run id and block (the other cells by column name), and its
+/// history. Rows are read in pieces.
+void copy_runs(const store::ResultsReader& file, const Study& study, const StudySchema& schema,
+               const std::vector<std::pair<std::uint64_t, std::int64_t>>& pairs, int compression,
+               store::ResultsWriter& writer) {
+  std::vector<std::size_t> from(schema.columns.size(), npos);  // new column -> old column
+  for (std::size_t c = 0; c < schema.columns.size(); ++c)
+    for (std::size_t o = 0; o < file.columns().size(); ++o)
+      if (file.columns()[o].name == schema.columns[c].name && file.columns()[o].type == schema.columns[c].type)
+        from[c] = o;
+  constexpr std::size_t kPiece = 4096;
+  for (std::size_t first = 0; first < pairs.size(); first += kPiece) {
+    const std::size_t n = std::min(kPiece, pairs.size() - first);
+    std::vector<std::int64_t> ids;
+    for (std::size_t i = 0; i < n; ++i) ids.push_back(pairs[first + i].second);
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    const std::vector<Record> rows = file.read_rows(ids);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto [id, old] = pairs[first + i];
+      const Record& row = rows[static_cast<std::size_t>(std::lower_bound(ids.begin(), ids.end(), old) - ids.begin())];
+      Record rec = schema.blank;
+      for (std::size_t c = 0; c < rec.cells.size(); ++c)
+        if (from[c] != npos) rec.cells[c] = row.cells[from[c]];
+      rec.cells[schema.run_id] = static_cast<std::int64_t>(id);
+      rec.cells[schema.block] = study.blocks[study.locate(id).block].name();
+      // the stored chunks, copied as they are (a format 2 file's histories are encoded at `compression`)
+      writer.write_run(static_cast<std::int64_t>(id), rec, file.read_history_chunks(old, compression));
+    }
+  }
+  writer.flush();
+}
+
+}  // namespace
+
+bool holds_edited_study(const std::string& out, const Study& study) {
+  try {
+    const store::ResultsReader file(out);
+    return lower(file.meta().study_sha256) != lower(study.sha256);
+  } catch (const store::StoreError&) {
+    return false;
+  }
+}
+
+EditedResume begin_edited_resume(const Study& study, const StudySchema& schema, const std::string& out,
+                                 const EditedResumeOptions& options) {
+  const store::ResultsReader file(out);
+  store::require_resumable(out, file.meta());
+  const Study before = stored_study(file, out);
+  const auto was = run_context(before, before.histories, file.meta().engine_version);
+  const auto now = run_context(study, options.histories);
+  if (const std::string what = context_changes(was, now); !what.empty()) refuse(out, what);
+  if (file.n_runs() != static_cast<std::int64_t>(before.run_count()))
+    refuse(out, "the file has " + std::to_string(file.n_runs()) + " runs, its study " +
+                    std::to_string(before.run_count()));
+  const Digest context = context_digest(now);
+
+  EditedResume r;
+  const std::vector<Entry> old = done_identities(file, before, context, out, r.old_done);
+  std::vector<std::pair<std::uint64_t, std::int64_t>> pairs;  // new run id, old run id
+  std::uint64_t id = 0;
+  for (const Block& b : study.blocks) {
+    const BlockIdentity ids(context, b);
+    for (std::uint64_t local = 0; local < b.run_count(); ++local, ++id) {
+      const Entry key{ids.run(local), 0};
+      const auto it = std::lower_bound(old.begin(), old.end(), key,
+                                       [](const Entry& a, const Entry& b) { return a.first < b.first; });
+      if (it != old.end() && it->first == key.first) pairs.emplace_back(id, it->second);
+    }
+  }
+
+  r.staging = store::staging_path(out);
+  store::StoreOptions so = options.store;
+  so.overwrite = false;
+  r.writer = store::ResultsWriter::create(r.staging, store_meta(study), schema.columns,
+                                          static_cast<std::int64_t>(study.run_count()), so);
+  try {
+    copy_runs(file, study, schema, pairs, options.compression, *r.writer);
+  } catch (...) {
+    r.writer.reset();
+    store::remove_results_file(r.staging);
+    throw;
+  }
+  r.previous.done.assign(study.run_count(), 0);
+  for (const auto& [n, o] : pairs) r.previous.done[n] = 1;
+  r.reused = pairs.size();
+  return r;
+}
+
+}  // namespace ks
