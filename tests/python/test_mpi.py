@@ -141,7 +141,17 @@ class KillOneRank(Base):
                 break
             time.sleep(0.05)
         self.assertIsNotNone(victim, "rank 1 not found")
-        time.sleep(1.5)  # let it commit some runs (shards commit every 512 runs or 2 s)
+        # let rank 1 commit some runs (shards commit every 512 runs or 2 s): wait until its shard
+        # shows done runs (a read that meets a commit under way raises or is retried)
+        deadline = time.time() + 120
+        while time.time() < deadline and p.poll() is None:
+            try:
+                with h5py.File(out + ".rank1.h5", "r") as f:
+                    if int(f["runs"]["done"][()].sum()) > 0:
+                        break
+            except (OSError, KeyError):
+                pass
+            time.sleep(0.1)
         self.assertIsNone(p.poll(), "the job finished before the kill: make LONG longer")
         os.kill(victim, signal.SIGKILL)
         try:
