@@ -234,6 +234,60 @@ TEST(Store, ResumeFillsGapsAndEqualsUninterruptedRun) {
   for (std::int64_t id = 0; id < n; ++id) expect_same_history(b.read_history(id), a.read_history(id), id);
 }
 
+// The writer's done flags (one bit per run) against the runs written, at the edges of 64-run words
+// and of the 65536-run pieces in which a resume reads /runs/done, before and after a resume.
+TEST(Store, IsDoneMatchesTheWrittenRunsAtWordAndPieceEdges) {
+  TempDir td;
+  const std::string path = td.file("bits.h5");
+  const std::int64_t n = 65536 + 130;  // two resume pieces, the last word partly used
+  std::vector<bool> want(static_cast<std::size_t>(n), false);
+  std::vector<std::int64_t> ids = {0, 62, 63, 64, 127, 128, 65535, 65536, 65537, n - 1};
+  for (std::int64_t id = 5; id < n; id += 97) ids.push_back(id);
+  auto expect_flags = [&](const ResultsWriter& w, const char* when) {
+    EXPECT_FALSE(w.is_done(-1)) << when;
+    EXPECT_FALSE(w.is_done(n)) << when;
+    std::int64_t wrong = 0, first_wrong = -1;
+    for (std::int64_t id = 0; id < n; ++id)
+      if (w.is_done(id) != want[static_cast<std::size_t>(id)] && wrong++ == 0) first_wrong = id;
+    EXPECT_EQ(wrong, 0) << when << ": first wrong run " << first_wrong;
+  };
+  StoreOptions opt;
+  opt.flush_every_runs = 500;  // commits while writing, as a sweep does
+  {
+    auto w = ResultsWriter::create(path, test_meta(), test_columns(), n, opt);
+    expect_flags(*w, "new file");
+    for (std::int64_t id : ids) {
+      w->write_run(id, test_record(id));
+      want[static_cast<std::size_t>(id)] = true;
+    }
+    w->write_run(64, test_record(64));  // written again: still done, its neighbours untouched
+    expect_flags(*w, "after write_run");
+    w->close();
+  }
+  {
+    auto res = ResultsWriter::open_for_resume(path, test_meta().study_sha256, opt);
+    ASSERT_EQ(res.writer->n_runs(), n);
+    expect_flags(*res.writer, "after resume");
+    for (std::int64_t id : {std::int64_t{1}, std::int64_t{65}, std::int64_t{65534}, n - 2}) {
+      res.writer->write_run(id, test_record(id));
+      want[static_cast<std::size_t>(id)] = true;
+    }
+    expect_flags(*res.writer, "after resume and write_run");
+    res.writer->close();
+  }
+  ResultsReader r(path);
+  const auto mask = r.done_mask();
+  ASSERT_EQ(static_cast<std::int64_t>(mask.size()), n);
+  for (std::int64_t id = 0; id < n; ++id)
+    ASSERT_EQ(mask[static_cast<std::size_t>(id)] != 0, want[static_cast<std::size_t>(id)]) << "run " << id;
+  // a file of no runs
+  const std::string empty = td.file("empty.h5");
+  ResultsWriter::create(empty, test_meta(), test_columns(), 0)->close();
+  auto res = ResultsWriter::open_for_resume(empty, test_meta().study_sha256);
+  EXPECT_EQ(res.writer->n_runs(), 0);
+  EXPECT_FALSE(res.writer->is_done(0));
+}
+
 TEST(Store, SecondWriterIsRefusedWhileOneIsOpen) {
   TempDir td;
   const std::string path = td.file("busy.h5");

@@ -246,7 +246,7 @@ std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, co
   auto impl = open_writer_impl(path, options);
   impl->columns = columns;
   impl->n_runs = n_runs;
-  impl->done.assign(static_cast<std::size_t>(n_runs), 0);
+  impl->done.assign(static_cast<std::size_t>(n_runs), false);
   impl->open_objects();
   return std::unique_ptr<ResultsWriter>(new ResultsWriter(std::move(impl)));
 }
@@ -266,7 +266,7 @@ const std::string& ResultsWriter::path() const { return impl_->path; }
 const std::vector<ColumnSpec>& ResultsWriter::columns() const { return impl_->columns; }
 std::int64_t ResultsWriter::n_runs() const { return impl_->n_runs; }
 bool ResultsWriter::is_done(std::int64_t id) const {
-  return id >= 0 && id < impl_->n_runs && impl_->done[static_cast<std::size_t>(id)] != 0;
+  return id >= 0 && id < impl_->n_runs && impl_->done[static_cast<std::size_t>(id)];
 }
 std::size_t ResultsWriter::pending() const { return impl_->pending.size() + impl_->unflagged.size(); }
 
@@ -306,7 +306,7 @@ void ResultsWriter::write_run(std::int64_t run_id, const Record& record, const E
   }
   if (!history.arrays.empty()) m.write_history(run_id, history);
   m.pending[run_id] = record;
-  m.done[static_cast<std::size_t>(run_id)] = 1;
+  m.done[static_cast<std::size_t>(run_id)] = true;
   // rows go to the datasets in batches as they come (uncommitted, invisible until the next commit),
   // so that the commit at the end of a sweep, which nothing overlaps, has little left to write
   if (m.pending.size() >= Impl::kRowBatch) m.write_rows();

@@ -20,7 +20,7 @@ struct ResultsWriter::Impl {
   std::int64_t n_runs = 0;
   detail::Hid file, runs, histories, landscapes, done_dset;
   std::vector<detail::Hid> col_dsets;
-  std::vector<std::uint8_t> done;       // committed or pending
+  std::vector<bool> done;                   // per run, one bit: committed or pending
   std::map<std::int64_t, Record> pending;   // rows not yet in the datasets
   std::vector<hsize_t> unflagged;           // rows in the datasets, not yet committed with done = 1
   /// A landscape whose cells are streamed in (writer_landscapes.cpp): its metric datasets and the
