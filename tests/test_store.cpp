@@ -216,9 +216,7 @@ TEST(Store, ResumeFillsGapsAndEqualsUninterruptedRun) {
   }
   {
     auto res = ResultsWriter::open_for_resume(part, test_meta().study_sha256);
-    std::vector<std::int64_t> want;
-    for (std::int64_t id = 0; id < n; id += 3) want.push_back(id);
-    EXPECT_EQ(res.done, want);
+    for (std::int64_t id = 0; id < n; ++id) EXPECT_EQ(res.writer->is_done(id), id % 3 == 0) << id;
     EXPECT_EQ(res.writer->columns().size(), test_columns().size());
     for (std::int64_t id = n - 1; id >= 0; --id)
       if (!res.writer->is_done(id)) res.writer->write_run(id, test_record(id), test_history(id));

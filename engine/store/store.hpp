@@ -207,8 +207,7 @@ class ResultsWriter {
 };
 
 struct ResultsWriter::Resumed {
-  std::unique_ptr<ResultsWriter> writer;
-  std::vector<std::int64_t> done;  ///< run ids already done, ascending
+  std::unique_ptr<ResultsWriter> writer;  ///< the runs already done: writer->is_done(id)
 };
 
 // ------------------------------------------------------------------------------------------------

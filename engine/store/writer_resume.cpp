@@ -97,8 +97,6 @@ ResultsWriter::Resumed ResultsWriter::open_for_resume(const std::string& path, c
     }
   }
   Resumed r;
-  for (std::int64_t i = 0; i < impl->n_runs; ++i)
-    if (impl->done[static_cast<std::size_t>(i)]) r.done.push_back(i);
   r.writer = std::unique_ptr<ResultsWriter>(new ResultsWriter(std::move(impl)));
   return r;
 }
