@@ -232,6 +232,47 @@ TEST(Store, ResumeFillsGapsAndEqualsUninterruptedRun) {
   for (std::int64_t id = 0; id < n; ++id) expect_same_history(b.read_history(id), a.read_history(id), id);
 }
 
+// Rows and landscape cells written since the last commit are held in memory (the journal's pages)
+// until the commit, so the writer commits once they reach a few MiB even when neither
+// flush_every_runs nor flush_every_seconds asks for a commit.
+TEST(Store, CommitsOnceTheUncommittedRowsReachAFewMiB) {
+  TempDir td;
+  const std::string path = td.file("bound.h5");
+  StoreOptions opt;
+  opt.flush_every_runs = 0;
+  opt.flush_every_seconds = 0;
+  const std::int64_t n = 20000;
+  LandscapeSpec spec;  // 64 metrics: 512 bytes of cells per run, 10 MB for all runs
+  spec.block = "b";
+  spec.axes.push_back({"i", "", {}});
+  for (std::int64_t i = 0; i < n; ++i) spec.axes[0].values.push_back(static_cast<double>(i));
+  for (int m = 0; m < 64; ++m) spec.metrics.push_back({"m" + std::to_string(m), "", "", {}});
+  std::vector<double> cell(64);
+  auto w = make_writer(path, n, opt);
+  const std::size_t grid = w->begin_landscape(spec);
+  for (std::int64_t id = 0; id < n; ++id) {
+    w->write_run(id, test_record(id));
+    for (int m = 0; m < 64; ++m) cell[static_cast<std::size_t>(m)] = static_cast<double>(id * 64 + m);
+    w->write_landscape_cell(grid, static_cast<std::uint64_t>(id), cell.data());
+  }
+  EXPECT_LT(w->pending(), static_cast<std::size_t>(n) / 2);  // 4 MiB: about 7400 runs of 569 bytes
+  {
+    ResultsReader r(path);  // the writer is still open: what the automatic commits committed
+    const auto d = r.done_mask();
+    EXPECT_EQ(std::count(d.begin(), d.end(), 1), n - static_cast<std::int64_t>(w->pending()));
+  }
+  w->close();
+  ResultsReader r(path);
+  const auto d = r.done_mask();
+  EXPECT_EQ(std::count(d.begin(), d.end(), 1), n);
+  const LandscapeSpec got = r.read_landscape("b");
+  ASSERT_EQ(got.metrics.size(), 64u);
+  for (int m : {0, 63})
+    for (std::int64_t id : {std::int64_t{0}, std::int64_t{7777}, n - 1})
+      EXPECT_EQ(got.metrics[static_cast<std::size_t>(m)].grid[static_cast<std::size_t>(id)],
+                static_cast<double>(id * 64 + m));
+}
+
 // The writer's done flags (one bit per run) against the runs written, at the edges of 64-run words
 // and of the 65536-run pieces in which a resume reads /runs/done, before and after a resume.
 TEST(Store, IsDoneMatchesTheWrittenRunsAtWordAndPieceEdges) {

@@ -311,10 +311,11 @@ void ResultsWriter::write_run(std::int64_t run_id, const Record& record, const E
   // so that the commit at the end of a sweep, which nothing overlaps, has little left to write
   if (m.pending.size() >= Impl::kRowBatch) m.write_rows();
   const bool by_count = m.opt.flush_every_runs > 0 && m.pending.size() + m.unflagged.size() >= m.opt.flush_every_runs;
+  const bool by_bytes = m.uncommitted_bytes >= Impl::kMaxUncommittedBytes;
   const bool by_time =
       m.opt.flush_every_seconds > 0 &&
       std::chrono::duration<double>(std::chrono::steady_clock::now() - m.last_flush).count() >= m.opt.flush_every_seconds;
-  if (by_count || by_time) m.do_flush();
+  if (by_count || by_bytes || by_time) m.do_flush();
 }
 
 namespace {
@@ -373,6 +374,9 @@ void ResultsWriter::Impl::write_rows() {
     }
     if (rc < 0) fail("cannot write column " + columns[c].name);
   }
+  std::size_t row_bytes = 1;  // the done flag, written at the commit
+  for (const ColumnSpec& c : columns) row_bytes += c.type == CellType::str ? 16 : 8;  // a string: its heap reference
+  uncommitted_bytes += ids.size() * row_bytes;
   unflagged.insert(unflagged.end(), ids.begin(), ids.end());
   pending.clear();
 }
@@ -395,6 +399,7 @@ void ResultsWriter::Impl::do_flush() {
     unflagged.clear();
   }
   if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) fail("flush (commit) failed");
+  uncommitted_bytes = 0;
   last_flush = std::chrono::steady_clock::now();
 }
 

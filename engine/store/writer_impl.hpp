@@ -34,6 +34,12 @@ struct ResultsWriter::Impl {
   };
   std::vector<LandscapeStream> landscape_streams;
   static constexpr std::size_t kRowBatch = 512;
+  /// Bytes of rows, done flags and landscape cells written into their datasets since the last commit.
+  /// Those datasets lie in the committed part of the file, so until the commit the journal holds
+  /// these bytes' pages in memory: write_run commits once they reach kMaxUncommittedBytes, whatever
+  /// the runs' pace (a fast sweep would otherwise hold flush_every_runs rows' pages, ~20 MB).
+  std::size_t uncommitted_bytes = 0;
+  static constexpr std::size_t kMaxUncommittedBytes = std::size_t{4} << 20;
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false, broken = false;
 

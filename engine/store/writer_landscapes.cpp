@@ -180,6 +180,7 @@ void ResultsWriter::Impl::write_landscape_cells() {
         i = j;
       }
     }
+    uncommitted_bytes += n * metrics * sizeof(double);
     s.cells.clear();
     s.values.clear();
   }
