@@ -4,6 +4,7 @@
 #include <chrono>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,7 @@ struct ResultsWriter::Impl {
     std::vector<double> values;
   };
   std::vector<LandscapeStream> landscape_streams;
+  std::set<std::string> begun_landscapes;  // blocks begin_landscape was called for by this writer
   static constexpr std::size_t kRowBatch = 512;
   /// Bytes of rows, done flags and landscape cells written into their datasets since the last commit.
   /// Those datasets lie in the committed part of the file, so until the commit the journal holds
