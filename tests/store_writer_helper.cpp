@@ -46,8 +46,10 @@ int main(int argc, char** argv) {
     std::vector<char> done(static_cast<std::size_t>(n), 0);
     if (access(path.c_str(), F_OK) == 0) {
       auto r = store::ResultsWriter::open_for_resume(path, store_test::test_meta().study_sha256, opt);
-      for (auto id : r.done) done[static_cast<std::size_t>(id)] = 1;
-      std::cout << "resumed " << r.done.size() << std::endl;
+      std::int64_t resumed = 0;
+      for (std::int64_t id = 0; id < n; ++id)
+        if (r.writer->is_done(id)) done[static_cast<std::size_t>(id)] = 1, ++resumed;
+      std::cout << "resumed " << resumed << std::endl;
       w = std::move(r.writer);
     } else {
       w = store::ResultsWriter::create(path, store_test::test_meta(), store_test::test_columns(), n, opt);

@@ -246,9 +246,7 @@ TEST(Store, ResumeFillsGapsAndEqualsUninterruptedRun) {
   }
   {
     auto res = ResultsWriter::open_for_resume(part, test_meta().study_sha256);
-    std::vector<std::int64_t> want;
-    for (std::int64_t id = 0; id < n; id += 3) want.push_back(id);
-    EXPECT_EQ(res.done, want);
+    for (std::int64_t id = 0; id < n; ++id) EXPECT_EQ(res.writer->is_done(id), id % 3 == 0) << id;
     EXPECT_EQ(res.writer->columns().size(), test_columns().size());
     for (std::int64_t id = n - 1; id >= 0; --id)
       if (!res.writer->is_done(id)) res.writer->write_run(id, test_record(id), test_history(id));
@@ -262,6 +260,101 @@ TEST(Store, ResumeFillsGapsAndEqualsUninterruptedRun) {
     for (std::size_t i = 0; i < x.size(); ++i) EXPECT_TRUE(same_cell(x[i], y[i])) << c.name << " row " << i;
   }
   for (std::int64_t id = 0; id < n; ++id) expect_same_history(b.read_history(id), a.read_history(id), id);
+}
+
+// Rows and landscape cells written since the last commit are held in memory (the journal's pages)
+// until the commit, so the writer commits once they reach a few MiB even when neither
+// flush_every_runs nor flush_every_seconds asks for a commit.
+TEST(Store, CommitsOnceTheUncommittedRowsReachAFewMiB) {
+  TempDir td;
+  const std::string path = td.file("bound.h5");
+  StoreOptions opt;
+  opt.flush_every_runs = 0;
+  opt.flush_every_seconds = 0;
+  const std::int64_t n = 20000;
+  LandscapeSpec spec;  // 64 metrics: 512 bytes of cells per run, 10 MB for all runs
+  spec.block = "b";
+  spec.axes.push_back({"i", "", {}});
+  for (std::int64_t i = 0; i < n; ++i) spec.axes[0].values.push_back(static_cast<double>(i));
+  for (int m = 0; m < 64; ++m) spec.metrics.push_back({"m" + std::to_string(m), "", "", {}});
+  std::vector<double> cell(64);
+  auto w = make_writer(path, n, opt);
+  const std::size_t grid = w->begin_landscape(spec);
+  for (std::int64_t id = 0; id < n; ++id) {
+    w->write_run(id, test_record(id));
+    for (int m = 0; m < 64; ++m) cell[static_cast<std::size_t>(m)] = static_cast<double>(id * 64 + m);
+    w->write_landscape_cell(grid, static_cast<std::uint64_t>(id), cell.data());
+  }
+  EXPECT_LT(w->pending(), static_cast<std::size_t>(n) / 2);  // 4 MiB: about 7400 runs of 569 bytes
+  {
+    ResultsReader r(path);  // the writer is still open: what the automatic commits committed
+    const auto d = r.done_mask();
+    EXPECT_EQ(std::count(d.begin(), d.end(), 1), n - static_cast<std::int64_t>(w->pending()));
+  }
+  w->close();
+  ResultsReader r(path);
+  const auto d = r.done_mask();
+  EXPECT_EQ(std::count(d.begin(), d.end(), 1), n);
+  const LandscapeSpec got = r.read_landscape("b");
+  ASSERT_EQ(got.metrics.size(), 64u);
+  for (int m : {0, 63})
+    for (std::int64_t id : {std::int64_t{0}, std::int64_t{7777}, n - 1})
+      EXPECT_EQ(got.metrics[static_cast<std::size_t>(m)].grid[static_cast<std::size_t>(id)],
+                static_cast<double>(id * 64 + m));
+}
+
+// The writer's done flags (one bit per run) against the runs written, at the edges of 64-run words
+// and of the 65536-run pieces in which a resume reads /runs/done, before and after a resume.
+TEST(Store, IsDoneMatchesTheWrittenRunsAtWordAndPieceEdges) {
+  TempDir td;
+  const std::string path = td.file("bits.h5");
+  const std::int64_t n = 65536 + 130;  // two resume pieces, the last word partly used
+  std::vector<bool> want(static_cast<std::size_t>(n), false);
+  std::vector<std::int64_t> ids = {0, 62, 63, 64, 127, 128, 65535, 65536, 65537, n - 1};
+  for (std::int64_t id = 5; id < n; id += 97) ids.push_back(id);
+  auto expect_flags = [&](const ResultsWriter& w, const char* when) {
+    EXPECT_FALSE(w.is_done(-1)) << when;
+    EXPECT_FALSE(w.is_done(n)) << when;
+    std::int64_t wrong = 0, first_wrong = -1;
+    for (std::int64_t id = 0; id < n; ++id)
+      if (w.is_done(id) != want[static_cast<std::size_t>(id)] && wrong++ == 0) first_wrong = id;
+    EXPECT_EQ(wrong, 0) << when << ": first wrong run " << first_wrong;
+  };
+  StoreOptions opt;
+  opt.flush_every_runs = 500;  // commits while writing, as a sweep does
+  {
+    auto w = ResultsWriter::create(path, test_meta(), test_columns(), n, opt);
+    expect_flags(*w, "new file");
+    for (std::int64_t id : ids) {
+      w->write_run(id, test_record(id));
+      want[static_cast<std::size_t>(id)] = true;
+    }
+    w->write_run(64, test_record(64));  // written again: still done, its neighbours untouched
+    expect_flags(*w, "after write_run");
+    w->close();
+  }
+  {
+    auto res = ResultsWriter::open_for_resume(path, test_meta().study_sha256, opt);
+    ASSERT_EQ(res.writer->n_runs(), n);
+    expect_flags(*res.writer, "after resume");
+    for (std::int64_t id : {std::int64_t{1}, std::int64_t{65}, std::int64_t{65534}, n - 2}) {
+      res.writer->write_run(id, test_record(id));
+      want[static_cast<std::size_t>(id)] = true;
+    }
+    expect_flags(*res.writer, "after resume and write_run");
+    res.writer->close();
+  }
+  ResultsReader r(path);
+  const auto mask = r.done_mask();
+  ASSERT_EQ(static_cast<std::int64_t>(mask.size()), n);
+  for (std::int64_t id = 0; id < n; ++id)
+    ASSERT_EQ(mask[static_cast<std::size_t>(id)] != 0, want[static_cast<std::size_t>(id)]) << "run " << id;
+  // a file of no runs
+  const std::string empty = td.file("empty.h5");
+  ResultsWriter::create(empty, test_meta(), test_columns(), 0)->close();
+  auto res = ResultsWriter::open_for_resume(empty, test_meta().study_sha256);
+  EXPECT_EQ(res.writer->n_runs(), 0);
+  EXPECT_FALSE(res.writer->is_done(0));
 }
 
 TEST(Store, SecondWriterIsRefusedWhileOneIsOpen) {

@@ -3,6 +3,7 @@
 // whose sizes do not divide the chunk. The oracle is a plain array filled with the same writes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numeric>
@@ -141,6 +142,77 @@ TEST(StoreLandscapes, BeginningALandscapeAgainStartsItAfresh) {
   ResultsReader r(path);
   const double nan = std::nan("");
   expect_grid(r.read_landscape("B"), {{nan, nan, 1.0}, {nan, nan, 1.0}}, "begun twice");
+}
+
+// A resumed writer keeps a landscape already in the file when it is begun with the same grid (its
+// cells are those of committed rows), and starts afresh one begun with another grid.
+TEST(StoreLandscapes, AResumedWriterKeepsTheSameGridAndReplacesAnother) {
+  TempDir td;
+  const std::string path = td.file("l.h5");
+  const double nan = std::nan("");
+  {
+    auto w = ResultsWriter::create(path, test_meta(), test_columns(), 4);
+    const double v[2] = {1.5, 1.0};
+    w->write_landscape_cell(w->begin_landscape(spec_of({2, 3})), 1, v);
+    w->close();
+  }
+  {
+    auto w = std::move(ResultsWriter::open_for_resume(path, test_meta().study_sha256).writer);
+    const std::size_t h = w->begin_landscape(spec_of({2, 3}));
+    const double v[2] = {2.5, 0.0};
+    w->write_landscape_cell(h, 4, v);
+    w->close();
+  }
+  expect_grid(ResultsReader(path).read_landscape("B"), {{nan, 1.5, nan, nan, 2.5, nan}, {nan, 1.0, nan, nan, 0.0, nan}},
+              "kept");
+  for (int other = 0; other < 4; ++other) {
+    LandscapeSpec spec = spec_of({2, 3});
+    if (other == 0) spec.axes[1].values[2] = 9.0;  // another axis value
+    if (other == 1) spec.axes[0].unit = "rad";
+    if (other == 2) spec.metrics[1].description = "1 where converged";
+    if (other == 3) spec = spec_of({3, 2});
+    auto w = std::move(ResultsWriter::open_for_resume(path, test_meta().study_sha256).writer);
+    const std::size_t h = w->begin_landscape(spec);
+    const double v[2] = {-1.0, -2.0};
+    w->write_landscape_cell(h, 0, v);
+    w->close();
+    const LandscapeSpec got = ResultsReader(path).read_landscape("B");
+    expect_grid(got, {{-1.0, nan, nan, nan, nan, nan}, {-2.0, nan, nan, nan, nan, nan}}, "replaced " + std::to_string(other));
+    EXPECT_EQ(got.axes[0].values, spec.axes[0].values);
+    EXPECT_EQ(got.metrics[1].description, spec.metrics[1].description);
+  }
+}
+
+// Cells written again into a kept landscape lie in the committed part of the file, where the journal
+// holds their pages in memory until the commit: the writer commits once a few MiB of them wait, even
+// without any run written.
+TEST(StoreLandscapes, CellsWrittenAgainIntoAKeptLandscapeAreCommittedEveryFewMiB) {
+  TempDir td;
+  const std::string path = td.file("l.h5");
+  LandscapeSpec spec = spec_of({2000, 1000});  // 2 metrics: 32 MB of cells
+  StoreOptions opt;
+  opt.flush_every_runs = 0;
+  opt.flush_every_seconds = 0;
+  {
+    auto w = ResultsWriter::create(path, test_meta(), test_columns(), 4, opt);
+    const std::size_t h = w->begin_landscape(spec);
+    const double v[2] = {1.0, 1.0};
+    for (std::uint64_t c = 0; c < 2000000; ++c) w->write_landscape_cell(h, c, v);
+    w->close();
+  }
+  auto w = std::move(ResultsWriter::open_for_resume(path, test_meta().study_sha256, opt).writer);
+  const std::size_t h = w->begin_landscape(spec);
+  const double v[2] = {2.0, 2.0};
+  for (std::uint64_t c = 0; c < 2000000; ++c) w->write_landscape_cell(h, c, v);
+  {
+    ResultsReader r(path);  // the writer is still open: what its automatic commits committed
+    const LandscapeSpec got = r.read_landscape("B");
+    EXPECT_EQ(got.metrics[0].grid[0], 2.0);
+    EXPECT_EQ(got.metrics[1].grid[1000000], 2.0);
+  }
+  w->close();
+  const LandscapeSpec got = ResultsReader(path).read_landscape("B");
+  EXPECT_EQ(std::count(got.metrics[0].grid.begin(), got.metrics[0].grid.end(), 2.0), 2000000);
 }
 
 }  // namespace

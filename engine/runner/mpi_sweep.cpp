@@ -79,7 +79,7 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
   std::unique_ptr<store::ResultsWriter> writer = std::move(opened.writer);
   PreviousRuns all;
   if (opened.previous) all = std::move(*opened.previous);
-  all.done.resize(total, 0);
+  all.done.resize(total, false);
 
   const std::vector<std::string> shards = find_shards(out);
   std::vector<std::unique_ptr<store::ResultsReader>> readers;
@@ -90,10 +90,10 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
       throw store::StoreError(shards[s], "shard of another study");
     const auto mask = r->done_mask();
     for (std::uint64_t id = 0; id < total && id < mask.size(); ++id)
-      if (mask[id] && !all.done[id]) all.done[id] = 1, owner[id] = static_cast<std::int32_t>(s);
+      if (mask[id] && !all.done[id]) all.done[id] = true, owner[id] = static_cast<std::int32_t>(s);
     readers.push_back(std::move(r));
   }
-  const std::uint64_t missing = static_cast<std::uint64_t>(std::count(all.done.begin(), all.done.end(), 0));
+  const std::uint64_t missing = static_cast<std::uint64_t>(std::count(all.done.begin(), all.done.end(), false));
   if (missing)
     throw store::StoreError(out, std::to_string(missing) + " runs are in neither the results file nor a shard");
 

@@ -160,7 +160,7 @@ class Accumulator {
 
 PreviousRuns previous_runs(const store::ResultsWriter& writer) {
   PreviousRuns p;
-  p.done.resize(static_cast<std::size_t>(std::max<std::int64_t>(0, writer.n_runs())));
+  p.done.resize(static_cast<std::size_t>(std::max<std::int64_t>(0, writer.n_runs())), false);
   for (std::size_t id = 0; id < p.done.size(); ++id) p.done[id] = writer.is_done(static_cast<std::int64_t>(id));
   return p;
 }
@@ -175,7 +175,7 @@ std::uint64_t add_previous(const Study& study, const PreviousRuns& previous, sto
   std::uint64_t added = 0;
   for (std::uint64_t first = 0; first < total; first += kPiece) {
     const std::uint64_t n = std::min(kPiece, total - first);
-    if (std::none_of(previous.done.begin() + first, previous.done.begin() + first + n, [](auto d) { return d != 0; }))
+    if (std::none_of(previous.done.begin() + first, previous.done.begin() + first + n, [](bool d) { return d; }))
       continue;
     const std::vector<Record> rows = writer.read_rows(static_cast<std::int64_t>(first), static_cast<std::int64_t>(n));
     for (std::uint64_t i = 0; i < n; ++i)

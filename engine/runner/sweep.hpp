@@ -74,9 +74,10 @@ struct SweepReport {
 };
 
 /// Which runs a results file already holds (resume). Their rows are read back from the writer in
-/// pieces, so a resume needs memory for this mask only, whatever the number of runs.
+/// pieces, so a resume needs memory for this mask only (one bit per run), whatever the number of runs.
+/// A copy, not the writer's own flags: the sweep reads it while the writer sets its flags.
 struct PreviousRuns {
-  std::vector<std::uint8_t> done;  ///< per run id
+  std::vector<bool> done;  ///< per run id
 };
 /// The done mask of `writer`'s file (its committed and pending runs).
 PreviousRuns previous_runs(const store::ResultsWriter& writer);

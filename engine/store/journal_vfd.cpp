@@ -14,6 +14,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -35,6 +36,48 @@ namespace {
 using namespace journal;  // the on-disk layout and its file I/O (journal_format.cpp)
 
 // ------------------------------------------------------------------------------------------------
+/// The memory of the overlay's pages: blocks mapped for them alone (anonymous mmap), reused from
+/// one commit to the next, and unmapped at a commit beyond the first kKeepBlocks. Pages allocated one
+/// by one from malloc would stay, once freed, in the arena of whichever thread wrote them (a sweep
+/// writes from any of its threads), each arena keeping the footprint of its largest overlay: the
+/// resident memory then grew with the length of a sweep although the overlay never holds more than
+/// the pages of one commit.
+class PagePool {
+ public:
+  PagePool() = default;
+  PagePool(const PagePool&) = delete;
+  PagePool& operator=(const PagePool&) = delete;
+  ~PagePool() {
+    for (unsigned char* b : blocks_) ::munmap(b, kBlockBytes);
+  }
+  /// kPage bytes, valid until reset(); nullptr when the system refuses memory.
+  unsigned char* get() {
+    if (used_ == kBlockPages) ++block_, used_ = 0;
+    if (block_ == blocks_.size()) {
+      void* b = ::mmap(nullptr, kBlockBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+      if (b == MAP_FAILED) return nullptr;
+      blocks_.push_back(static_cast<unsigned char*>(b));
+    }
+    return blocks_[block_] + kPage * used_++;
+  }
+  /// Takes every page back (they are invalid afterwards); unmaps the blocks beyond kKeepBlocks.
+  void reset() {
+    while (blocks_.size() > kKeepBlocks) {
+      ::munmap(blocks_.back(), kBlockBytes);
+      blocks_.pop_back();
+    }
+    block_ = used_ = 0;
+  }
+
+ private:
+  static constexpr std::size_t kBlockPages = 256, kBlockBytes = kBlockPages * kPage;  // 1 MiB blocks
+  /// Kept across commits: the overlay of a commit of the writer's usual size (it commits once 4 MiB
+  /// of rows wait) plus the metadata HDF5 rewrites with them.
+  static constexpr std::size_t kKeepBlocks = 8;
+  std::vector<unsigned char*> blocks_;
+  std::size_t block_ = 0, used_ = 0;  // the block pages are handed out of, and its pages handed out
+};
+
 struct JFile {
   H5FD_t pub;  // must be first
   int fd = -1, jfd = -1;
@@ -47,7 +90,8 @@ struct JFile {
   bool poisoned = false;        // an I/O error happened: never commit again (the journal stays)
   bool readonly = false;        // a reader's overlay of an unapplied commit (open_overlay): no journal
   std::string path;
-  std::map<std::uint64_t, std::vector<unsigned char>> pages;  // page number -> kPage bytes
+  std::map<std::uint64_t, unsigned char*> pages;  // page number -> kPage bytes of page_pool
+  PagePool page_pool;
   // Test hook (crash-safety tests only): KS_STORE_TEST_CRASH="<n>:<phase>" makes the process
   // _exit(86) during its n-th commit, phase = journal_half | journal_done | apply_half.
   long crash_commit = -1, commits = 0;
@@ -63,12 +107,21 @@ struct JFapl {
   int readonly;  // open_overlay()
 };
 
-std::vector<unsigned char>* page_for(JFile* f, std::uint64_t pno) {
+/// The overlay's copy of page `pno` (read from the file on first use); nullptr on a read error or
+/// when no memory is left.
+unsigned char* page_for(JFile* f, std::uint64_t pno) {
   auto it = f->pages.find(pno);
-  if (it != f->pages.end()) return &it->second;
-  std::vector<unsigned char> pg(kPage);
-  if (!read_all(f->fd, pg.data(), kPage, pno * kPage)) return nullptr;
-  return &f->pages.emplace(pno, std::move(pg)).first->second;
+  if (it != f->pages.end()) return it->second;
+  unsigned char* pg = f->page_pool.get();
+  if (!pg || !read_all(f->fd, pg, kPage, pno * kPage)) return nullptr;
+  f->pages.emplace(pno, pg);
+  return pg;
+}
+
+/// Empties the overlay (after a commit).
+void clear_pages(JFile* f) {
+  f->pages.clear();
+  f->page_pool.reset();
 }
 
 void* j_fapl_get(H5FD_t* file) {
@@ -111,7 +164,7 @@ H5FD_t* open_overlay(JFile* f) {
   for (auto& [addr, bytes] : p.records) {
     auto* pg = page_for(f, addr / kPage);
     if (!pg || addr % kPage != 0) { set_error("cannot read " + f->path, errno); return nullptr; }
-    std::memcpy(pg->data(), bytes.data(), bytes.size());
+    std::memcpy(pg, bytes.data(), bytes.size());
   }
   return &f->pub;
 }
@@ -217,8 +270,8 @@ bool commit_impl(JFile* f) {
     unsigned char rh[16];
     put64(rh, addr); put64(rh + 8, len);
     crc = crc32(crc, rh, 16);
-    crc = crc32(crc, pg.data(), static_cast<uInt>(len));
-    if (!put(rh, 16, false) || !put(pg.data(), len, false)) return false;
+    crc = crc32(crc, pg, static_cast<uInt>(len));
+    if (!put(rh, 16, false) || !put(pg, len, false)) return false;
   }
   unsigned char tail[kTailSize] = {};
   std::memcpy(tail, kTailMagic, 8);
@@ -237,14 +290,14 @@ bool commit_impl(JFile* f) {
     const std::uint64_t addr = pno * kPage;
     if (addr >= f->committed) continue;
     const std::uint64_t len = std::min<std::uint64_t>(kPage, f->committed - addr);
-    if (!write_all(f->fd, pg.data(), len, addr)) return false;
+    if (!write_all(f->fd, pg, len, addr)) return false;
   }
   if (f->durable && ::fdatasync(f->fd) != 0) return false;
   if (!reset_journal(f->jfd, f->fd, f->dev, f->ino, new_size, f->seq + 1, f->session)) return false;
   ++f->seq;
   f->committed = new_size;
   f->eof = new_size;
-  f->pages.clear();
+  clear_pages(f);
   return true;
 }
 
@@ -301,7 +354,7 @@ herr_t j_read(H5FD_t* file, H5FD_mem_t, hid_t, haddr_t addr, size_t size, void* 
     const std::uint64_t pno = a / kPage, in = a % kPage;
     std::size_t len = static_cast<std::size_t>(std::min<std::uint64_t>({size, kPage - in, f->committed - a}));
     auto it = f->pages.find(pno);
-    if (it != f->pages.end()) std::memcpy(out, it->second.data() + in, len);
+    if (it != f->pages.end()) std::memcpy(out, it->second + in, len);
     else if (!read_all(f->fd, out, len, a)) return -1;
     out += len; a += len; size -= len;
   }
@@ -327,7 +380,7 @@ herr_t j_write(H5FD_t* file, H5FD_mem_t, hid_t, haddr_t addr, size_t size, const
     std::size_t len = static_cast<std::size_t>(std::min<std::uint64_t>({size, kPage - off, f->committed - a}));
     auto* pg = page_for(f, pno);
     if (!pg) { f->poisoned = true; return -1; }
-    std::memcpy(pg->data() + off, in, len);
+    std::memcpy(pg + off, in, len);
     in += len; a += len; size -= len;
   }
   return 0;

@@ -201,6 +201,8 @@ class ResultsWriter {
   /// metrics' names, units and descriptions (their grids are not read): every cell NaN until
   /// write_landscape_cell sets it. Returns the landscape's handle. The group is written at once
   /// (committed at the next flush), so a file of an interrupted sweep has its partial landscapes.
+  /// Exception: a group that was in the file when this writer opened it, with the same axes and
+  /// metrics (a resumed sweep), is kept with its cells (FORMAT.md, /landscapes).
   std::size_t begin_landscape(const LandscapeSpec& spec);
   /// Set one cell (row-major index into the axes' grid) of a begun landscape to `values` (one per
   /// metric, in the spec's order). Written with the rows and committed with them; a cell set twice
@@ -228,8 +230,7 @@ class ResultsWriter {
 };
 
 struct ResultsWriter::Resumed {
-  std::unique_ptr<ResultsWriter> writer;
-  std::vector<std::int64_t> done;  ///< run ids already done, ascending
+  std::unique_ptr<ResultsWriter> writer;  ///< the runs already done: writer->is_done(id)
 };
 
 // ------------------------------------------------------------------------------------------------

@@ -247,7 +247,7 @@ std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, co
   auto impl = open_writer_impl(path, options);
   impl->columns = columns;
   impl->n_runs = n_runs;
-  impl->done.assign(static_cast<std::size_t>(n_runs), 0);
+  impl->done.assign(static_cast<std::size_t>(n_runs), false);
   impl->open_objects();
   return std::unique_ptr<ResultsWriter>(new ResultsWriter(std::move(impl)));
 }
@@ -267,7 +267,7 @@ const std::string& ResultsWriter::path() const { return impl_->path; }
 const std::vector<ColumnSpec>& ResultsWriter::columns() const { return impl_->columns; }
 std::int64_t ResultsWriter::n_runs() const { return impl_->n_runs; }
 bool ResultsWriter::is_done(std::int64_t id) const {
-  return id >= 0 && id < impl_->n_runs && impl_->done[static_cast<std::size_t>(id)] != 0;
+  return id >= 0 && id < impl_->n_runs && impl_->done[static_cast<std::size_t>(id)];
 }
 std::size_t ResultsWriter::pending() const { return impl_->pending.size() + impl_->unflagged.size(); }
 
@@ -307,15 +307,16 @@ void ResultsWriter::write_run(std::int64_t run_id, const Record& record, const E
   }
   m.write_history(run_id, history);
   m.pending[run_id] = record;
-  m.done[static_cast<std::size_t>(run_id)] = 1;
+  m.done[static_cast<std::size_t>(run_id)] = true;
   // rows go to the datasets in batches as they come (uncommitted, invisible until the next commit),
   // so that the commit at the end of a sweep, which nothing overlaps, has little left to write
   if (m.pending.size() >= Impl::kRowBatch) m.write_rows();
   const bool by_count = m.opt.flush_every_runs > 0 && m.pending.size() + m.unflagged.size() >= m.opt.flush_every_runs;
+  const bool by_bytes = m.uncommitted_bytes >= Impl::kMaxUncommittedBytes;
   const bool by_time =
       m.opt.flush_every_seconds > 0 &&
       std::chrono::duration<double>(std::chrono::steady_clock::now() - m.last_flush).count() >= m.opt.flush_every_seconds;
-  if (by_count || by_time) m.do_flush();
+  if (by_count || by_bytes || by_time) m.do_flush();
 }
 
 namespace detail {
@@ -375,6 +376,9 @@ void ResultsWriter::Impl::write_rows() {
     }
     if (rc < 0) fail("cannot write column " + columns[c].name);
   }
+  std::size_t row_bytes = 1;  // the done flag, written at the commit
+  for (const ColumnSpec& c : columns) row_bytes += c.type == CellType::str ? 16 : 8;  // a string: its heap reference
+  uncommitted_bytes += ids.size() * row_bytes;
   unflagged.insert(unflagged.end(), ids.begin(), ids.end());
   pending.clear();
 }
@@ -397,6 +401,7 @@ void ResultsWriter::Impl::do_flush() {
     unflagged.clear();
   }
   if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) fail("flush (commit) failed");
+  uncommitted_bytes = 0;
   last_flush = std::chrono::steady_clock::now();
 }
 

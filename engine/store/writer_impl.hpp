@@ -5,6 +5,7 @@
 #include <chrono>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,7 @@ struct ResultsWriter::Impl {
   std::int64_t n_runs = 0;
   detail::Hid file, runs, histories, landscapes, done_dset;
   std::vector<detail::Hid> col_dsets;
-  std::vector<std::uint8_t> done;       // committed or pending
+  std::vector<bool> done;                   // per run, one bit: committed or pending
   std::map<std::int64_t, Record> pending;   // rows not yet in the datasets
   std::vector<hsize_t> unflagged;           // rows in the datasets, not yet committed with done = 1
   /// A landscape whose cells are streamed in (writer_landscapes.cpp): its metric datasets and the
@@ -57,7 +58,14 @@ struct ResultsWriter::Impl {
       start.reset(); rows.reset(); layout.reset();
     }
   } hist;
+  std::set<std::string> begun_landscapes;  // blocks begin_landscape was called for by this writer
   static constexpr std::size_t kRowBatch = 512;
+  /// Bytes of rows, done flags and landscape cells written into their datasets since the last commit.
+  /// Those datasets lie in the committed part of the file, so until the commit the journal holds
+  /// these bytes' pages in memory: write_run commits once they reach kMaxUncommittedBytes, whatever
+  /// the runs' pace (a fast sweep would otherwise hold flush_every_runs rows' pages, ~20 MB).
+  std::size_t uncommitted_bytes = 0;
+  static constexpr std::size_t kMaxUncommittedBytes = std::size_t{4} << 20;
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false, broken = false;
 

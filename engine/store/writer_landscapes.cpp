@@ -3,6 +3,7 @@
 #include <hdf5_hl.h>  // H5DS: dimension scales
 
 #include <algorithm>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <set>
@@ -46,6 +47,46 @@ bool for_each_block(const std::vector<hsize_t>& dims, hsize_t first, hsize_t cou
   }
   return true;
 }
+
+/// The doubles of a 1-D dataset (empty when it cannot be read).
+std::vector<double> read_doubles(hid_t d) {
+  Hid space(H5Dget_space(d));
+  const hssize_t n = space.ok() ? H5Sget_simple_extent_npoints(space) : -1;
+  std::vector<double> v(n > 0 ? static_cast<std::size_t>(n) : 0);
+  if (n <= 0 || H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0) v.clear();
+  return v;
+}
+
+/// The metric datasets of the existing landscape `g` when it is the grid `spec` describes: the same
+/// axes (names, units, values bit for bit) and metrics (names, units, descriptions), each metric an
+/// f64 dataset of shape `dims`. Empty otherwise (and for a spec without metrics).
+std::vector<Hid> same_grid_metrics(hid_t g, const LandscapeSpec& spec, const std::vector<hsize_t>& dims) {
+  if (spec.metrics.empty()) return {};
+  std::vector<std::string> names;
+  for (auto& a : spec.axes) names.push_back(a.name);
+  if (read_str_list_attr(g, "axes") != names) return {};
+  for (auto& a : spec.axes) {
+    Hid d(H5Dopen2(g, a.name.c_str(), H5P_DEFAULT));
+    if (!d.ok() || read_str_attr(d, "unit") != a.unit) return {};
+    const std::vector<double> v = read_doubles(d);
+    if (v.size() != a.values.size() || std::memcmp(v.data(), a.values.data(), v.size() * sizeof(double)) != 0) return {};
+  }
+  names.clear();
+  for (auto& mt : spec.metrics) names.push_back(mt.name);
+  if (read_str_list_attr(g, "metrics") != names) return {};
+  std::vector<Hid> metrics;
+  for (auto& mt : spec.metrics) {
+    Hid d(H5Dopen2(g, mt.name.c_str(), H5P_DEFAULT));
+    if (!d.ok() || read_str_attr(d, "unit") != mt.unit || read_str_attr(d, "description") != mt.description) return {};
+    Hid type(H5Dget_type(d)), space(H5Dget_space(d));
+    if (!type.ok() || H5Tequal(type, H5T_IEEE_F64LE) <= 0 || !space.ok()) return {};
+    const int rank = H5Sget_simple_extent_ndims(space);
+    std::vector<hsize_t> shape(rank > 0 ? static_cast<std::size_t>(rank) : 0);
+    if (rank < 0 || (rank > 0 && H5Sget_simple_extent_dims(space, shape.data(), nullptr) < 0) || shape != dims) return {};
+    metrics.push_back(std::move(d));
+  }
+  return metrics;
+}
 }  // namespace
 
 std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
@@ -70,7 +111,33 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
   }
   for (auto& s : m.landscape_streams)  // a landscape begun again (a re-run block) starts afresh
     if (s.block == spec.block) s = {};
-  if (link_exists(m.landscapes, spec.block) && H5Ldelete(m.landscapes, spec.block.c_str(), H5P_DEFAULT) < 0)
+  const bool exists = link_exists(m.landscapes, spec.block);
+  if (exists && m.begun_landscapes.insert(spec.block).second) {
+    // In the file before this writer (a resumed sweep): kept, cells and all, when it is this very
+    // grid. Its cells are those of committed rows, which the sweep writes again. Replacing it would
+    // give the new metrics the space the old ones free, in the committed part of the file, so that
+    // their NaN fill (8 bytes a cell and metric) would wait in the journal's memory until the commit.
+    Hid g(H5Gopen2(m.landscapes, spec.block.c_str(), H5P_DEFAULT));
+    std::vector<Hid> metrics;
+    if (g.ok()) {
+      try {
+        metrics = same_grid_metrics(g, spec, dims);
+      } catch (const StoreError&) {  // an attribute that cannot be read: not this grid
+        metrics.clear();
+      }
+    }
+    H5Eclear2(H5E_DEFAULT);
+    if (!metrics.empty()) {
+      Impl::LandscapeStream stream;
+      stream.block = spec.block;
+      stream.dims = dims;
+      stream.metrics = std::move(metrics);
+      m.landscape_streams.push_back(std::move(stream));
+      return m.landscape_streams.size() - 1;
+    }
+  }
+  m.begun_landscapes.insert(spec.block);
+  if (exists && H5Ldelete(m.landscapes, spec.block.c_str(), H5P_DEFAULT) < 0)
     m.fail("cannot replace /landscapes/" + spec.block);
   Hid g(H5Gcreate2(m.landscapes, spec.block.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
   if (!g.ok()) m.fail("cannot create /landscapes/" + spec.block);
@@ -138,6 +205,10 @@ void ResultsWriter::write_landscape_cell(std::size_t landscape, std::uint64_t ce
     QuietHdf5 quiet;
     m.write_landscape_cells();
   }
+  if (m.uncommitted_bytes >= Impl::kMaxUncommittedBytes) {  // cells written again into a kept landscape
+    QuietHdf5 quiet;
+    m.do_flush();
+  }
 }
 
 void ResultsWriter::Impl::write_landscape_cells() {
@@ -180,6 +251,7 @@ void ResultsWriter::Impl::write_landscape_cells() {
         i = j;
       }
     }
+    uncommitted_bytes += n * metrics * sizeof(double);
     s.cells.clear();
     s.values.clear();
   }

@@ -1,9 +1,11 @@
 // ResultsWriter::open_for_resume (see store.hpp, FORMAT.md "Creation, overwrite, resume").
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cstring>
+#include <vector>
 
 #include "store/h5util.hpp"
 #include "store/journal_vfd.hpp"
@@ -84,13 +86,22 @@ ResultsWriter::Resumed ResultsWriter::open_for_resume(const std::string& path, c
   impl->columns = read_run_columns(f, path, impl->n_runs, true);
   impl->open_objects();
   if (impl->n_runs < 0) impl->n_runs = H5Sget_simple_extent_npoints(Hid(H5Dget_space(impl->done_dset)));
-  impl->done.assign(static_cast<std::size_t>(impl->n_runs), 0);
-  if (impl->n_runs > 0)
-    check(H5Dread(impl->done_dset, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, impl->done.data()), path,
-          "read /runs/done");
+  impl->done.assign(static_cast<std::size_t>(impl->n_runs), false);
+  {  // /runs/done into one bit per run, read in pieces (memory bounded whatever the run count)
+    constexpr hsize_t kPiece = hsize_t{1} << 16;
+    const hsize_t n = static_cast<hsize_t>(impl->n_runs);
+    std::vector<std::uint8_t> piece(static_cast<std::size_t>(std::min(n, kPiece)));
+    Hid fs(check(H5Dget_space(impl->done_dset), path, "read /runs/done"));
+    for (hsize_t first = 0; first < n; first += kPiece) {
+      hsize_t count = std::min(kPiece, n - first);
+      Hid ms(check(H5Screate_simple(1, &count, nullptr), path, "read /runs/done"));
+      check(H5Sselect_hyperslab(fs, H5S_SELECT_SET, &first, nullptr, &count, nullptr), path, "read /runs/done");
+      check(H5Dread(impl->done_dset, H5T_NATIVE_UINT8, ms, fs, H5P_DEFAULT, piece.data()), path, "read /runs/done");
+      for (hsize_t i = 0; i < count; ++i)
+        if (piece[static_cast<std::size_t>(i)]) impl->done[static_cast<std::size_t>(first + i)] = true;
+    }
+  }
   Resumed r;
-  for (std::int64_t i = 0; i < impl->n_runs; ++i)
-    if (impl->done[static_cast<std::size_t>(i)]) r.done.push_back(i);
   r.writer = std::unique_ptr<ResultsWriter>(new ResultsWriter(std::move(impl)));
   return r;
 }

@@ -111,6 +111,7 @@ void Parser::generate_axes(BlockDraft& d) {
     const ParamDef* info = d.info_of(a.axis.name);
     const std::string what = "axis '" + a.axis.name + "'";
     const std::vector<double> vals = a.generate();
+    a.axis.values.reserve(a.axis.values.size() + vals.size());  // a long axis: no doubling's slack
     for (double v : vals)
       if (auto p = value_problem(*info, what, v); !p.empty()) {
         error(*a.node, p);
