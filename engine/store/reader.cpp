@@ -7,6 +7,7 @@
 
 #include "store/h5util.hpp"
 #include "store/journal_vfd.hpp"
+#include "store/reader_impl.hpp"
 #include "store/runs_read.hpp"
 #include "store/store.hpp"
 
@@ -22,65 +23,36 @@ std::string read_text_dataset(hid_t group, const char* name, const std::string& 
 }
 }  // namespace
 
-struct ResultsReader::Impl {
-  std::string path;
-  Hid file;
-  StoreMeta meta;
-  std::vector<ColumnSpec> columns;
-  std::int64_t n_runs = 0;
-  std::string stamp;  // consistency stamp at open
-  V1ColumnRoles v1_roles;
-
-  void load() {
-    hid_t f = file;
-    meta.format = read_str_attr(f, "format");
-    if (meta.format != kFormatName)
-      throw StoreError(path, "not a kinesweep results file (attribute format = '" + meta.format + "')");
-    meta.format_version = read_i64_attr(f, "format_version", -1);
-    meta.engine_version = read_str_attr(f, "engine_version");
-    if (meta.format_version < kOldestReadableFormatVersion || meta.format_version > kFormatVersion)
-      throw StoreError(path, "unsupported format_version " + std::to_string(meta.format_version) +
-                                 " (written by kinesweep " + meta.engine_version + "; this kinesweep reads " +
-                                 std::to_string(kOldestReadableFormatVersion) + " to " +
-                                 std::to_string(kFormatVersion) + ")");
-    meta.study_sha256 = read_str_attr(f, "study_sha256");
-    meta.created = read_str_attr(f, "created");
-    meta.study_name = read_str_attr(f, "study_name");
-    Hid study(check(H5Gopen2(f, "study", H5P_DEFAULT), path, "open /study"));
-    meta.study_path = read_str_attr(study, "path");
-    meta.study_text = read_text_dataset(study, "text", path);
-    if (H5Lexists(study, "robot", H5P_DEFAULT) > 0) {
-      meta.robot_text = read_text_dataset(study, "robot", path);
-      Hid d(check(H5Dopen2(study, "robot", H5P_DEFAULT), path, "open /study/robot"));
-      meta.robot_path = read_str_attr(d, "path");
-    }
-    columns = read_run_columns(f, path, n_runs, meta.format_version >= 2);
-    if (meta.format_version == 1 && v1_roles) v1_roles(columns);
-    if (n_runs < 0) {
-      Hid d(check(H5Dopen2(f, "runs/done", H5P_DEFAULT), path, "open /runs/done"));
-      n_runs = H5Sget_simple_extent_npoints(Hid(H5Dget_space(d)));
-    }
+void ResultsReader::Impl::load() {
+  hid_t f = file;
+  meta.format = read_str_attr(f, "format");
+  if (meta.format != kFormatName)
+    throw StoreError(path, "not a kinesweep results file (attribute format = '" + meta.format + "')");
+  meta.format_version = read_i64_attr(f, "format_version", -1);
+  meta.engine_version = read_str_attr(f, "engine_version");
+  if (meta.format_version < kOldestReadableFormatVersion || meta.format_version > kFormatVersion)
+    throw StoreError(path, "unsupported format_version " + std::to_string(meta.format_version) +
+                               " (written by kinesweep " + meta.engine_version + "; this kinesweep reads " +
+                               std::to_string(kOldestReadableFormatVersion) + " to " +
+                               std::to_string(kFormatVersion) + ")");
+  meta.study_sha256 = read_str_attr(f, "study_sha256");
+  meta.created = read_str_attr(f, "created");
+  meta.study_name = read_str_attr(f, "study_name");
+  Hid study(check(H5Gopen2(f, "study", H5P_DEFAULT), path, "open /study"));
+  meta.study_path = read_str_attr(study, "path");
+  meta.study_text = read_text_dataset(study, "text", path);
+  if (H5Lexists(study, "robot", H5P_DEFAULT) > 0) {
+    meta.robot_text = read_text_dataset(study, "robot", path);
+    Hid d(check(H5Dopen2(study, "robot", H5P_DEFAULT), path, "open /study/robot"));
+    meta.robot_path = read_str_attr(d, "path");
   }
-
-  const ColumnSpec& column(const std::string& name) const {
-    for (auto& c : columns)
-      if (c.name == name) return c;
-    throw StoreError(path, "no column '" + name + "'");
+  columns = read_run_columns(f, path, n_runs, meta.format_version >= 2);
+  if (meta.format_version == 1 && v1_roles) v1_roles(columns);
+  if (n_runs < 0) {
+    Hid d(check(H5Dopen2(f, "runs/done", H5P_DEFAULT), path, "open /runs/done"));
+    n_runs = H5Sget_simple_extent_npoints(Hid(H5Dget_space(d)));
   }
-
-  /// Rows `first` .. `first + count` (clamped to n_runs).
-  RowSelection range(std::int64_t first, std::int64_t count) const {
-    if (first < 0 || count < 0) throw StoreError(path, "negative row range");
-    const std::int64_t end = std::min(n_runs, first + std::min(count, n_runs));
-    return {static_cast<hsize_t>(std::min(first, n_runs)), static_cast<hsize_t>(std::max<std::int64_t>(0, end - first))};
-  }
-  const ColumnSpec& typed(const std::string& name, CellType type) const {
-    const ColumnSpec& c = column(name);
-    static const char* names[] = {"f64", "i64", "str"};
-    if (c.type != type) throw StoreError(path, "column " + name + " is not " + names[static_cast<int>(type)]);
-    return c;
-  }
-};
+}
 
 ResultsReader::ResultsReader(const std::string& path, V1ColumnRoles v1_roles) : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
@@ -91,6 +63,7 @@ ResultsReader::ResultsReader(const std::string& path, V1ColumnRoles v1_roles) : 
 void ResultsReader::refresh() {
   QuietHdf5 quiet;
   const std::string path = impl_->path;
+  impl_->hist.reset();
   impl_->file.reset();
   if (::access(path.c_str(), F_OK) != 0) throw StoreError(path, "no such file");
   if (H5Fis_hdf5(path.c_str()) == 0)  // a readable file that is no HDF5 file at all (a study file, ...)

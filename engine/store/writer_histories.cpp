@@ -52,26 +52,9 @@ void ResultsWriter::Impl::open_histories() {
   h.layout = Hid(check(H5Dopen2(histories, "layout", H5P_DEFAULT), path, "open /histories/layout"));
   h.layouts = read_str_list_attr(histories, "layouts");
   std::set<std::string> names;
-  for (const auto& l : h.layouts) {
-    std::size_t at = 0;
-    while (at <= l.size() && !l.empty()) {
-      const std::size_t comma = std::min(l.find(',', at), l.size());
-      names.insert(l.substr(at, comma - at));
-      at = comma + 1;
-    }
-  }
-  for (const auto& n : names) {
-    HistoryDataset d;
-    d.name = n;
-    d.dset = Hid(check(H5Dopen2(histories, n.c_str(), H5P_DEFAULT), path, "open /histories/" + n));
-    d.array = read_str_attr(d.dset, "array");
-    d.unit = read_str_attr(d.dset, "unit");
-    hsize_t dims[2] = {0, 0};
-    H5Sget_simple_extent_dims(Hid(H5Dget_space(d.dset)), dims, nullptr);
-    d.extent = dims[0];
-    d.cols = dims[1];
-    h.datasets.push_back(std::move(d));
-  }
+  for (const auto& l : h.layouts)
+    for (auto& n : split_layout(l)) names.insert(std::move(n));
+  for (const auto& n : names) h.datasets.push_back(open_history_dataset(histories, n, path));
 }
 
 void ResultsWriter::Impl::write_history(std::int64_t id, const EncodedHistory& given) {

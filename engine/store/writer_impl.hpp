@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "store/h5util.hpp"
+#include "store/history_datasets.hpp"
 #include "store/journal_vfd.hpp"
 #include "store/store.hpp"
 
@@ -36,12 +37,7 @@ struct ResultsWriter::Impl {
   };
   std::vector<LandscapeStream> landscape_streams;
   /// The histories' shared row space (writer_histories.cpp, FORMAT.md: /histories).
-  struct HistoryDataset {
-    std::string name, array, unit;  ///< dataset name (the array name, or "<array>.<n>"), array name, unit
-    std::size_t cols = 1;
-    detail::Hid dset;
-    hsize_t extent = 0;       ///< rows of the dataset's current extent (>= used_rows once written)
-  };
+  using HistoryDataset = detail::HistoryDataset;
   struct HistoryIndexEntry {
     std::int64_t start = -1, rows = 0, layout = -1;
   };
