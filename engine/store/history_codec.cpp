@@ -8,25 +8,12 @@
 #include <cstring>
 #include <limits>
 
+#include "store/plane_codec.hpp"
 #include "store/store.hpp"
 
 namespace ks::store {
 
 namespace {
-/// HDF5's shuffle filter for 8-byte elements: byte j of element i goes to j * n + i.
-void shuffle8(const double* src, std::size_t n, unsigned char* dst) {
-  const unsigned char* s = reinterpret_cast<const unsigned char*>(src);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < 8; ++j) dst[j * n + i] = s[i * 8 + j];
-}
-/// The byte-shuffled array as one zlib stream, the format HDF5's deflate filter reads. The six
-/// low-order byte planes of a history's doubles are close to noise (deflate gains ~4 % on them at
-/// the price of most of its time), so they go into the stream as stored blocks, copied; only the two
-/// high planes (sign, exponent, top of the mantissa: 2.5x and 50x smaller) are deflated, at `level`.
-/// The stream: zlib header, stored blocks (BFINAL = 0, each ending on a byte boundary), libdeflate's
-/// raw deflate of the high planes (its last block final), Adler-32 of all the bytes. Empty on failure.
-std::vector<unsigned char> zlib_stream_high_planes(const unsigned char* shuffled, std::size_t n, int level);
-
 /// One libdeflate compressor per thread and level (allocating one costs more than a small array).
 libdeflate_compressor* compressor(int level) {
   struct Cache {
@@ -41,31 +28,54 @@ libdeflate_compressor* compressor(int level) {
   return cache.c[level];
 }
 
-std::vector<unsigned char> zlib_stream_high_planes(const unsigned char* shuffled, std::size_t n, int level) {
-  const std::size_t total = 8 * n, low = 6 * n;  // planes 0..5 stored, 6..7 deflated
-  libdeflate_compressor* c = compressor(level);
-  if (!c) return {};
-  const std::size_t stored_blocks = (low + 65534) / 65535;
-  std::vector<unsigned char> out(2 + low + 5 * stored_blocks + libdeflate_deflate_compress_bound(c, total - low) + 4);
-  unsigned char* p = out.data();
-  *p++ = 0x78;  // CMF: deflate, 32 KiB window
-  *p++ = 0x01;  // FLG: no dictionary, (0x78 * 256 + 0x01) % 31 == 0
-  for (std::size_t at = 0; at < low;) {
-    const std::size_t len = std::min<std::size_t>(65535, low - at);
-    *p++ = 0x00;  // BFINAL = 0, BTYPE = 00 (stored), then padding to the byte boundary
-    *p++ = static_cast<unsigned char>(len & 0xff);
-    *p++ = static_cast<unsigned char>(len >> 8);
-    *p++ = static_cast<unsigned char>(~len & 0xff);
-    *p++ = static_cast<unsigned char>((~len >> 8) & 0xff);
-    std::memcpy(p, shuffled + at, len);
-    p += len;
-    at += len;
+/// The zlib stream of one chunk of `n` values of `cols` columns, as HDF5's shuffle then deflate
+/// filters store it: zlib header; the byte planes 0 .. first_coded-1 as stored blocks (BFINAL = 0,
+/// byte-aligned), shuffled straight into place; the planes first_coded .. 7 coded together as the
+/// final block(s), by deflate_runs (level 1: matches at distance `cols`, a value's previous row) or
+/// by libdeflate at `level`; Adler-32 of all the planes. Empty on failure.
+ByteBuffer planes_stream(const double* values, std::size_t n, std::size_t cols, int first_coded,
+                                         int level, ByteBuffer& coded_planes) {
+  constexpr std::size_t kStored = 65535;  // longest stored block
+  const std::size_t segments = (n + kStored - 1) / kStored, coded = static_cast<std::size_t>(8 - first_coded) * n;
+  libdeflate_compressor* z = level > 1 ? compressor(level) : nullptr;
+  if (level > 1 && !z) return {};
+  const std::size_t bound = level > 1 ? libdeflate_deflate_compress_bound(z, coded) : detail::deflate_runs_bound(coded);
+  ByteBuffer out(2 + static_cast<std::size_t>(first_coded) * (n + 5 * segments) + bound + 4);
+  out[0] = 0x78;  // CMF: deflate, 32 KiB window
+  out[1] = 0x01;  // FLG: no dictionary, (0x78 * 256 + 0x01) % 31 == 0
+  coded_planes.resize(coded);
+  // Plane j's segment s: a stored block of the values [s * kStored, ...) of plane j.
+  const auto block = [&](int j, std::size_t s) {
+    return out.data() + 2 + (static_cast<std::size_t>(j) * segments + s) * 5 + static_cast<std::size_t>(j) * n + s * kStored;
+  };
+  std::uint32_t adler = 1;
+  for (std::size_t s = 0; s < segments; ++s) {
+    const std::size_t at = s * kStored, len = std::min(kStored, n - at);
+    unsigned char* planes[8];
+    for (int j = 0; j < 8; ++j) {
+      if (j < first_coded) {
+        unsigned char* h = block(j, s);
+        h[0] = 0x00;  // BFINAL = 0, BTYPE = 00 (stored), then padding to the byte boundary
+        h[1] = static_cast<unsigned char>(len & 0xff);
+        h[2] = static_cast<unsigned char>(len >> 8);
+        h[3] = static_cast<unsigned char>(~len & 0xff);
+        h[4] = static_cast<unsigned char>((~len >> 8) & 0xff);
+        planes[j] = h + 5;
+      } else {
+        planes[j] = coded_planes.data() + static_cast<std::size_t>(j - first_coded) * n + at;
+      }
+    }
+    detail::shuffle8(values + at, len, planes);
   }
-  const std::size_t room = static_cast<std::size_t>(out.data() + out.size() - p) - 4;
-  const std::size_t m = libdeflate_deflate_compress(c, shuffled + low, total - low, p, room);
+  for (int j = 0; j < first_coded; ++j)
+    for (std::size_t s = 0; s < segments; ++s)
+      adler = libdeflate_adler32(adler, block(j, s) + 5, std::min(kStored, n - s * kStored));
+  adler = libdeflate_adler32(adler, coded_planes.data(), coded);
+  unsigned char* p = block(first_coded, 0);
+  const std::size_t m = level > 1 ? libdeflate_deflate_compress(z, coded_planes.data(), coded, p, bound)
+                                  : detail::deflate_runs(coded_planes.data(), coded, cols, p);
   if (m == 0) return {};
   p += m;
-  const std::uint32_t adler = libdeflate_adler32(1, shuffled, total);
   *p++ = static_cast<unsigned char>(adler >> 24);
   *p++ = static_cast<unsigned char>(adler >> 16);
   *p++ = static_cast<unsigned char>(adler >> 8);
@@ -87,17 +97,14 @@ libdeflate_decompressor* decompressor() {
   return cache.d;
 }
 
-void unshuffle8(const unsigned char* src, std::size_t n, double* dst) {
-  unsigned char* d = reinterpret_cast<unsigned char*>(dst);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = 0; j < 8; ++j) d[i * 8 + j] = src[j * n + i];
-}
-
-/// One chunk of `n` values: raw for level 0; else shuffled, then the fast stream above when the
-/// chunk is at least 7/8 data (its NaN padding's low planes cost little stored), or libdeflate's
-/// zlib stream of everything when padding dominates (short runs: a few rows in a large chunk).
-EncodedChunk encode_chunk(const double* values, std::size_t n, std::size_t data_values, int level,
-                          std::vector<unsigned char>& shuffled) {
+/// One chunk of `n` values (`data_values` of them data, the rest NaN padding) of `cols` columns: raw
+/// for level 0; else a zlib stream of its byte planes (planes_stream). A chunk mostly of data keeps
+/// its six (level >= 2) or seven (level 1) low planes stored: close to noise in a history's doubles,
+/// deflate gains ~4 % on them at the price of most of its time. The high planes (sign, exponent,
+/// top of the mantissa) are coded. A chunk mostly of padding (short runs: a few rows in a large
+/// chunk) has all its planes coded.
+EncodedChunk encode_chunk(const double* values, std::size_t n, std::size_t cols, std::size_t data_values, int level,
+                          ByteBuffer& scratch) {
   EncodedChunk c;
   const std::size_t bytes = n * sizeof(double);
   if (level == 0) {
@@ -106,15 +113,9 @@ EncodedChunk encode_chunk(const double* values, std::size_t n, std::size_t data_
     std::memcpy(c.bytes.data(), values, bytes);
     return c;
   }
-  shuffled.resize(bytes);
-  shuffle8(values, n, shuffled.data());
-  if (8 * data_values >= 7 * n) {
-    c.bytes = zlib_stream_high_planes(shuffled.data(), n, level);
-  } else if (libdeflate_compressor* z = compressor(level)) {
-    c.bytes.resize(libdeflate_zlib_compress_bound(z, bytes));
-    const std::size_t m = libdeflate_zlib_compress(z, shuffled.data(), bytes, c.bytes.data(), c.bytes.size());
-    c.bytes.resize(m);
-  }
+  if (level == 1 && cols > 32768) level = 2;  // beyond deflate's longest distance: libdeflate's fastest
+  const bool mostly_data = 8 * data_values >= 7 * n;
+  c.bytes = planes_stream(values, n, cols, mostly_data ? (level == 1 ? 7 : 6) : 0, level, scratch);
   if (c.bytes.empty()) throw StoreError("", "libdeflate failed to compress a history chunk");
   return c;
 }
@@ -124,8 +125,8 @@ EncodedHistory encode_history(const RunHistory& history, int level, std::size_t 
   level = std::clamp(level, 0, 9);
   EncodedHistory out;
   out.arrays.reserve(history.arrays.size());
-  std::vector<unsigned char> shuffled;
-  std::vector<double> padded;
+  thread_local ByteBuffer shuffled;  // kept from run to run: no allocation per run
+  thread_local std::vector<double> padded;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (const auto& a : history.arrays) {
     if (a.data.size() != a.rows * a.cols)
@@ -147,7 +148,7 @@ EncodedHistory encode_history(const RunHistory& history, int level, std::size_t 
           std::copy(v, v + r * a.cols, padded.begin());
           v = padded.data();
         }
-        e.chunks.push_back(encode_chunk(v, n, r * a.cols, level, shuffled));
+        e.chunks.push_back(encode_chunk(v, n, a.cols, r * a.cols, level, shuffled));
       }
     out.arrays.push_back(std::move(e));
   }
@@ -179,7 +180,9 @@ RunHistory decode_history(const EncodedHistory& history) {
         throw StoreError("", "history array '" + e.name + "': chunk " + std::to_string(k) + " holds " +
                                  std::to_string(size) + " bytes, expected " + std::to_string(bytes));
       chunk.resize(n);
-      if (!(c.filter_mask & 0x1)) unshuffle8(p, n, chunk.data());  // shuffle applied
+      const unsigned char* planes[8];
+      for (int j = 0; j < 8; ++j) planes[j] = p + static_cast<std::size_t>(j) * n;
+      if (!(c.filter_mask & 0x1)) detail::unshuffle8(planes, n, chunk.data());  // shuffle applied
       else std::memcpy(chunk.data(), p, bytes);
       const std::size_t r = std::min(e.chunk_rows, e.rows - k * e.chunk_rows);
       a.data.insert(a.data.end(), chunk.begin(), chunk.begin() + static_cast<std::ptrdiff_t>(r * e.cols));

@@ -11,6 +11,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "store/record.hpp"
@@ -74,10 +75,32 @@ struct StoreOptions {
   bool durable = false;              ///< fsync around commits (power-loss safety; kill -9 safety needs none)
 };
 
+/// An allocator whose resize leaves new elements uninitialised (for buffers an encoder or a read
+/// fills completely: no zeroing of bytes about to be overwritten).
+template <class T>
+struct UninitializedAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UninitializedAllocator<U>;
+  };
+  UninitializedAllocator() = default;
+  template <class U>
+  UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+using ByteBuffer = std::vector<unsigned char, UninitializedAllocator<unsigned char>>;
+
 /// One HDF5 chunk of a history dataset, as its filter pipeline stores it: shuffle then deflate
 /// (filter_mask 0), or the raw little-endian rows (filter_mask kRawChunk: both filters skipped).
 struct EncodedChunk {
-  std::vector<unsigned char> bytes;
+  ByteBuffer bytes;
   std::uint32_t filter_mask = 0;
 };
 inline constexpr std::uint32_t kRawChunk = 0x3;
