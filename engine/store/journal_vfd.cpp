@@ -92,6 +92,12 @@ struct JFile {
   std::string path;
   std::map<std::uint64_t, unsigned char*> pages;  // page number -> kPage bytes of page_pool
   PagePool page_pool;
+  // Small writes past the committed size (new chunks, mostly) that continue one another, gathered
+  // into one pwrite of up to kGather bytes: a sweep with short histories writes several small
+  // chunks per run. Writes of kDirect bytes or more go straight to the file (no extra copy).
+  static constexpr std::size_t kGather = std::size_t{1} << 20, kDirect = std::size_t{64} << 10;
+  std::vector<unsigned char> gathered;
+  std::uint64_t gathered_at = 0;
   // Test hook (crash-safety tests only): KS_STORE_TEST_CRASH="<n>:<phase>" makes the process
   // _exit(86) during its n-th commit, phase = journal_half | journal_done | apply_half.
   long crash_commit = -1, commits = 0;
@@ -235,7 +241,31 @@ H5FD_t* j_open(const char* name, unsigned flags, hid_t fapl, haddr_t /*maxaddr*/
   return &f->pub;
 }
 
+/// Writes the gathered bytes; false (errno set) on an I/O error.
+bool write_gathered(JFile* f) {
+  if (f->gathered.empty()) return true;
+  const bool ok = write_all(f->fd, f->gathered.data(), f->gathered.size(), f->gathered_at);
+  f->gathered.clear();
+  return ok;
+}
+
+/// Writes [a, a + n) past the committed size: appended to the gathered bytes when it continues them
+/// and fits, else after writing those (directly when n >= kDirect).
+bool write_past_committed(JFile* f, const unsigned char* in, std::size_t n, std::uint64_t a) {
+  if (!f->gathered.empty() && a == f->gathered_at + f->gathered.size() && f->gathered.size() + n <= JFile::kGather) {
+    f->gathered.insert(f->gathered.end(), in, in + n);
+    return true;
+  }
+  if (!write_gathered(f)) return false;
+  if (n >= JFile::kDirect) return write_all(f->fd, in, n, a);
+  if (f->gathered.capacity() < JFile::kGather) f->gathered.reserve(JFile::kGather);
+  f->gathered.assign(in, in + n);
+  f->gathered_at = a;
+  return true;
+}
+
 bool commit_impl(JFile* f) {
+  if (!write_gathered(f)) return false;  // appended data first: the commit's new size covers it
   struct stat st{};
   if (::fstat(f->fd, &st) != 0) return false;
   const std::uint64_t new_size = std::max<std::uint64_t>(f->eof, static_cast<std::uint64_t>(st.st_size));
@@ -346,6 +376,12 @@ herr_t j_read(H5FD_t* file, H5FD_mem_t, hid_t, haddr_t addr, size_t size, void* 
   auto* f = reinterpret_cast<JFile*>(file);
   auto* out = static_cast<unsigned char*>(buffer);
   std::uint64_t a = addr;
+  if (!f->gathered.empty() && addr + size > f->gathered_at && addr < f->gathered_at + f->gathered.size() &&
+      !write_gathered(f)) {
+    set_error("write to " + f->path + " failed", errno);
+    f->poisoned = true;
+    return -1;
+  }
   while (size > 0) {
     if (a >= f->committed) {
       if (!read_all(f->fd, out, size, a)) return -1;
@@ -368,7 +404,7 @@ herr_t j_write(H5FD_t* file, H5FD_mem_t, hid_t, haddr_t addr, size_t size, const
   std::uint64_t a = addr;
   while (size > 0) {
     if (a >= f->committed) {
-      if (!write_all(f->fd, in, size, a)) {
+      if (!write_past_committed(f, in, size, a)) {
         set_error("write to " + f->path + " failed", errno);
         f->poisoned = true;
         return -1;
@@ -396,6 +432,11 @@ herr_t j_flush(H5FD_t* file, hid_t, hbool_t) {
 herr_t j_truncate(H5FD_t* file, hid_t, hbool_t) {
   auto* f = reinterpret_cast<JFile*>(file);
   if (f->readonly) return 0;
+  if (!write_gathered(f)) {
+    set_error("write to " + f->path + " failed", errno);
+    f->poisoned = true;
+    return -1;
+  }
   // Grow to the EOA when needed; never shrink below the committed size (committed readers need it).
   const std::uint64_t want = std::max<std::uint64_t>(f->eoa, f->committed);
   if (want > f->eof) {
