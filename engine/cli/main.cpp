@@ -1,4 +1,6 @@
 // kinesweep: the command-line front end (run, table4, schema; info and query read results files).
+#include <malloc.h>
+
 #include <CLI/CLI.hpp>
 #include <iostream>
 
@@ -11,6 +13,13 @@
 #include "store/store.hpp"
 
 int main(int argc, char** argv) {
+  // A sweep's histories travel as buffers of a few hundred KiB, made by the workers and freed by
+  // the writer thread. glibc's defaults return memory to the kernel once 128 KiB lie free at the
+  // heap's top and map every block over 128 KiB on its own, so such buffers' pages were faulted in
+  // (and zeroed by the kernel) again and again: with full histories, most of the system time beyond
+  // the write itself. Keep up to 64 MiB free, and map only blocks of 16 MiB or more.
+  mallopt(M_TRIM_THRESHOLD, 64 << 20);
+  mallopt(M_MMAP_THRESHOLD, 16 << 20);
   CLI::App app{"kinesweep: parameter-sweep studies of redundant manipulators"};
   app.set_version_flag("--version", std::string("kinesweep ") + KINESWEEP_VERSION);
   app.require_subcommand(1);
