@@ -211,6 +211,7 @@ void ResultsWriter::Impl::write_history_index() {
     if (fs.get() < 0 || H5Dwrite(*dsets[i], H5T_NATIVE_INT64, mspace, fs, H5P_DEFAULT, v[i].data()) < 0)
       fail(std::string("cannot write /histories/") + kIndex[i]);
   }
+  uncommitted_bytes += ids.size() * 3 * sizeof(std::int64_t);  // journaled until the commit, like the rows
   h.pending.clear();
 }
 
