@@ -104,31 +104,27 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
   std::vector<std::uint64_t> ids;
   for (std::uint64_t id = 0; id < total; ++id)
     if (owner[id] >= 0) ids.push_back(id);
-  const std::size_t chunk = 64 * static_cast<std::size_t>(threads);
-  std::vector<store::EncodedHistory> enc(chunk);
-  for (std::size_t at = 0; at < ids.size(); at += chunk) {
-    const std::size_t n = std::min(chunk, ids.size() - at);
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& r = *readers[owner[ids[at + i]]];
-      enc[i] = r.read_history_chunks(static_cast<std::int64_t>(ids[at + i]), level);
-    }
-    // The piece's rows, read from each shard that owns some of them (one read per column).
+  // Pieces of up to 4096 runs: each shard's rows of a piece in one range read per column (its runs
+  // in the piece, and any between them it does not own), then each run's history chunks.
+  constexpr std::size_t kPiece = 4096;
+  for (std::size_t at = 0; at < ids.size(); at += kPiece) {
+    const std::size_t n = std::min(kPiece, ids.size() - at);
     std::vector<Record> rows(n);
     for (std::size_t s = 0; s < readers.size(); ++s) {
-      std::vector<std::int64_t> mine;
-      std::vector<std::size_t> slot;
+      std::size_t first = n, last = 0;
       for (std::size_t i = 0; i < n; ++i)
+        if (owner[ids[at + i]] == static_cast<std::int32_t>(s)) first = std::min(first, i), last = i;
+      if (first == n) continue;
+      const auto from = static_cast<std::int64_t>(ids[at + first]);
+      std::vector<Record> got = readers[s]->read_rows(from, static_cast<std::int64_t>(ids[at + last]) - from + 1);
+      for (std::size_t i = first; i <= last; ++i)
         if (owner[ids[at + i]] == static_cast<std::int32_t>(s))
-          mine.push_back(static_cast<std::int64_t>(ids[at + i])), slot.push_back(i);
-      if (mine.empty()) continue;
-      std::vector<Record> got = readers[s]->read_rows(mine);
-      for (std::size_t k = 0; k < slot.size(); ++k) rows[slot[k]] = std::move(got[k]);
+          rows[i] = std::move(got[static_cast<std::size_t>(static_cast<std::int64_t>(ids[at + i]) - from)]);
     }
     for (std::size_t i = 0; i < n; ++i) {
       const std::uint64_t id = ids[at + i];
-      const Record& row = rows[i];
-      writer->write_run(static_cast<std::int64_t>(id), row, enc[i]);
-      enc[i] = {};
+      const store::EncodedHistory enc = readers[owner[id]]->read_history_chunks(static_cast<std::int64_t>(id), level);
+      writer->write_run(static_cast<std::int64_t>(id), rows[i], enc);
     }
   }
   writer->flush();
