@@ -95,7 +95,7 @@ struct JFile {
   // Small writes past the committed size (new chunks, mostly) that continue one another, gathered
   // into one pwrite of up to kGather bytes: a sweep with short histories writes several small
   // chunks per run. Writes of kDirect bytes or more go straight to the file (no extra copy).
-  static constexpr std::size_t kGather = std::size_t{1} << 20, kDirect = std::size_t{64} << 10;
+  static constexpr std::size_t kGather = std::size_t{1} << 20, kDirect = std::size_t{16} << 10;
   std::vector<unsigned char> gathered;
   std::uint64_t gathered_at = 0;
   // Test hook (crash-safety tests only): KS_STORE_TEST_CRASH="<n>:<phase>" makes the process
