@@ -11,6 +11,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -75,27 +76,32 @@ struct StoreOptions {
   bool durable = false;              ///< fsync around commits (power-loss safety; kill -9 safety needs none)
 };
 
-/// An allocator whose resize leaves new elements uninitialised (for buffers an encoder or a read
-/// fills completely: no zeroing of bytes about to be overwritten).
-template <class T>
-struct UninitializedAllocator : std::allocator<T> {
+namespace detail {
+/// Blocks of `n` bytes for ByteBuffer (byte_buffer.cpp): blocks of 16 KiB and more come from a
+/// cache shared by all threads, in power-of-two sizes, keeping up to 64 MiB of freed blocks.
+void* byte_buffer_allocate(std::size_t n);
+void byte_buffer_deallocate(void* p, std::size_t n) noexcept;
+}  // namespace detail
+
+/// The allocator of ByteBuffer: resize leaves new bytes uninitialised (buffers an encoder or a read
+/// fills completely), and the blocks are recycled (a sweep's history chunks are made by the workers
+/// and freed by the writer thread, run after run; from malloc, their pages went back to the kernel
+/// and were faulted in, zeroed, again for every run).
+struct ByteAllocator {
+  using value_type = unsigned char;
+  using is_always_equal = std::true_type;
   template <class U>
   struct rebind {
-    using other = UninitializedAllocator<U>;
+    static_assert(std::is_same_v<U, unsigned char>, "ByteAllocator allocates bytes only");
+    using other = ByteAllocator;
   };
-  UninitializedAllocator() = default;
-  template <class U>
-  UninitializedAllocator(const UninitializedAllocator<U>&) noexcept {}
-  template <class U>
-  void construct(U* p) noexcept {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
+  unsigned char* allocate(std::size_t n) { return static_cast<unsigned char*>(detail::byte_buffer_allocate(n)); }
+  void deallocate(unsigned char* p, std::size_t n) noexcept { detail::byte_buffer_deallocate(p, n); }
+  void construct(unsigned char* p) noexcept { ::new (static_cast<void*>(p)) unsigned char; }
+  void construct(unsigned char* p, unsigned char v) noexcept { *p = v; }
+  friend bool operator==(const ByteAllocator&, const ByteAllocator&) noexcept { return true; }
 };
-using ByteBuffer = std::vector<unsigned char, UninitializedAllocator<unsigned char>>;
+using ByteBuffer = std::vector<unsigned char, ByteAllocator>;
 
 /// One HDF5 chunk of a history dataset, as its filter pipeline stores it: shuffle then deflate
 /// (filter_mask 0), or the raw little-endian rows (filter_mask kRawChunk: both filters skipped).
