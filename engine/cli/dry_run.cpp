@@ -92,7 +92,7 @@ Written write_samples(const std::string& path, const Study& study, const StudySc
   Written out;
   const auto t0 = Clock::now();
   {
-    auto w = store::ResultsWriter::create(path, store_meta(study), schema.columns,
+    auto w = store::ResultsWriter::create(path, store_meta(study, study.histories), schema.columns,
                                           static_cast<std::int64_t>(std::max<std::size_t>(rows, 1)),
                                           {.overwrite = true});
     for (std::size_t i = 0; i < rows && !samples.empty(); ++i) {

@@ -56,30 +56,6 @@ std::string path_chars_problem(const std::string& path) {
   return "";
 }
 
-/// "full", "none", "every=N" -> policy; false when malformed.
-bool parse_histories(const std::string& s, HistoryPolicy& p) {
-  if (s == "full") {
-    p = {HistoryPolicy::Mode::full, 1};
-    return true;
-  }
-  if (s == "none") {
-    p = {HistoryPolicy::Mode::none, 0};
-    return true;
-  }
-  if (s.rfind("every=", 0) == 0) {
-    try {
-      std::size_t used = 0;
-      const int n = std::stoi(s.substr(6), &used);
-      if (n >= 1 && used == s.size() - 6) {
-        p = {HistoryPolicy::Mode::every, n};
-        return true;
-      }
-    } catch (...) {
-    }
-  }
-  return false;
-}
-
 /// Why `path` cannot name a results file ("" when it can): the file is HDF5, so its name ends in
 /// .h5 or .hdf5 (a .csv or .json name would hide what it holds; `kinesweep query` exports those).
 std::string output_name_problem(const std::string& path) {
@@ -137,7 +113,7 @@ RunArgs& add_run_command(CLI::App& app) {
   c->add_flag("--overwrite", a.overwrite, "replace an existing results file");
   c->add_flag("--dry-run", a.dry_run, "print the output path, runs per block, estimated size and time (from sample runs); write nothing");
   c->add_option("--histories", a.histories, "full | every=N | none (default: the study's)");
-  c->add_option("--compression", a.compression, "deflate level of the histories, after HDF5's shuffle (default 1; 0: raw chunks, no filter)")
+  c->add_option("--compression", a.compression, "history compression, read by HDF5's shuffle and deflate filters (default 1: runs of the top byte plane coded, the rest stored; 2-9: libdeflate on the two high planes at that level; 0: raw chunks, no filter)")
       ->check(CLI::Range(0, 9));
   c->add_option("--max-runs", a.max_runs, "the most runs a study may ask for (default 50000000; a study's max_runs may only lower it)")
       ->check(CLI::PositiveNumber);
@@ -157,7 +133,7 @@ int run_command(const RunArgs& a) {
     return 2;
   }
   HistoryPolicy histories = study.histories;
-  if (!a.histories.empty() && !parse_histories(a.histories, histories)) {
+  if (!a.histories.empty() && !HistoryPolicy::parse(a.histories, histories)) {
     std::cerr << "kinesweep run: --histories " << a.histories << ": expected full, none or every=N (N >= 1)\n";
     return 2;
   }
@@ -190,6 +166,7 @@ int run_command(const RunArgs& a) {
   r.options.threads = a.threads;
   r.options.lanes = a.lanes;
   r.options.histories = histories;
+  r.histories_given = !a.histories.empty();
   r.options.compression = a.compression;
   r.options.stop = &g_stop;
   ProgressDisplay progress(a.quiet);

@@ -75,7 +75,7 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
   store::StoreOptions so;
   so.flush_every_runs = 0;
   so.flush_every_seconds = 30.0;
-  OpenedResults opened = open_results(study, schema, out, true, so);
+  OpenedResults opened = open_results(study, schema, out, true, so, run.options.histories, false);
   std::unique_ptr<store::ResultsWriter> writer = std::move(opened.writer);
   PreviousRuns all;
   if (opened.previous) all = std::move(*opened.previous);
@@ -161,7 +161,7 @@ class MpiBackend final : public SweepBackend {
   }
   std::string resume_command(const RunRequest& r) const override {
     return "mpirun -np " + std::to_string(size_) + " " + r.program + " run " + shell_word(r.study_arg) + " -o " +
-           shell_word(r.output) + " --resume";
+           shell_word(r.output) + " --resume" + histories_argument(r);
   }
 
   int open(const Study& study, const StudySchema& schema, const RunRequest& r, std::ostream& err) override {
@@ -203,10 +203,13 @@ class MpiBackend final : public SweepBackend {
       so.flush_every_runs = 512;
       so.flush_every_seconds = 2.0;
       const std::string sp = shard_path(r.output, rank_);
-      if (fs::exists(sp))
+      if (fs::exists(sp)) {
         shard_ = std::move(store::ResultsWriter::open_for_resume(sp, study.sha256, so).writer);
-      else
-        shard_ = store::ResultsWriter::create(sp, store_meta(study), schema.columns, static_cast<std::int64_t>(total), so);
+        require_recorded_histories(*shard_, sp, r.options.histories);
+      } else {
+        shard_ = store::ResultsWriter::create(sp, store_meta(study, r.options.histories), schema.columns,
+                                              static_cast<std::int64_t>(total), so);
+      }
     } catch (const std::exception& e) {  // every rank must reach the Allreduce
       fail(e.what());
       local = 1;

@@ -133,7 +133,12 @@ EditedResume begin_edited_resume(const Study& study, const StudySchema& schema, 
   const store::ResultsReader file(out);
   store::require_resumable(out, file.meta());
   const Study before = stored_study(file, out);
-  const auto was = run_context(before, before.histories, file.meta().engine_version);
+  // The policy the old runs were written with: the one the file records (a --histories given then),
+  // else its study's.
+  HistoryPolicy was_histories = before.histories;
+  if (!file.meta().histories.empty() && !HistoryPolicy::parse(file.meta().histories, was_histories))
+    refuse(out, "the file records an unknown history policy '" + file.meta().histories + "'");
+  const auto was = run_context(before, was_histories, file.meta().engine_version);
   const auto now = run_context(study, options.histories);
   if (const std::string what = context_changes(was, now); !what.empty()) refuse(out, what);
   if (file.n_runs() != static_cast<std::int64_t>(before.run_count()))
@@ -158,7 +163,7 @@ EditedResume begin_edited_resume(const Study& study, const StudySchema& schema, 
   r.staging = store::staging_path(out);
   store::StoreOptions so = options.store;
   so.overwrite = false;
-  r.writer = store::ResultsWriter::create(r.staging, store_meta(study), schema.columns,
+  r.writer = store::ResultsWriter::create(r.staging, store_meta(study, options.histories), schema.columns,
                                           static_cast<std::int64_t>(study.run_count()), so);
   try {
     copy_runs(file, study, schema, pairs, options.compression, *r.writer);

@@ -14,8 +14,9 @@ namespace ks {
 
 namespace fs = std::filesystem;
 
-store::StoreMeta store_meta(const Study& study) {
+store::StoreMeta store_meta(const Study& study, const HistoryPolicy& histories) {
   store::StoreMeta meta;
+  meta.histories = histories.str();
   meta.study_name = study.name;
   meta.study_path = study.file;
   meta.study_text = study.text;
@@ -66,18 +67,34 @@ void require_same_columns(const std::string& out, const std::vector<ColumnSpec>&
 }
 }  // namespace
 
+void require_recorded_histories(const store::ResultsWriter& writer, const std::string& path,
+                                const HistoryPolicy& histories) {
+  const std::string was = writer.recorded_histories();
+  if (!was.empty() && was != histories.str())
+    throw store::StoreError(path, "its runs were written with histories = " + was + ", this run asks for " +
+                                      histories.str() + " ([study] histories or --histories): resume with --histories " +
+                                      was + " (refusing to resume: rerun with --overwrite to replace the file)");
+}
+
+std::string histories_argument(const RunRequest& request) {
+  return request.histories_given ? " --histories " + request.options.histories.str() : "";
+}
+
 OpenedResults open_results(const Study& study, const StudySchema& schema, const std::string& out, bool resume,
-                           const store::StoreOptions& so) {
+                           const store::StoreOptions& so, const HistoryPolicy& histories, bool adopt_recorded) {
   OpenedResults r;
+  r.histories = histories;
   if (resume && fs::exists(out)) {
     r.writer = std::move(store::ResultsWriter::open_for_resume(out, study.sha256, so).writer);
+    if (!adopt_recorded || !HistoryPolicy::parse(r.writer->recorded_histories(), r.histories))
+      require_recorded_histories(*r.writer, out, histories);
     require_same_columns(out, r.writer->columns(), schema);
     r.previous = previous_runs(*r.writer);
     return r;
   }
   if (!fs::path(out).parent_path().empty()) fs::create_directories(fs::path(out).parent_path());
   check_free_space(out, schema, study.run_count());
-  r.writer = store::ResultsWriter::create(out, store_meta(study), schema.columns,
+  r.writer = store::ResultsWriter::create(out, store_meta(study, histories), schema.columns,
                                          static_cast<std::int64_t>(study.run_count()), so);
   return r;
 }
@@ -122,8 +139,9 @@ class LocalBackend final : public SweepBackend {
       previous_ = std::move(edited_->previous);
       return 0;
     }
-    OpenedResults o = open_results(study, schema, out, r.resume, so);
+    OpenedResults o = open_results(study, schema, out, r.resume, so, r.options.histories, !r.histories_given);
     writer_ = std::move(o.writer);
+    histories_ = o.histories;
     previous_ = std::move(o.previous);
     return 0;
   }
@@ -132,6 +150,7 @@ class LocalBackend final : public SweepBackend {
                     std::ostream&) override {
     SweepResult res;
     SweepOptions o = r.options;
+    if (!edited_) o.histories = histories_;
     if (r.quiet) o.on_progress = nullptr;
     if (edited_)
       out << "the study differs from the one in " << r.output << ": " << edited_->reused << " of its "
@@ -151,7 +170,8 @@ class LocalBackend final : public SweepBackend {
            ") would replace it only once complete, and is deleted";
   }
   std::string resume_command(const RunRequest& r) const override {
-    return r.program + " run " + shell_word(r.study_arg) + " -o " + shell_word(r.output) + " --resume";
+    return r.program + " run " + shell_word(r.study_arg) + " -o " + shell_word(r.output) + " --resume" +
+           histories_argument(r);
   }
   void publish(const RunRequest& r) override {
     if (!edited_) return;
@@ -169,6 +189,7 @@ class LocalBackend final : public SweepBackend {
 
  private:
   std::optional<EditedResume> edited_;  // a resume of an edited study: the new file, beside the old one
+  HistoryPolicy histories_;  // the policy of a new or plainly resumed file (open_results)
   std::optional<PreviousRuns> previous_;
   std::unique_ptr<store::ResultsWriter> writer_;
 };

@@ -15,6 +15,9 @@ struct RunRequest {
   std::string program = "kinesweep";  ///< the command that runs kinesweep, one shell word (for the hint)
   std::string output;      ///< the results file
   bool resume = false, overwrite = false, quiet = false;
+  /// options.histories was given on the command line (--histories); otherwise it is the study's,
+  /// and a plain resume takes the policy the file records instead.
+  bool histories_given = false;
   /// threads (per process or rank; 0: all cores, shared fairly between the ranks on a node),
   /// histories, compression, stop (e.g. set by SIGINT), on_progress (the whole job's progress).
   SweepOptions options;
@@ -25,7 +28,12 @@ struct RunRequest {
 /// rank: 0 done, 1 results file problem, 130 interrupted.
 int run_study(const Study& study, const RunRequest& request, std::ostream& out, std::ostream& err);
 
-/// The StoreMeta of a study's results file (or shard).
-store::StoreMeta store_meta(const Study& study);
+/// The StoreMeta of a study's results file (or shard) whose runs are written with `histories`.
+store::StoreMeta store_meta(const Study& study, const HistoryPolicy& histories);
+
+/// Throws store::StoreError when the results file `path` open in `writer` records another history
+/// policy than `histories` (a resume must not mix two in one file; files that record none pass).
+void require_recorded_histories(const store::ResultsWriter& writer, const std::string& path,
+                                const HistoryPolicy& histories);
 
 }  // namespace ks

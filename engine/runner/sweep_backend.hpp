@@ -58,11 +58,18 @@ bool launched_under_mpi();
 struct OpenedResults {
   std::unique_ptr<store::ResultsWriter> writer;
   std::optional<PreviousRuns> previous;  ///< set when an existing file was reopened
+  HistoryPolicy histories;               ///< the policy to write the runs with
 };
-/// Reopen `out` when `resume` and it exists (its runs read first), else create it (and its folder).
-/// Throws store::StoreError (another study, another format version, unwritable, ...).
+/// Reopen `out` when `resume` and it exists (its runs read first), else create it (and its folder)
+/// recording `histories`. A reopened file keeps the policy it records: taken when `adopt_recorded`
+/// (no --histories given), else it must be `histories`. Throws store::StoreError (another study,
+/// another format version, another recorded history policy, unwritable, ...).
 OpenedResults open_results(const Study& study, const StudySchema& schema, const std::string& out, bool resume,
-                           const store::StoreOptions& options);
+                           const store::StoreOptions& options, const HistoryPolicy& histories,
+                           bool adopt_recorded);
+
+/// " --histories X" when the request gave --histories X (so a printed resume command repeats it).
+std::string histories_argument(const RunRequest& request);
 
 /// "exists; use --resume ... or --overwrite ..." when `out` (or its `what`) exists and neither was
 /// asked for; "" otherwise.

@@ -38,6 +38,7 @@ void ResultsReader::Impl::load() {
   meta.study_sha256 = read_str_attr(f, "study_sha256");
   meta.created = read_str_attr(f, "created");
   meta.study_name = read_str_attr(f, "study_name");
+  meta.histories = read_str_attr(f, "histories");
   Hid study(check(H5Gopen2(f, "study", H5P_DEFAULT), path, "open /study"));
   meta.study_path = read_str_attr(study, "path");
   meta.study_text = read_text_dataset(study, "text", path);

@@ -58,6 +58,9 @@ struct StoreMeta {
   std::string robot_text;    ///< its text verbatim (/study/robot; written only when non-empty)
   std::string engine_version = KINESWEEP_VERSION;
   std::string created;       ///< ISO 8601 UTC; filled at creation when empty
+  /// The history policy the runs are written with (root attribute "histories": full, every=N or
+  /// none; written when not empty; "" in files from before it was recorded).
+  std::string histories;
   std::string format = kFormatName;
   std::int64_t format_version = kFormatVersion;
 };
@@ -246,6 +249,8 @@ class ResultsWriter {
 
   const std::string& path() const;
   const std::vector<ColumnSpec>& columns() const;
+  /// The history policy recorded in the file (root attribute "histories"; "" when it has none).
+  std::string recorded_histories() const;
   std::int64_t n_runs() const;
   bool is_done(std::int64_t run_id) const;  ///< committed or pending
   /// Rows `first` .. `first + count` (clamped to n_runs) as they are in the file, pending rows

@@ -93,6 +93,7 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
   write_str_attr(file, "study_sha256", meta.study_sha256);
   write_str_attr(file, "created", meta.created.empty() ? now_iso8601() : meta.created);
   write_str_attr(file, "study_name", meta.study_name);
+  if (!meta.histories.empty()) write_str_attr(file, "histories", meta.histories);
 
   Hid study(check(H5Gcreate2(file, "study", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /study"));
   write_str_attr(study, "path", meta.study_path);

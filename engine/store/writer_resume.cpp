@@ -70,6 +70,11 @@ void require_resumable(const std::string& path, const StoreMeta& meta) {
   require_resumable_format(path, {meta.format, meta.engine_version, meta.format_version});
 }
 
+std::string ResultsWriter::recorded_histories() const {
+  QuietHdf5 quiet;
+  return read_str_attr(impl_->file, "histories");
+}
+
 ResultsWriter::Resumed ResultsWriter::open_for_resume(const std::string& path, const std::string& expected_sha256,
                                                       const StoreOptions& options) {
   QuietHdf5 quiet;

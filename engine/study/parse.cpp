@@ -2,6 +2,7 @@
 // parts of the Parser are listed in study/parser.hpp.
 #include <algorithm>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "study/parser.hpp"
@@ -16,6 +17,22 @@ std::string HistoryPolicy::str() const {
     case Mode::every: return "every=" + std::to_string(stride);
   }
   return "?";
+}
+
+bool HistoryPolicy::parse(const std::string& s, HistoryPolicy& p) {
+  if (s == "full" || s == "none") {
+    p = s == "full" ? HistoryPolicy{Mode::full, 1} : HistoryPolicy{Mode::none, 0};
+    return true;
+  }
+  if (s.rfind("every=", 0) != 0 || s.size() == 6 || s.size() > 15) return false;
+  long n = 0;
+  for (std::size_t i = 6; i < s.size(); ++i) {
+    if (s[i] < '0' || s[i] > '9') return false;
+    n = n * 10 + (s[i] - '0');
+  }
+  if (n < 1 || n > std::numeric_limits<int>::max()) return false;
+  p = {Mode::every, static_cast<int>(n)};
+  return true;
 }
 
 std::size_t Study::block_index(std::string_view n) const {

@@ -66,6 +66,8 @@ struct HistoryPolicy {
   Mode mode = Mode::full;
   int stride = 1;  ///< every=N: N (full: 1; none: 0)
   std::string str() const;  ///< "full", "every=10", "none"
+  /// "full", "none", "every=N" (N >= 1) -> policy; false (p unchanged) when malformed.
+  static bool parse(const std::string& s, HistoryPolicy& p);
 };
 
 struct StudyTask {

@@ -223,6 +223,32 @@ class ResumeEdited(TempDirTest):
         self.refused("# histories off from now on\n" + BASE, "--histories", "none",
                      expect=["the settings changed: [study] histories: every=50 -> none"])
 
+    def test_a_histories_option_given_then_is_remembered(self):
+        # The old file was written with --histories every=25 (its study says every=50): resuming an
+        # edited study with the same option reuses every run, since the file records the policy.
+        out = os.path.join(self.dir, "edit.h5")
+        r = run("run", self.study("old", BASE), "-o", out, "-q", "--histories", "every=25")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with h5py.File(out, "r") as f:
+            self.assertEqual(f.attrs["histories"], "every=25")
+        edited = "# commented\n" + BASE
+        r = run("run", self.study("edit", edited), "-o", out, "-q", "--resume", "--histories", "every=25")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(computed(r.stdout), (0, 30))
+        with h5py.File(out, "r") as f:
+            self.assertEqual(f.attrs["histories"], "every=25")
+
+    def test_plain_resume_with_another_histories_option_is_refused(self):
+        out = self.old_file(BASE)
+        before = file_sha(out)
+        r = run("run", self.study("old", BASE), "-o", out, "-q", "--resume", "--histories", "full")
+        self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+        self.assertIn("its runs were written with histories = every=50, this run asks for full", r.stderr)
+        self.assertIn("resume with --histories every=50", r.stderr)
+        self.assertEqual(file_sha(out), before)
+        r = run("run", self.study("old", BASE), "-o", out, "-q", "--resume", "--histories", "every=50")
+        self.assertEqual(r.returncode, 0, r.stderr)
+
     def test_the_defaults_written_out_are_no_change(self):
         edited = BASE + "\n[robot]\ng = 9.81\n[task]\ndt = 1e-3\nintegrator = \"semi_implicit_euler\"\n"
         out, old, r = self.old_and_edited(BASE, edited)
