@@ -298,6 +298,7 @@ int run_info(const InfoArgs& args) {
   }
   os << "engine      kinesweep " << m.engine_version << "; format " << m.format << " v" << m.format_version
      << "; created " << m.created << '\n';
+  if (!m.histories.empty()) os << "histories   " << m.histories << "  (the policy the runs were written with)\n";
   if (m.format_version == 1)
     os << "note        format v" << m.format_version << " stores no column roles: taken from this kinesweep's "
        << "tables (kinesweep run --overwrite rewrites the file as v" << store::kFormatVersion << ")\n";
