@@ -14,7 +14,6 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -29,54 +28,12 @@
 #include <vector>
 
 #include "store/journal_format.hpp"
+#include "store/journal_pages.hpp"
 
 namespace ks::store::detail {
 namespace {
 
 using namespace journal;  // the on-disk layout and its file I/O (journal_format.cpp)
-
-// ------------------------------------------------------------------------------------------------
-/// The memory of the overlay's pages: blocks mapped for them alone (anonymous mmap), reused from
-/// one commit to the next, and unmapped at a commit beyond the first kKeepBlocks. Pages allocated one
-/// by one from malloc would stay, once freed, in the arena of whichever thread wrote them (a sweep
-/// writes from any of its threads), each arena keeping the footprint of its largest overlay: the
-/// resident memory then grew with the length of a sweep although the overlay never holds more than
-/// the pages of one commit.
-class PagePool {
- public:
-  PagePool() = default;
-  PagePool(const PagePool&) = delete;
-  PagePool& operator=(const PagePool&) = delete;
-  ~PagePool() {
-    for (unsigned char* b : blocks_) ::munmap(b, kBlockBytes);
-  }
-  /// kPage bytes, valid until reset(); nullptr when the system refuses memory.
-  unsigned char* get() {
-    if (used_ == kBlockPages) ++block_, used_ = 0;
-    if (block_ == blocks_.size()) {
-      void* b = ::mmap(nullptr, kBlockBytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-      if (b == MAP_FAILED) return nullptr;
-      blocks_.push_back(static_cast<unsigned char*>(b));
-    }
-    return blocks_[block_] + kPage * used_++;
-  }
-  /// Takes every page back (they are invalid afterwards); unmaps the blocks beyond kKeepBlocks.
-  void reset() {
-    while (blocks_.size() > kKeepBlocks) {
-      ::munmap(blocks_.back(), kBlockBytes);
-      blocks_.pop_back();
-    }
-    block_ = used_ = 0;
-  }
-
- private:
-  static constexpr std::size_t kBlockPages = 256, kBlockBytes = kBlockPages * kPage;  // 1 MiB blocks
-  /// Kept across commits: the overlay of a commit of the writer's usual size (it commits once 4 MiB
-  /// of rows wait) plus the metadata HDF5 rewrites with them.
-  static constexpr std::size_t kKeepBlocks = 8;
-  std::vector<unsigned char*> blocks_;
-  std::size_t block_ = 0, used_ = 0;  // the block pages are handed out of, and its pages handed out
-};
 
 struct JFile {
   H5FD_t pub;  // must be first
