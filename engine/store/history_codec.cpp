@@ -125,7 +125,7 @@ EncodedHistory encode_history(const RunHistory& history, int level, std::size_t 
   level = std::clamp(level, 0, 9);
   EncodedHistory out;
   out.arrays.reserve(history.arrays.size());
-  thread_local ByteBuffer shuffled;  // kept from run to run: no allocation per run
+  thread_local ByteBuffer coded_planes;  // the planes to code, kept from run to run: no allocation per run
   thread_local std::vector<double> padded;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (const auto& a : history.arrays) {
@@ -148,7 +148,7 @@ EncodedHistory encode_history(const RunHistory& history, int level, std::size_t 
           std::copy(v, v + r * a.cols, padded.begin());
           v = padded.data();
         }
-        e.chunks.push_back(encode_chunk(v, n, a.cols, r * a.cols, level, shuffled));
+        e.chunks.push_back(encode_chunk(v, n, a.cols, r * a.cols, level, coded_planes));
       }
     out.arrays.push_back(std::move(e));
   }
