@@ -33,7 +33,7 @@ import kshistory
 import kslive
 from kssolutions import cluster_solutions  # noqa: F401 (part of this module's interface)
 from kstypes import FormatVersionError  # noqa: F401 (the same)
-from kstypes import IK_STATUSES, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s  # noqa: F401 (the same)
+from kstypes import IK_STATUSES, STATUS_COLOURS, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s  # noqa: F401 (the same)
 
 RAD2DEG = 180.0 / np.pi
 FORMAT_VERSIONS = (2, 3)  # the results formats this module reads (engine/store/FORMAT.md)

@@ -5,9 +5,15 @@ Run with Debian's interpreter: /usr/bin/python3.
 """
 import numpy as np
 
-TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged", "undersampled"]
+TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged", "undersampled", "off_path",
+                       "out_of_limits"]
 IK_STATUSES = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution",
                "out_of_limits"]
+# The colour of each failed status in every plot and the report (good runs are drawn by their metric).
+STATUS_COLOURS = {"unreachable_start": "#b0b0b0", "singular": "#7b3294", "diverged": "#202020",
+                  "undersampled": "#8c6d31", "off_path": "#c51b7d",
+                  "stalled": "#e08214", "max_iter": "#d7191c", "cycle": "#f4a582", "unsupported": "#6a6a6a",
+                  "no_solution": "#8f8f8f", "out_of_limits": "#fdae61"}
 
 
 class FormatVersionError(ValueError):

@@ -28,10 +28,7 @@ METRIC_LABELS = {"E": "E (mean ‖τ‖)", "E_M": "E_M (mean ‖τ‖ in M⁻¹ 
                  "iterations": "iterations", "convergence": "convergence fraction", "error": "final ‖F‖",
                  "min_manipulability": "min manipulability", "max_tracking_error": "max tracking error"}
 MAX_PANELS = 6  # small multiples: at most this many panels, one per value of a categorical dim
-STATUS_COLOURS = {"unreachable_start": "#b0b0b0", "singular": "#7b3294", "diverged": "#202020",
-                  "undersampled": "#8c6d31",
-                  "stalled": "#e08214", "max_iter": "#d7191c", "cycle": "#f4a582",
-                  "unsupported": "#6a6a6a", "no_solution": "#b0b0b0", "out_of_limits": "#fdae61"}
+STATUS_COLOURS = ksread.STATUS_COLOURS
 
 
 def parse_args(argv=None):

@@ -6,14 +6,11 @@ import math
 
 import numpy as np
 
+from kstypes import STATUS_COLOURS  # noqa: F401 (used below)
 from report_page import esc, fmt
 
 MAX_FRAMES = 24      # facets / dropdown entries per figure; further dims are held at the best cell
 MAX_FACETS = 4       # up to this many frames side by side, more in a dropdown
-STATUS_COLOURS = {"unreachable_start": "#b0b0b0", "singular": "#7b3294", "diverged": "#202020",
-                  "undersampled": "#8c6d31",
-                  "stalled": "#e08214", "max_iter": "#d7191c", "cycle": "#f4a582", "unsupported": "#6a6a6a",
-                  "no_solution": "#8f8f8f", "out_of_limits": "#fdae61"}
 METRIC_LABELS = {"E": "E (mean ‖τ‖)", "iterations": "iterations to converge", "tau_inf": "‖τ‖∞"}
 
 

@@ -5,7 +5,9 @@
 // revolute joints take the fixed-size run of methods/planar_chain_run.hpp instead.
 #include "methods/chain_trajectory.hpp"
 #include "methods/run_sums.hpp"
+#include "methods/sample_sums.hpp"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -57,6 +59,27 @@ struct Evaluation {
   double w2 = 0;           // det(Jt Jt^T) (local methods); unused by the non-redundant solve
 };
 
+/// Where the path wants the tip at one instant (closed-loop feedback and the orientation error): its
+/// position and velocity [m, m/s], for planar_pose the tip angle, its rate and the arm's angle at the
+/// state evaluated [rad, rad/s], for spatial_pose the orientation held (the start's).
+struct Desired {
+  Eigen::Vector3d p, v;
+  double alpha = 0, alpha_v = 0, alpha_now = 0;
+  const Eigen::Matrix3d* R = nullptr;
+};
+
+/// The orientation error vector of R against Rd, 1/2 sum_k r_k x rd_k (zero when R = Rd; for small
+/// errors the rotation vector from R to Rd) [rad].
+inline Eigen::Vector3d orientation_error(const Eigen::Matrix3d& R, const Eigen::Matrix3d& Rd) {
+  return 0.5 * (R.col(0).cross(Rd.col(0)) + R.col(1).cross(Rd.col(1)) + R.col(2).cross(Rd.col(2)));
+}
+/// The angle of the rotation from Rd to R [rad].
+inline double orientation_angle(const Eigen::Matrix3d& R, const Eigen::Matrix3d& Rd) {
+  const Eigen::Matrix3d E = Rd.transpose() * R;
+  const Eigen::Vector3d w(E(2, 1) - E(1, 2), E(0, 2) - E(2, 0), E(1, 0) - E(0, 1));
+  return std::atan2(0.5 * w.norm(), 0.5 * (E.trace() - 1.0));
+}
+
 template <TaskSpace S, Resolution R>
 class ChainResolver {
  public:
@@ -73,12 +96,35 @@ class ChainResolver {
     return task_of(p.acceleration(i), p.segment(i), p.time(i));
   }
 
-  /// Joint accelerations for task acceleration xdd at (q, qd); fills every intermediate in `e`.
+  /// Where the path wants the tip at time t on `segment` (closed loop, orientation error).
+  void desired(double t, std::size_t segment, Desired& d) const {
+    const PathSample<3> x = path_.sample_on(segment, t);
+    d.p = x.p;
+    d.v = x.v;
+    if constexpr (S == TaskSpace::planar_pose) {
+      const PathSample<1> a = alpha_->sample_on(segment, t);
+      d.alpha = a.p[0];
+      d.alpha_v = a.v[0];
+    }
+  }
+
+  /// Joint accelerations for task acceleration xdd at (q, qd); fills every intermediate in `e`. With
+  /// `fb` (closed loop), xdd + K_D (path velocity - J qd) + K_P (path - tip) is commanded instead.
   /// Returns false when the task Jacobian is singular.
-  bool evaluate(const TaskVec<m>& xdd, const VecN& q, const VecN& qd, Evaluation<m>& e) {
+  bool evaluate(const TaskVec<m>& xdd, const VecN& q, const VecN& qd, Evaluation<m>& e, const Desired* fb = nullptr) {
     evaluate_dynamics(chain_, data_, q, qd, e.st);
     select_task_rows<S>(e.st.J, e.Jt);
-    const TaskVec<m> b = xdd - select_task_rows<S>(e.st.bias);
+    TaskVec<m> b = xdd - select_task_rows<S>(e.st.bias);
+    if (fb) {
+      constexpr int P = position_rows(S);
+      const TaskVec<m> xd = e.Jt * qd;
+      b.template head<P>() += o_.clik_kd * (fb->v.template head<P>() - xd.template head<P>()) +
+                              o_.clik_kp * (fb->p.template head<P>() - e.st.tip.p.template head<P>());
+      if constexpr (S == TaskSpace::planar_pose)
+        b[2] += o_.clik_kd * (fb->alpha_v - xd[2]) + o_.clik_kp * (fb->alpha - fb->alpha_now);
+      if constexpr (S == TaskSpace::spatial_pose)
+        b.template tail<3>() += -o_.clik_kd * xd.template tail<3>() + o_.clik_kp * orientation_error(e.st.tip.R, *fb->R);
+    }
     const int n = static_cast<int>(q.size());
     e.Mf.compute(e.st.M, n);
     if constexpr (R == Resolution::nonredundant) {
@@ -119,16 +165,6 @@ class ChainResolver {
   VecN u_;  // c + k g
 };
 
-TrajectoryMetrics unreachable(int n) {
-  TrajectoryMetrics out;
-  out.status = RunStatus::unreachable_start;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  out.E = out.E_M = out.min_manipulability = out.torque_sq_integral = out.power_sq_integral = nan;
-  out.max_tracking_error = out.final_alpha = nan;
-  out.tau_inf.setConstant(n, nan);
-  return out;
-}
-
 /// The loop of one run from the start q_start at rest.
 template <TaskSpace S, Resolution R>
 TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_start, const TrajectoryOptions& o,
@@ -140,55 +176,75 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
   const int dof = chain.dof();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::optional<PlanarAngle> angle = is_planar(S) ? std::optional<PlanarAngle>(PlanarAngle(chain)) : std::nullopt;
+  const bool closed = o.closed_loop();
+  constexpr bool oriented = S == TaskSpace::planar_pose || S == TaskSpace::spatial_pose;
+  const LimitTable limits = LimitTable::of(chain);
+  RunShape shape{dof, oriented, false, limits.any() ? &limits : nullptr};
+  bool prismatic[kMaxJoints];
+  for (int j = 0; j < dof; ++j) shape.prismatic |= prismatic[j] = chain.joints[j].type == JointType::prismatic;
 
-  TrajectoryMetrics out;
+  RunStatus status = RunStatus::ok;
   ChainResolver<S, R> resolver(chain, path, o, alpha_profile);
   Evaluation<m> e, s;  // e: at the sample; s: RK4 stages
-  VecN q = q_start, qd = VecN::Zero(dof), tau(dof), z(dof), inf = VecN::Zero(dof);
-  VecN k1q, k1v, k2q, k2v, k3q, k3v, k4q, k4v;
-  double sumE = 0, sumEM = 0, min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0;
-  TrapezoidSums trapezoid;
+  VecN q = q_start, qd = VecN::Zero(dof), tau(dof), z(dof);
+  VecN k1q, k1v, k2q, k2v, k3q, k3v, k4q, k4v, yq;
+  SampleSums<double, kMaxJoints> sums(o.tracking_bound, o.orientation_bound, shape.limits);
+  const auto keep = [](double updated, double) { return updated; };
   const double dt = o.dt;
-  std::size_t done = 0;
-  double last_t = 0, last_alpha = angle ? (*angle)(q) : nan;
+  Desired d, dh, d1;  // at the sample, at RK4's stage times
+  Eigen::Matrix3d held = Eigen::Matrix3d::Identity();  // spatial_pose: the start's orientation
+  d.R = dh.R = d1.R = &held;
+  sums.start_alpha(angle ? (*angle)(q) : nan);
 
   for (std::size_t i = 0; i < n; ++i) {
     const double t = sampled.time(i);
-    if (!resolver.evaluate(resolver.task(sampled, i), q, qd, e)) {
-      out.status = RunStatus::singular;
+    if (closed || oriented) resolver.desired(t, sampled.segment(i), d);
+    if (angle) d.alpha_now = (*angle)(q);
+    if (i == 0 && S == TaskSpace::spatial_pose) {  // the orientation held: the start's, before any feedback
+      ChainState st0;
+      ChainData data0;
+      evaluate_dynamics(chain, data0, q, qd, st0);
+      held = st0.tip.R;
+    }
+    if (!resolver.evaluate(resolver.task(sampled, i), q, qd, e, closed ? &d : nullptr)) {
+      status = RunStatus::singular;
       break;
     }
-    double tt = 0, p6 = 0;
+    double tt = 0, ff = 0, p6 = 0, abs_tau[kMaxJoints];
     bool bounded = true;
     for (int j = 0; j < dof; ++j) {
       double Mqdd = 0;
       for (int k = 0; k < dof; ++k) Mqdd += e.st.M(j, k) * e.qdd[k];
       const double tj = Mqdd + e.st.c[j] + e.st.g[j];
       tau[j] = z[j] = tj;
-      tt += tj * tj;
+      (prismatic[j] ? ff : tt) += tj * tj;
       const double pj = tj * qd[j];
       p6 += pj * pj;
-      const double a = std::abs(tj);
-      bounded = bounded && a <= o.torque_bound;  // NaN fails the comparison
+      abs_tau[j] = std::abs(tj);
+      bounded = bounded && abs_tau[j] <= o.torque_bound;  // NaN fails the comparison
     }
     // one test catches non-finite values and the bound
-    if (!(bounded && std::isfinite(tt))) {
-      out.status = RunStatus::diverged;
+    if (!(bounded && std::isfinite(tt) && std::isfinite(ff))) {
+      status = RunStatus::diverged;
       break;
     }
     // metrics of this sample
-    for (int j = 0; j < dof; ++j) inf[j] = std::max(inf[j], std::abs(tau[j]));
-    sumE += std::sqrt(tt);
-    sumEM += std::sqrt(e.Mf.inverse_quadratic_form(z.data()));  // tau^T M^-1 tau
+    SampleValues<double> v;
+    v.tt = tt, v.ff = ff, v.p6 = p6;
+    v.qf = e.Mf.inverse_quadratic_form(z.data()), v.det = 1.0;  // tau^T M^-1 tau
     if constexpr (P == m && R != Resolution::nonredundant)
-      min_w2 = std::min(min_w2, e.w2);
+      v.w2 = e.w2;
     else
-      min_w2 = std::min(min_w2, gram_determinant<P, m>(e.Jt));
+      v.w2 = gram_determinant<P, m>(e.Jt);
     const Eigen::Matrix<double, P, 1> err = e.st.tip.p.template head<P>() - sampled.position(i).template head<P>();
-    max_err2 = std::max(max_err2, err.squaredNorm());
-    trapezoid.add(i, tt, p6);
-    last_t = t;
-    if (angle) last_alpha = (*angle)(q);
+    v.err2 = err.squaredNorm();
+    v.orient = 0.0;
+    if constexpr (S == TaskSpace::planar_pose) v.orient = std::abs(d.alpha_now - d.alpha);
+    if constexpr (S == TaskSpace::spatial_pose) v.orient = orientation_angle(e.st.tip.R, held);
+    v.alpha = angle ? d.alpha_now : nan;
+    const bool off = sums.add(i, t, v, abs_tau, dof, keep);
+    const bool beyond = sums.limits(q.data(), qd.data(), tau.data(), dof);
+    sums.mark(off, beyond);
     if (history && (i % history->stride == 0 || i + 1 == n)) {
       const Eigen::Index c = history->size++;
       history->t[c] = t;
@@ -197,9 +253,9 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       history->qdd.col(c) = e.qdd;
       history->tau.col(c) = tau;
       history->x.col(c) = e.st.tip.p.template head<P>();
-      history->alpha[c] = last_alpha;
+      history->alpha[c] = v.alpha;
     }
-    ++done;
+    if (o.on_violation == OnViolation::stop && (off || beyond)) break;
     if (i + 1 == n) break;  // the last sample is measured, not integrated past
     // integrate to the next sample
     if (o.integrator == Integrator::semi_implicit_euler) {
@@ -213,15 +269,28 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       k1q = qd;
       k1v = e.qdd;
       const TaskVec<m> xh = resolver.task(th, sh), x1 = resolver.task(t1, s1);
-      bool good = resolver.evaluate(xh, q + 0.5 * dt * k1q, qd + 0.5 * dt * k1v, s);
+      if (closed) {
+        resolver.desired(th, sh, dh);
+        resolver.desired(t1, s1, d1);
+      }
+      // stage state's tip angle for planar_pose feedback
+      const auto at = [&](const VecN& y, Desired& dd) -> const Desired* {
+        if (!closed) return nullptr;
+        if (angle) dd.alpha_now = (*angle)(y);
+        return &dd;
+      };
+      yq = q + 0.5 * dt * k1q;
+      bool good = resolver.evaluate(xh, yq, qd + 0.5 * dt * k1v, s, at(yq, dh));
       k2q = qd + 0.5 * dt * k1v;
       k2v = s.qdd;
-      good = good && resolver.evaluate(xh, q + 0.5 * dt * k2q, qd + 0.5 * dt * k2v, s);
+      yq = q + 0.5 * dt * k2q;
+      good = good && resolver.evaluate(xh, yq, qd + 0.5 * dt * k2v, s, at(yq, dh));
       k3q = qd + 0.5 * dt * k2v;
       k3v = s.qdd;
-      good = good && resolver.evaluate(x1, q + dt * k3q, qd + dt * k3v, s);
+      yq = q + dt * k3q;
+      good = good && resolver.evaluate(x1, yq, qd + dt * k3v, s, at(yq, d1));
       if (!good) {
-        out.status = RunStatus::singular;
+        status = RunStatus::singular;
         break;
       }
       k4q = qd + dt * k3v;
@@ -230,9 +299,7 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       qd += dt / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
     }
   }
-  out.tau_inf = inf;
-  finish_metrics(out, done, sumE, sumEM, min_w2, max_err2, trapezoid, dt, last_alpha, last_t);
-  return out;
+  return finish_run(sums.of_lane(0, status, dof), shape, o);
 }
 
 template <TaskSpace S>
@@ -287,7 +354,7 @@ TrajectoryMetrics simulate(const Chain& chain, const ChainTask& task, const VecN
   target.planar = planar;
   target.angle = o.alpha1A;
   const std::optional<VecN> start = solve_start(chain, target, q0);
-  if (!start) return unreachable(n);
+  if (!start) return not_simulated(RunStatus::unreachable_start, n);
 
   // planar chains of revolute joints: the run on fixed-size types, chosen by the joint count
   if (planar && planar_revolute(chain)) return planar_chain_run(chain, task, *start, o, alpha_profile, history);

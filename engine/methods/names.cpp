@@ -12,11 +12,15 @@ constexpr NameTable<TrajectoryMethod, 3> kMethods{{{TrajectoryMethod::local_weig
                                                {TrajectoryMethod::vertex_alpha, "vertex_alpha"}}};
 constexpr NameTable<Integrator, 2> kIntegrators{
     {{Integrator::semi_implicit_euler, "semi_implicit_euler"}, {Integrator::rk4, "rk4"}}};
-constexpr NameTable<RunStatus, 5> kStatuses{{{RunStatus::ok, "ok"},
+constexpr NameTable<RunStatus, 7> kStatuses{{{RunStatus::ok, "ok"},
                                          {RunStatus::unreachable_start, "unreachable_start"},
                                          {RunStatus::singular, "singular"},
                                          {RunStatus::diverged, "diverged"},
-                                         {RunStatus::undersampled, "undersampled"}}};
+                                         {RunStatus::undersampled, "undersampled"},
+                                         {RunStatus::off_path, "off_path"},
+                                         {RunStatus::out_of_limits, "out_of_limits"}}};
+constexpr NameTable<OnViolation, 3> kOnViolation{
+    {{OnViolation::mark, "mark"}, {OnViolation::stop, "stop"}, {OnViolation::ignore, "ignore"}}};
 
 }  // namespace
 
@@ -26,6 +30,8 @@ std::string_view to_string(RunStatus s) { return name_of(kStatuses, s); }
 bool parse(std::string_view n, TrajectoryMethod& out) { return value_of(kMethods, n, out); }
 bool parse(std::string_view n, Integrator& out) { return value_of(kIntegrators, n, out); }
 bool parse(std::string_view n, RunStatus& out) { return value_of(kStatuses, n, out); }
+std::string_view to_string(OnViolation v) { return name_of(kOnViolation, v); }
+bool parse(std::string_view n, OnViolation& out) { return value_of(kOnViolation, n, out); }
 
 }  // namespace ks
 
@@ -37,7 +43,11 @@ bool TrajectoryOptions::IsValid(std::string* why) const {
                      {"null_damping", null_damping, null_damping_rule},
                      {"dt", dt, dt_rule},
                      {"torque_bound", torque_bound, torque_bound_rule},
-                     {"singular_tolerance", singular_tolerance, singular_tolerance_rule}},
+                     {"singular_tolerance", singular_tolerance, singular_tolerance_rule},
+                     {"K_P", clik_kp, clik_gain_rule},
+                     {"K_D", clik_kd, clik_gain_rule},
+                     {"tracking_bound", tracking_bound, bound_rule},
+                     {"orientation_bound", orientation_bound, bound_rule}},
                     why))
     return false;
   for (double a : vertex_alpha)

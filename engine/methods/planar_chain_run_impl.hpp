@@ -13,6 +13,7 @@
 #include "methods/chain_resolution.hpp"
 #include "methods/fixed_ldlt.hpp"
 #include "methods/run_sums.hpp"
+#include "methods/sample_sums.hpp"
 #include "methods/planar_chain_run.hpp"
 #include "model/planar_chain_dynamics.hpp"
 
@@ -69,12 +70,36 @@ class Stepper {
     task_of(p.acceleration(i), p.segment(i), p.time(i), xdd);
   }
 
+  /// Where the path wants the tip at time t on `segment`: position p (2) [m], velocity v (2) [m/s],
+  /// for planar_pose the tip angle and its rate in p[2], v[2] [rad, rad/s].
+  void desired(double t, std::size_t segment, double* p, double* v) const {
+    const PathSample<3> x = path_.sample_on(segment, t);
+    p[0] = x.p[0], p[1] = x.p[1], v[0] = x.v[0], v[1] = x.v[1];
+    if constexpr (m == 3) {
+      const PathSample<1> a = alpha_->sample_on(segment, t);
+      p[2] = a.p[0], v[2] = a.v[0];
+    }
+  }
+
   /// Joint accelerations e.qdd for task acceleration xdd (m) at the frames' trig (s, c) and qd (N);
-  /// fills every intermediate in `e`. Returns false when the task Jacobian is singular.
-  bool evaluate(const double* xdd, const double* s, const double* c, const double* qd, Evaluation<N, m>& e) const {
+  /// fills every intermediate in `e`. With fb (closed loop: the path's position and velocity as
+  /// desired() gives them, then the arm's tip angle at this state), xdd + K_D (v - J qd) + K_P (p - x)
+  /// is commanded instead. Returns false when the task Jacobian is singular.
+  bool evaluate(const double* xdd, const double* s, const double* c, const double* qd, Evaluation<N, m>& e,
+                const double* fb = nullptr) const {
     planar_chain_state<N, m>(k_, s, c, qd, e.st);
     double b[m];
     for (int r = 0; r < m; ++r) b[r] = xdd[r] - e.st.bias[r];
+    if (fb) {
+      const double* p = fb;
+      const double* v = fb + 3;
+      const double x[3] = {e.st.px, e.st.py, fb[6]};
+      for (int r = 0; r < m; ++r) {
+        double xd = 0;
+        for (int j = 0; j < N; ++j) xd += e.st.J[r][j] * qd[j];
+        b[r] += o_.clik_kd * (v[r] - xd) + o_.clik_kp * (p[r] - x[r]);
+      }
+    }
     e.Mf.compute(e.st.M);
     if constexpr (R == Resolution::nonredundant) {
       static_assert(N == m);
@@ -161,27 +186,33 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
     for (int j = 0; j < N; ++j) a += u[j];
     return alpha_offset + a;
   };
+  const bool closed = o.closed_loop();
+  constexpr bool oriented = m == 3;
+  const LimitTable limits = LimitTable::of(chain);
+  const RunShape shape{N, oriented, false, limits.any() ? &limits : nullptr};
 
-  TrajectoryMetrics out;
+  RunStatus status = RunStatus::ok;
   Evaluation<N, m> e, s;  // e: at the sample; s: RK4 stages
   // q, qd, qdd, tau: in the coordinates u = sigma q of the kernel (model/planar_chain_dynamics.hpp)
-  double q[N], qd[N], tau[N], inf[N];
-  for (int j = 0; j < N; ++j) q[j] = k.sigma[j] * q_start[j], qd[j] = 0.0, inf[j] = 0.0;
+  double q[N], qd[N], tau[N], abs_tau[N];
+  for (int j = 0; j < N; ++j) q[j] = k.sigma[j] * q_start[j], qd[j] = 0.0;
   PlanarChainTrig<N> trig, stage;  // trig: the sample's, carried from step to step (semi-implicit Euler)
   trig.reset(k, q);
-  RootSums roots;
-  double min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0;
-  TrapezoidSums trapezoid;
+  SampleSums<double, N> sums(o.tracking_bound, o.orientation_bound, shape.limits);
+  const auto keep = [](double updated, double) { return updated; };
   const double dt = o.dt;
-  std::size_t done = 0;
-  double last_t = 0, last_alpha = alpha_of(q);
   double xdd[m];
+  double fb[7] = {}, fh[7] = {}, f1[7] = {};  // closed loop: path position (3), velocity (3), arm angle
+  sums.start_alpha(alpha_of(q));
 
   for (std::size_t i = 0; i < n; ++i) {
     const double t = sampled.time(i);
     stepper.task(sampled, i, xdd);
-    if (!stepper.evaluate(xdd, trig.s, trig.c, qd, e)) {
-      out.status = RunStatus::singular;
+    if (closed || oriented) stepper.desired(t, sampled.segment(i), fb, fb + 3);
+    const double alpha = alpha_of(q);
+    fb[6] = alpha;
+    if (!stepper.evaluate(xdd, trig.s, trig.c, qd, e, closed ? fb : nullptr)) {
+      status = RunStatus::singular;
       break;
     }
     double tt = 0, p6 = 0;
@@ -194,28 +225,37 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       tt += tj * tj;
       const double pj = tj * qd[j];
       p6 += pj * pj;
-      bounded = bounded && std::abs(tj) <= o.torque_bound;  // NaN fails the comparison
+      abs_tau[j] = std::abs(tj);
+      bounded = bounded && abs_tau[j] <= o.torque_bound;  // NaN fails the comparison
     }
     // one test catches non-finite values and the bound
     if (!(bounded && std::isfinite(tt))) {
-      out.status = RunStatus::diverged;
+      status = RunStatus::diverged;
       break;
     }
     // metrics of this sample
-    for (int j = 0; j < N; ++j) inf[j] = std::max(inf[j], std::abs(tau[j]));
+    SampleValues<double> v;
+    v.tt = tt, v.ff = 0.0, v.p6 = p6;
     double z[N];
     for (int j = 0; j < N; ++j) z[j] = tau[j];
-    roots.add(tt, e.Mf.inverse_quadratic_form(z));  // tau^T M^-1 tau
+    v.qf = e.Mf.inverse_quadratic_form(z), v.det = 1.0;  // tau^T M^-1 tau
     if constexpr (P == m && R != Resolution::nonredundant)
-      min_w2 = std::min(min_w2, e.w2);
+      v.w2 = e.w2;
     else
-      min_w2 = std::min(min_w2, gram_det<P>(e.st.J));
+      v.w2 = gram_det<P>(e.st.J);
     const Eigen::Vector3d ref = sampled.position(i);
     const double ex = e.st.px - ref[0], ey = e.st.py - ref[1];
-    max_err2 = std::max(max_err2, ex * ex + ey * ey);
-    trapezoid.add(i, tt, p6);
-    last_t = t;
-    last_alpha = alpha_of(q);
+    v.err2 = ex * ex + ey * ey;
+    v.orient = oriented ? std::abs(alpha - fb[2]) : 0.0;
+    v.alpha = alpha;
+    const bool off = sums.add(i, t, v, abs_tau, N, keep);
+    bool beyond = false;
+    if (shape.limits) {  // in the chain's coordinates q = sigma u
+      double qa[N], qda[N];
+      for (int j = 0; j < N; ++j) qa[j] = k.sigma[j] * q[j], qda[j] = k.sigma[j] * qd[j];
+      beyond = sums.limits(qa, qda, tau, N);
+    }
+    sums.mark(off, beyond);
     if (history && (i % history->stride == 0 || i + 1 == n)) {
       const Eigen::Index col = history->size++;
       history->t[col] = t;
@@ -227,9 +267,9 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       }
       history->x(0, col) = e.st.px;
       history->x(1, col) = e.st.py;
-      history->alpha[col] = last_alpha;
+      history->alpha[col] = alpha;
     }
-    ++done;
+    if (o.on_violation == OnViolation::stop && (off || beyond)) break;
     if (i + 1 == n) break;  // the last sample is measured, not integrated past
     // integrate to the next sample
     if (o.integrator == Integrator::semi_implicit_euler) {
@@ -246,29 +286,36 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       double xh[m], x1[m], k2q[N], k3q[N], k4q[N], k2v[N], k3v[N], yq[N], yv[N];
       stepper.task(th, sh, xh);
       stepper.task(t1, s1, x1);
+      if (closed) {
+        stepper.desired(th, sh, fh, fh + 3);
+        stepper.desired(t1, s1, f1, f1 + 3);
+      }
       // stage 2 at (q + h k1q, qd + h k1v) with k1q = qd, k1v = qdd
       for (int j = 0; j < N; ++j) {
         yq[j] = q[j] + h * qd[j];
         k2q[j] = yv[j] = qd[j] + h * e.qdd[j];
       }
       stage.reset(k, yq);
-      bool good = stepper.evaluate(xh, stage.s, stage.c, yv, s);
+      fh[6] = alpha_of(yq);
+      bool good = stepper.evaluate(xh, stage.s, stage.c, yv, s, closed ? fh : nullptr);
       for (int j = 0; j < N; ++j) {
         k2v[j] = s.qdd[j];
         yq[j] = q[j] + h * k2q[j];
         k3q[j] = yv[j] = qd[j] + h * k2v[j];
       }
       stage.reset(k, yq);
-      good = good && stepper.evaluate(xh, stage.s, stage.c, yv, s);
+      fh[6] = alpha_of(yq);
+      good = good && stepper.evaluate(xh, stage.s, stage.c, yv, s, closed ? fh : nullptr);
       for (int j = 0; j < N; ++j) {
         k3v[j] = s.qdd[j];
         yq[j] = q[j] + dt * k3q[j];
         k4q[j] = yv[j] = qd[j] + dt * k3v[j];
       }
       stage.reset(k, yq);
-      good = good && stepper.evaluate(x1, stage.s, stage.c, yv, s);
+      f1[6] = alpha_of(yq);
+      good = good && stepper.evaluate(x1, stage.s, stage.c, yv, s, closed ? f1 : nullptr);
       if (!good) {
-        out.status = RunStatus::singular;
+        status = RunStatus::singular;
         break;
       }
       const double w = dt / 6.0;
@@ -280,11 +327,7 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       trig.reset(k, q);
     }
   }
-  roots.flush();
-  out.tau_inf.resize(N);
-  for (int j = 0; j < N; ++j) out.tau_inf[j] = inf[j];
-  finish_metrics(out, done, roots.sumE, roots.sumEM, min_w2, max_err2, trapezoid, dt, last_alpha, last_t);
-  return out;
+  return finish_run(sums.of_lane(0, status, N), shape, o);
 }
 
 }  // namespace planar_run

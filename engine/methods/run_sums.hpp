@@ -62,23 +62,4 @@ struct TrapezoidSums {
   double power(double dt) const { return dt * (f6 - 0.5 * (first6 + last6)); }   ///< [W^2 s]
 };
 
-/// The metrics a run's sums give, after `done` samples at step dt [s]: samples, E and E_M (means of
-/// the sample values summed in sumE, sumEM), the minimum manipulability sqrt(min_w2), the trapezoid
-/// integrals, the maximum tracking error sqrt(max_err2) (these stay at their defaults when no sample
-/// was done), and the last sample's tip angle and time.
-inline void finish_metrics(TrajectoryMetrics& out, std::size_t done, double sumE, double sumEM, double min_w2,
-                           double max_err2, const TrapezoidSums& trapezoid, double dt, double last_alpha, double last_t) {
-  out.samples = done;
-  if (done > 0) {
-    out.E = sumE / static_cast<double>(done);
-    out.E_M = sumEM / static_cast<double>(done);
-    out.min_manipulability = std::sqrt(min_w2);
-    out.torque_sq_integral = trapezoid.torque(dt);
-    out.power_sq_integral = trapezoid.power(dt);
-    out.max_tracking_error = std::sqrt(max_err2);
-  }
-  out.final_alpha = last_alpha;
-  out.stop_time = last_t;
-}
-
 }  // namespace ks

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "methods/run_sums.hpp"
+#include "methods/sample_sums.hpp"
 #include "methods/trajectory_batch.hpp"
 #include "methods/trajectory_lanes.hpp"
 
@@ -25,7 +26,8 @@ TrajectoryMetrics not_simulated(RunStatus status, int joints) {
   out.status = status;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   out.E = out.E_M = out.min_manipulability = out.torque_sq_integral = out.power_sq_integral = nan;
-  out.max_tracking_error = out.final_alpha = nan;
+  out.max_tracking_error = out.mean_tracking_error = out.final_alpha = out.max_orientation_error = nan;
+  out.max_q_limit_ratio = out.max_qd_limit_ratio = out.max_tau_limit_ratio = out.E_force = nan;
   out.tau_inf.setConstant(joints, nan);
   return out;
 }
@@ -60,6 +62,17 @@ double unit_alpha_acceleration(const Profile1& unit, std::size_t segment, double
   return unit.sample_on(segment, t).a[0];
 }
 
+void path_state(const Path2& path, const Profile1* unit, std::size_t segment, double t, PathState& out) {
+  const PathSample<2> x = path.sample_on(segment, t);
+  out.p[0] = x.p[0], out.p[1] = x.p[1], out.v[0] = x.v[0], out.v[1] = x.v[1];
+  out.rise_p = out.rise_v = 0.0;
+  if (unit) {
+    const PathSample<1> u = unit->sample_on(segment, t);
+    out.rise_p = u.p[0] - static_cast<double>(segment);  // the unit profile is k at vertex k
+    out.rise_v = u.v[0];
+  }
+}
+
 void prepare(Batch& b, int lanes, const PlanarArm3& arm, const SampledPath& sampled, const TrajectoryOptions* options,
              int count, TrajectoryHistory* const* histories) {
   if (count < 1 || count > lanes || lanes > kMaxLanes)
@@ -90,6 +103,8 @@ void prepare(Batch& b, int lanes, const PlanarArm3& arm, const SampledPath& samp
   s.samples = sampled.data();
   s.segment = sampled.segments();
   s.alpha_unit = nullptr;
+  s.closed_loop = o0.closed_loop();
+  s.stop_on_bound = o0.on_violation == OnViolation::stop;
   const std::size_t segments = path.segments();
   if (o0.method == TrajectoryMethod::vertex_alpha) {
     std::vector<Eigen::Matrix<double, 1, 1>> v;
@@ -97,6 +112,7 @@ void prepare(Batch& b, int lanes, const PlanarArm3& arm, const SampledPath& samp
     b.alpha_unit.emplace(std::move(v), path.durations());
     s.alpha_unit = &*b.alpha_unit;
     b.alpha_rise.assign(segments * kMaxLanes, 0.0);
+    b.alpha_from.assign(segments * kMaxLanes, 0.0);
   }
   Runs& L = b.runs;
   L = Runs{};
@@ -116,10 +132,15 @@ void prepare(Batch& b, int lanes, const PlanarArm3& arm, const SampledPath& samp
     L.null_damping[i] = o.null_damping;
     L.torque_bound[i] = o.torque_bound;
     L.tolerance[i] = o.singular_tolerance;
+    L.kp[i] = o.clik_kp;
+    L.kd[i] = o.clik_kd;
+    L.tracking_bound[i] = o.tracking_bound;
+    L.orientation_bound[i] = o.orientation_bound;
     if (o.method == TrajectoryMethod::vertex_alpha) {
       // the rise of each segment, as QuinticPath::sample_on takes it: vertex i + 1 - vertex i
       double prev = o.alpha1A;
       for (std::size_t k = 0; k < segments; ++k) {
+        b.alpha_from[k * kMaxLanes + i] = prev;
         b.alpha_rise[k * kMaxLanes + i] = o.vertex_alpha[k] - prev;
         prev = o.vertex_alpha[k];
       }
@@ -139,22 +160,23 @@ void prepare(Batch& b, int lanes, const PlanarArm3& arm, const SampledPath& samp
     for (int j = 0; j < 3; ++j) L.q0[j][i] = L.q0[j][donor];
     L.k[i] = L.k[donor], L.null_damping[i] = L.null_damping[donor];
     L.torque_bound[i] = L.torque_bound[donor], L.tolerance[i] = L.tolerance[donor];
-    for (std::size_t k = 0; k < b.alpha_rise.size() / kMaxLanes; ++k)
+    L.kp[i] = L.kp[donor], L.kd[i] = L.kd[donor];
+    L.tracking_bound[i] = L.tracking_bound[donor], L.orientation_bound[i] = L.orientation_bound[donor];
+    for (std::size_t k = 0; k < b.alpha_rise.size() / kMaxLanes; ++k) {
       b.alpha_rise[k * kMaxLanes + i] = b.alpha_rise[k * kMaxLanes + donor];
+      b.alpha_from[k * kMaxLanes + i] = b.alpha_from[k * kMaxLanes + donor];
+    }
   }
   L.alpha_rise = b.alpha_rise.empty() ? nullptr : b.alpha_rise.data();
+  L.alpha_from = b.alpha_from.empty() ? nullptr : b.alpha_from.data();
+  b.options = options;
 }
 
 TrajectoryMetrics finish(const Batch& b, int i, const Sums& r) {
   if (b.runs.active[i] == 0.0) return not_simulated(RunStatus::unreachable_start, 3);
-  TrajectoryMetrics out;
-  out.status = r.status;
-  if (r.done > 0) out.tau_inf = Vec3(r.inf[0], r.inf[1], r.inf[2]);  // VecN of size 3: no allocation
-  TrapezoidSums trapezoid;
-  trapezoid.f5 = r.f5, trapezoid.f6 = r.f6, trapezoid.first5 = r.first5, trapezoid.first6 = r.first6;
-  trapezoid.last5 = r.last5, trapezoid.last6 = r.last6;
-  finish_metrics(out, r.done, r.sumE, r.sumEM, r.min_w2, r.max_err2, trapezoid, b.shared.dt, r.last_alpha, r.last_t);
-  return out;
+  RunShape shape;
+  shape.orientation = b.shared.method == TrajectoryMethod::vertex_alpha;
+  return finish_run(r, shape, b.options[i]);
 }
 
 }  // namespace kernel

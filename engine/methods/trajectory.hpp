@@ -2,6 +2,7 @@
 // Redundancy resolution along a path (seed 000, chapter 3): one run = one simulation of the arm
 // following the path from rest, with joint accelerations chosen by a method, integrated open loop.
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,16 +35,27 @@ enum class RunStatus {
   singular,           ///< the Jacobian became singular (see TrajectoryOptions::singular_tolerance)
   diverged,           ///< a non-finite value, or a torque above TrajectoryOptions::torque_bound
   undersampled,       ///< dt leaves fewer than kMinSamplesPerSegment samples on a segment: nothing simulated
+  off_path,           ///< the tip left the path by more than tracking_bound (or orientation_bound)
+  out_of_limits,      ///< a joint position, velocity or effort went beyond the robot's limits
+};
+
+/// What a run does when a sample crosses its tracking bound or its robot's joint limits.
+enum class OnViolation {
+  mark,    ///< the run goes on to the end, every metric kept, and ends off_path / out_of_limits
+  stop,    ///< the run ends at the first such sample, off_path / out_of_limits, metrics NaN
+  ignore,  ///< the bounds only measure: the status is not changed
 };
 
 
 std::string_view to_string(TrajectoryMethod m);
 std::string_view to_string(Integrator i);
 std::string_view to_string(RunStatus s);
+std::string_view to_string(OnViolation v);
 /// Parse a name; false when unknown.
 bool parse(std::string_view name, TrajectoryMethod& out);
 bool parse(std::string_view name, Integrator& out);
 bool parse(std::string_view name, RunStatus& out);
+bool parse(std::string_view name, OnViolation& out);
 
 /// Options of one run. Defaults reproduce the seed.
 struct TrajectoryOptions {
@@ -58,12 +70,25 @@ struct TrajectoryOptions {
   double torque_bound = 1.0e6;        ///< |tau_i| above this [Nm] stops the run as diverged
   /// singular when sqrt(det(J J^T)) [m^2] (local methods) or |det J3| (vertex_alpha) falls below this
   double singular_tolerance = 1.0e-9;
+  /// Closed-loop task feedback (CLIK): the commanded task acceleration is the path's plus
+  /// K_D (xd_path - xd) + K_P (x_path - x), orientation rows included for pose tasks. 0 and 0 = the
+  /// seeds' open loop (bitwise).
+  double clik_kp = 0.0;               ///< K_P [1/s^2]
+  double clik_kd = 0.0;               ///< K_D [1/s]
+  double tracking_bound = 0.05;       ///< |tip - path| above this [m] is off the path
+  double orientation_bound = 0.05;    ///< pose tasks: an orientation error above this [rad] is off the path
+  OnViolation on_violation = OnViolation::mark;
 
   /// The rules on the fields (checked by IsValid; the study schema reports them at the key).
   static constexpr Domain null_damping_rule = Domain::nonnegative();
   static constexpr Domain dt_rule = Domain::positive();
   static constexpr Domain torque_bound_rule = Domain::positive();
   static constexpr Domain singular_tolerance_rule = Domain::nonnegative();
+  static constexpr Domain clik_gain_rule = Domain::nonnegative();
+  static constexpr Domain bound_rule = Domain::positive();
+
+  /// True when the run feeds the task error back (a gain is not 0).
+  bool closed_loop() const { return clik_kp != 0.0 || clik_kd != 0.0; }
 
   /// True when every field is finite and within its rule; otherwise false, with `why` (when given)
   /// naming the field and the rule, e.g. "dt = -0.001; expected dt > 0".
@@ -81,6 +106,17 @@ struct TrajectoryMetrics {
   double torque_sq_integral = 0.0;    ///< trapezoidal integral of sum tau_i^2 [N^2 m^2 s]
   double power_sq_integral = 0.0;     ///< trapezoidal integral of sum (tau_i qd_i)^2 [W^2 s]
   double max_tracking_error = 0.0;    ///< max over samples of |tip - path| [m] (open-loop drift)
+  double mean_tracking_error = 0.0;   ///< mean over samples of |tip - path| [m]
+  /// max over samples of the tip's orientation error [rad] (pose tasks and vertex_alpha; NaN otherwise)
+  double max_orientation_error = std::numeric_limits<double>::quiet_NaN();
+  /// max over samples and limited joints of |q - mid| / half range, |qd| / velocity limit and
+  /// |tau| / effort limit (1 = at the limit); NaN when the robot has no such limit
+  double max_q_limit_ratio = std::numeric_limits<double>::quiet_NaN();
+  double max_qd_limit_ratio = std::numeric_limits<double>::quiet_NaN();
+  double max_tau_limit_ratio = std::numeric_limits<double>::quiet_NaN();
+  /// prismatic joints: mean over samples of sqrt(f^T f) of their forces [N] (E then covers the
+  /// revolute joints' torques only); NaN for a chain without prismatic joints
+  double E_force = std::numeric_limits<double>::quiet_NaN();
   double final_alpha = 0.0;           ///< alpha at the last sample [rad]
   double stop_time = 0.0;             ///< time of the last sample computed [s]
 };

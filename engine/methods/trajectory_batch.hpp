@@ -16,6 +16,8 @@ struct Batch {
   std::optional<DynamicsCoefficients> dyn;
   std::optional<Profile1> alpha_unit;  ///< vertex_alpha: each segment rises by exactly 1
   std::vector<double> alpha_rise;      ///< vertex_alpha: see Runs::alpha_rise
+  std::vector<double> alpha_from;      ///< vertex_alpha: see Runs::alpha_from
+  const TrajectoryOptions* options = nullptr;  ///< the runs' options (lanes 0 .. count - 1)
   HistoryView views[kMaxLanes];
 };
 

@@ -14,6 +14,7 @@
 
 #include "methods/resolution.hpp"
 #include "methods/run_sums.hpp"
+#include "methods/sample_sums.hpp"
 #include "methods/trajectory.hpp"
 #include "model/dynamics.hpp"
 
@@ -32,6 +33,14 @@ struct StageTasks {
 /// each rise by exactly 1: `unit`, null when the method is not vertex_alpha).
 void stage_tasks(const Path2& path, const Profile1* unit, double t, double dt, StageTasks& out);
 double unit_alpha_acceleration(const Profile1& unit, std::size_t segment, double t);
+
+/// The path's position and velocity at time t on `segment`, and for vertex_alpha (`unit` not null)
+/// the fraction of the segment's rise done and its rate (closed-loop feedback, orientation error).
+struct PathState {
+  double p[2], v[2];     ///< [m], [m/s]
+  double rise_p, rise_v;  ///< vertex_alpha: unit profile's value past its segment start [1], rate [1/s]
+};
+void path_state(const Path2& path, const Profile1* unit, std::size_t segment, double t, PathState& out);
 
 /// A run's history as raw column-major arrays (TrajectoryHistory's storage), written in place.
 struct HistoryView {
@@ -52,6 +61,8 @@ struct Shared {
   std::size_t n = 0;                    ///< samples
   const double* samples = nullptr;      ///< SampledPath::data(): position (2), acceleration (2) per sample
   const std::uint32_t* segment = nullptr;  ///< SampledPath::segments()
+  bool closed_loop = false;             ///< the runs feed the task error back (TrajectoryOptions::closed_loop)
+  bool stop_on_bound = false;           ///< on_violation = stop
 };
 
 /// The per-run inputs, one slot per lane (lanes past the batch and unreachable starts: active = 0, with
@@ -60,18 +71,16 @@ struct Runs {
   double active[kMaxLanes] = {};
   double q0[3][kMaxLanes] = {};
   double k[kMaxLanes] = {}, null_damping[kMaxLanes] = {}, torque_bound[kMaxLanes] = {}, tolerance[kMaxLanes] = {};
+  double kp[kMaxLanes] = {}, kd[kMaxLanes] = {};  ///< CLIK gains [1/s^2], [1/s]
+  double tracking_bound[kMaxLanes] = {}, orientation_bound[kMaxLanes] = {};  ///< [m], [rad]
   const double* alpha_rise = nullptr;  ///< vertex_alpha: rise of segment s in lane l at [s * kMaxLanes + l] [rad]
+  const double* alpha_from = nullptr;  ///< vertex_alpha: alpha at the start of segment s, the same layout [rad]
   const HistoryView* history[kMaxLanes] = {};
   bool any_history = false;
 };
 
-/// A lane's sums when the loop ends (finish_metrics turns them into TrajectoryMetrics).
-struct Sums {
-  RunStatus status = RunStatus::ok;
-  std::size_t done = 0;
-  double sumE = 0, sumEM = 0, inf[3] = {0, 0, 0}, min_w2 = 0, max_err2 = 0, last_alpha = 0, last_t = 0;
-  double f5 = 0, f6 = 0, first5 = 0, first6 = 0, last5 = 0, last6 = 0;  ///< TrapezoidSums
-};
+/// A lane's sums when the loop ends (finish_run turns them into TrajectoryMetrics).
+using Sums = RunSums;
 
 template <class T>
 inline T load_lanes(const double* p) {
@@ -89,6 +98,10 @@ template <class T>
 struct Task {
   double a[2];  // path acceleration (shared)
   T alpha_dd;   // vertex_alpha: orientation acceleration
+  // closed loop only: the path's position and velocity (shared), and for vertex_alpha the desired
+  // orientation, its rate and the arm's orientation at this state
+  double p[2], v[2];
+  T alpha_d, alpha_v, alpha;
 };
 
 template <class T>
@@ -107,8 +120,8 @@ class Resolver {
   Resolver(const Shared& s, const Runs& in)
       : arm_(*s.arm), dyn_(*s.dyn), method_(s.method),
         w_(s.method == TrajectoryMethod::local_unweighted ? Weighting::inertia_squared : Weighting::inertia),
-        k_(load_lanes<T>(in.k)), kn_(load_lanes<T>(in.null_damping)), tol_(load_lanes<T>(in.tolerance)),
-        tol2_(tol_ * tol_) {}
+        closed_(s.closed_loop), k_(load_lanes<T>(in.k)), kn_(load_lanes<T>(in.null_damping)),
+        tol_(load_lanes<T>(in.tolerance)), tol2_(tol_ * tol_), kp_(load_lanes<T>(in.kp)), kd_(load_lanes<T>(in.kd)) {}
 
   /// Joint accelerations of the method for task x at (trig, qd); fills every intermediate in `e`.
   /// The mask: lanes whose Jacobian is not singular.
@@ -119,10 +132,19 @@ class Resolver {
     e.J = jacobian(arm_, trig);
     e.Mi = SymInverse3Of<T>(e.M);
     const Vec2Of<T> jdqd = jacobian_dot_times_qd(arm_, trig, qd);
-    const Vec2Of<T> b{x.a[0] - jdqd[0], x.a[1] - jdqd[1]};
+    Vec2Of<T> b{x.a[0] - jdqd[0], x.a[1] - jdqd[1]};
+    T alpha_dd = x.alpha_dd;
+    if (closed_) {  // CLIK: + K_D (v_path - J qd) + K_P (p_path - tip), tip = (J10, -J00)
+      const T v0 = e.J(0, 0) * qd[0] + e.J(0, 1) * qd[1] + e.J(0, 2) * qd[2];
+      const T v1 = e.J(1, 0) * qd[0] + e.J(1, 1) * qd[1] + e.J(1, 2) * qd[2];
+      b[0] = b[0] + kd_ * (x.v[0] - v0) + kp_ * (x.p[0] - e.J(1, 0));
+      b[1] = b[1] + kd_ * (x.v[1] - v1) + kp_ * (x.p[1] + e.J(0, 0));
+      if (method_ == TrajectoryMethod::vertex_alpha)
+        alpha_dd = alpha_dd + kd_ * (x.alpha_v - (qd[0] + qd[1] + qd[2])) + kp_ * (x.alpha_d - x.alpha);
+    }
     if (method_ == TrajectoryMethod::vertex_alpha) {
       T det = 0.0;
-      e.qdd = nonredundant_acceleration<T>(e.J, b, x.alpha_dd, det);
+      e.qdd = nonredundant_acceleration<T>(e.J, b, alpha_dd, det);
       e.w2 = manipulability_squared(e.J);
       return vabs(det) >= tol_;
     }
@@ -138,7 +160,8 @@ class Resolver {
   const DynamicsCoefficients& dyn_;
   const TrajectoryMethod method_;
   const Weighting w_;
-  const T k_, kn_, tol_, tol2_;
+  const bool closed_;
+  const T k_, kn_, tol_, tol2_, kp_, kd_;
 };
 
 /// Writes sample i of the lanes in `write` (a bit per lane) to their histories.
@@ -190,15 +213,11 @@ void run(const Shared& s, const Runs& in, Sums* out) {
   const V3 q_start{load_lanes<T>(in.q0[0]), load_lanes<T>(in.q0[1]), load_lanes<T>(in.q0[2])};
   V3 q = q_start, qd{T(0.0), T(0.0), T(0.0)};
   M active = load_lanes<T>(in.active) != 0.0;
-  M singular = T(0.0) != T(0.0), diverged = singular;
+  M singular = T(0.0) != T(0.0), diverged = singular, bounded = singular;
   Evaluation<T> e, st;  // e: at the sample; st: RK4 stages
   TrigTrackerOf<T> trig(q);  // the sample's trig, carried from step to step (semi-implicit Euler)
-  struct NoRoots {};
-  std::conditional_t<one, RootSums, NoRoots> roots;  // one lane: square roots a block at a time (the same sums)
-  T sumE = 0.0, sumEM = 0.0, inf0 = 0.0, inf1 = 0.0, inf2 = 0.0;
-  T min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0.0;
-  T f5 = 0.0, f6 = 0.0, first5 = 0.0, first6 = 0.0, last5 = 0.0, last6 = 0.0;
-  T done = 0.0, last_t = 0.0, last_alpha = q[0] + q[1] + q[2];
+  SampleSums<T, 3> sums(load_lanes<T>(in.tracking_bound), load_lanes<T>(in.orientation_bound));
+  sums.start_alpha(q[0] + q[1] + q[2]);
   // a sample's value enters a lane's sums only while the lane runs (one lane: the loop stops instead;
   // while every lane runs, nothing is masked)
   bool all_on = all(active);
@@ -209,7 +228,19 @@ void run(const Shared& s, const Runs& in, Sums* out) {
   const double dt = s.dt, hdt = 0.5 * dt, dt6 = dt / 6.0;
   const std::size_t n = s.n;
   const bool vertex = s.method == TrajectoryMethod::vertex_alpha;
-  const auto rise = [&](std::size_t segment) -> T { return load_lanes<T>(in.alpha_rise + segment * kMaxLanes); };
+  const auto lanes_at = [](const double* a, std::size_t segment) -> T { return load_lanes<T>(a + segment * kMaxLanes); };
+  const auto rise = [&](std::size_t segment) -> T { return lanes_at(in.alpha_rise, segment); };
+  // the closed loop's path state at (segment, t) into task x (vertex_alpha: also the desired orientation)
+  const auto feed = [&](std::size_t segment, double t, Task<T>& x) {
+    PathState ps;
+    path_state(*s.path, s.alpha_unit, segment, t, ps);
+    x.p[0] = ps.p[0], x.p[1] = ps.p[1], x.v[0] = ps.v[0], x.v[1] = ps.v[1];
+    if (vertex) {
+      const T r = rise(segment);
+      x.alpha_d = lanes_at(in.alpha_from, segment) + ps.rise_p * r;
+      x.alpha_v = ps.rise_v * r;
+    }
+  };
   const auto stop = [&](M ok, M& status) {  // lanes failing ok stop with `status`; true when none runs on
     if constexpr (one) {
       if (!ok) status = true;
@@ -225,53 +256,35 @@ void run(const Shared& s, const Runs& in, Sums* out) {
   for (std::size_t i = 0; i < n; ++i) {
     const double t = static_cast<double>(i) * dt;  // SampledPath::time(i)
     const double* xa = s.samples + 4 * i;
-    Task<T> x{{xa[2], xa[3]}, T(0.0)};
+    Task<T> x{{xa[2], xa[3]}, T(0.0), {xa[0], xa[1]}, {0.0, 0.0}, T(0.0), T(0.0), q[0] + q[1] + q[2]};
     if (vertex) x.alpha_dd = unit_alpha_acceleration(*s.alpha_unit, s.segment[i], t) * rise(s.segment[i]);
+    if (s.closed_loop || vertex) feed(s.segment[i], t, x);
     if (stop(resolver.evaluate(x, trig.trig(), qd, e), singular)) break;
     const V3 Mqdd = e.M * e.qdd;
     const T tau0 = Mqdd[0] + e.c[0] + e.g[0], tau1 = Mqdd[1] + e.c[1] + e.g[1], tau2 = Mqdd[2] + e.c[2] + e.g[2];
-    const T a0 = vabs(tau0), a1 = vabs(tau1), a2 = vabs(tau2);
+    const T a[3] = {vabs(tau0), vabs(tau1), vabs(tau2)};
     const T tt = tau0 * tau0 + tau1 * tau1 + tau2 * tau2;
     // NaN fails every comparison: one test catches non-finite values and the bound
     const T bound = load_lanes<T>(in.torque_bound);
-    const M good = (a0 <= bound) & (a1 <= bound) & (a2 <= bound) & (vabs(tt) < std::numeric_limits<double>::infinity());
+    const M good = (a[0] <= bound) & (a[1] <= bound) & (a[2] <= bound) & (vabs(tt) < std::numeric_limits<double>::infinity());
     if (stop(good, diverged)) break;
     // metrics of this sample
     const V3 tau{tau0, tau1, tau2};
-    if constexpr (one) {
-      roots.add(tt, e.Mi.P.quadratic_form(tau), e.Mi.det);
-    } else {
-      // lanes: the square roots sample by sample (measured faster here than a block at a time)
-      const T qf = e.Mi.P.quadratic_form(tau);
-      sumE = keep(sumE + vsqrt(tt), sumE);
-      sumEM = keep(sumEM + vsqrt(qf / e.Mi.det), sumEM);
-    }
-    inf0 = keep(vmax(inf0, a0), inf0);
-    inf1 = keep(vmax(inf1, a1), inf1);
-    inf2 = keep(vmax(inf2, a2), inf2);
-    min_w2 = keep(vmin(min_w2, e.w2), min_w2);
     const T ex = e.J(1, 0) - xa[0], ey = -e.J(0, 0) - xa[1];  // tip = (x1, y1) = (J10, -J00)
-    max_err2 = keep(vmax(max_err2, ex * ex + ey * ey), max_err2);
     const T p0 = tau0 * qd[0], p1 = tau1 * qd[1], p2 = tau2 * qd[2];
-    const T p6 = p0 * p0 + p1 * p1 + p2 * p2;
-    f5 = keep(f5 + tt, f5);
-    f6 = keep(f6 + p6, f6);
-    if (i == 0) {
-      first5 = keep(tt, first5);
-      first6 = keep(p6, first6);
-    }
-    last5 = keep(tt, last5);
-    last6 = keep(p6, last6);
-    last_t = keep(T(t), last_t);
-    last_alpha = keep(q[0] + q[1] + q[2], last_alpha);
+    const T alpha = q[0] + q[1] + q[2];
+    const SampleValues<T> v{tt, T(0.0), e.Mi.P.quadratic_form(tau), e.Mi.det, p0 * p0 + p1 * p1 + p2 * p2,
+                            e.w2, ex * ex + ey * ey, vertex ? vabs(alpha - x.alpha_d) : T(0.0), alpha};
+    const M off = sums.add(i, t, v, a, 3, keep) & active;
+    sums.mark(off);
     if (in.any_history) {
       int write = 0;
       for (int l = 0; l < N; ++l)
         if (in.history[l] && (i % in.history[l]->stride == 0 || i + 1 == n)) write |= 1 << l;
       write &= lane_bits<T>(active);
-      if (write) write_histories<T>(in, write, t, q, qd, e, {tau0, tau1, tau2}, last_alpha);
+      if (write) write_histories<T>(in, write, t, q, qd, e, {tau0, tau1, tau2}, alpha);
     }
-    done = keep(done + 1.0, done);
+    if (s.stop_on_bound && any(off) && stop(!off, bounded)) break;
     if (i + 1 == n) break;  // the last sample is measured, not integrated past
     // integrate to the next sample
     if (s.integrator == Integrator::semi_implicit_euler) {
@@ -282,22 +295,30 @@ void run(const Shared& s, const Runs& in, Sums* out) {
     } else {
       StageTasks stt;
       stage_tasks(*s.path, s.alpha_unit, t, dt, stt);
-      Task<T> xh{{stt.a_h[0], stt.a_h[1]}, T(0.0)}, x1{{stt.a_1[0], stt.a_1[1]}, T(0.0)};
+      Task<T> xh{{stt.a_h[0], stt.a_h[1]}, T(0.0), {0.0, 0.0}, {0.0, 0.0}, T(0.0), T(0.0), T(0.0)};
+      Task<T> x1{{stt.a_1[0], stt.a_1[1]}, T(0.0), {0.0, 0.0}, {0.0, 0.0}, T(0.0), T(0.0), T(0.0)};
       if (vertex) {
         xh.alpha_dd = stt.unit_h * rise(stt.seg_h);
         x1.alpha_dd = stt.unit_1 * rise(stt.seg_1);
       }
+      if (s.closed_loop) {
+        feed(stt.seg_h, t + hdt, xh);
+        feed(stt.seg_1, t + dt, x1);
+      }
       const V3 k1q = qd, k1v = e.qdd;
       const V3 q2{q[0] + hdt * k1q[0], q[1] + hdt * k1q[1], q[2] + hdt * k1q[2]};
       const V3 k2q{qd[0] + hdt * k1v[0], qd[1] + hdt * k1v[1], qd[2] + hdt * k1v[2]};
+      xh.alpha = q2[0] + q2[1] + q2[2];
       M good_stages = resolver.evaluate(xh, joint_trig(q2), k2q, st);
       const V3 k2v = st.qdd;
       const V3 q3{q[0] + hdt * k2q[0], q[1] + hdt * k2q[1], q[2] + hdt * k2q[2]};
       const V3 k3q{qd[0] + hdt * k2v[0], qd[1] + hdt * k2v[1], qd[2] + hdt * k2v[2]};
+      xh.alpha = q3[0] + q3[1] + q3[2];
       good_stages = good_stages & resolver.evaluate(xh, joint_trig(q3), k3q, st);
       const V3 k3v = st.qdd;
       const V3 q4{q[0] + dt * k3q[0], q[1] + dt * k3q[1], q[2] + dt * k3q[2]};
       const V3 k4q{qd[0] + dt * k3v[0], qd[1] + dt * k3v[1], qd[2] + dt * k3v[2]};
+      x1.alpha = q4[0] + q4[1] + q4[2];
       good_stages = good_stages & resolver.evaluate(x1, joint_trig(q4), k4q, st);
       if (stop(good_stages, singular)) break;
       const V3 k4v = st.qdd;
@@ -309,23 +330,10 @@ void run(const Shared& s, const Runs& in, Sums* out) {
     }
   }
 
-  if constexpr (one) {
-    roots.flush();
-    sumE = roots.sumE;
-    sumEM = roots.sumEM;
-  }
-  alignas(64) double v[16][N];
-  const T fields[16] = {sumE, sumEM, inf0, inf1, inf2, min_w2, max_err2, last_alpha, last_t,
-                        f5, f6, first5, first6, last5, last6, done};
-  for (int f = 0; f < 16; ++f) store_lanes(fields[f], v[f]);
   const int sing = lane_bits<T>(singular), div = lane_bits<T>(diverged);
   for (int l = 0; l < N; ++l) {
-    Sums& o = out[l];
-    o.status = (sing >> l & 1) ? RunStatus::singular : (div >> l & 1) ? RunStatus::diverged : RunStatus::ok;
-    o.sumE = v[0][l], o.sumEM = v[1][l], o.inf[0] = v[2][l], o.inf[1] = v[3][l], o.inf[2] = v[4][l];
-    o.min_w2 = v[5][l], o.max_err2 = v[6][l], o.last_alpha = v[7][l], o.last_t = v[8][l];
-    o.f5 = v[9][l], o.f6 = v[10][l], o.first5 = v[11][l], o.first6 = v[12][l], o.last5 = v[13][l], o.last6 = v[14][l];
-    o.done = static_cast<std::size_t>(v[15][l]);
+    const RunStatus st = (sing >> l & 1) ? RunStatus::singular : (div >> l & 1) ? RunStatus::diverged : RunStatus::ok;
+    out[l] = sums.of_lane(l, st, 3);
   }
 }
 

@@ -74,6 +74,7 @@ bool Chain::IsValid(std::string* why) const {
     if (!j.axis.allFinite() || std::abs(j.axis.norm() - 1.0) > 1e-9) return fail(why, who + ": axis is not a unit vector");
     if (std::isnan(j.lower) || std::isnan(j.upper) || j.lower > j.upper)
       return fail(why, who + ": limits need lower <= upper");
+    if (!(j.velocity > 0.0) || !(j.effort > 0.0)) return fail(why, who + ": velocity and effort limits must be > 0");
     if (!std::isfinite(j.mass) || j.mass < 0.0) return fail(why, who + ": mass must be finite and >= 0");
     if (!finite(j.com)) return fail(why, who + ": centre of mass is not finite");
     if (!finite(j.inertia)) return fail(why, who + ": inertia is not finite");
@@ -101,6 +102,8 @@ Chain planar_chain(const std::vector<PlanarLink>& links, double g, std::string n
     j.axis = Eigen::Vector3d::UnitZ();
     j.lower = L.lower;
     j.upper = L.upper;
+    j.velocity = L.velocity;
+    j.effort = L.effort;
     j.mass = L.m;
     j.com = Eigen::Vector3d(L.lc, 0.0, 0.0);
     const double b2 = L.m > 0.0 ? std::max(0.0, 12.0 * L.I / L.m - L.l * L.l) : 0.0;

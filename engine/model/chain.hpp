@@ -48,6 +48,8 @@ struct ChainJoint {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ(); ///< unit axis in this joint's frame
   double lower = -std::numeric_limits<double>::infinity();  ///< position limits [rad or m]
   double upper = std::numeric_limits<double>::infinity();
+  double velocity = std::numeric_limits<double>::infinity();  ///< |qd| limit [rad/s or m/s] (URDF <limit velocity>)
+  double effort = std::numeric_limits<double>::infinity();    ///< |tau| limit [Nm or N] (URDF <limit effort>)
   double mass = 0.0;                               ///< of the body this joint moves [kg]
   Eigen::Vector3d com = Eigen::Vector3d::Zero();   ///< its centre of mass, joint frame [m]
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();  ///< about the centre of mass, joint frame axes [kg m^2]
@@ -88,6 +90,8 @@ struct PlanarLink {
   double I = 0.0;      ///< rotational inertia about the centre of mass, about z [kg m^2]
   double lower = -std::numeric_limits<double>::infinity();  ///< joint limits [rad]
   double upper = std::numeric_limits<double>::infinity();
+  double velocity = std::numeric_limits<double>::infinity();  ///< |qd| limit [rad/s]
+  double effort = std::numeric_limits<double>::infinity();    ///< |tau| limit [Nm]
 };
 
 /// An n-link planar arm in the base xy plane with gravity g along -y [m/s^2]; the tip frame at the

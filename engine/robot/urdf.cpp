@@ -267,6 +267,13 @@ class Builder {
       if (!(j.lower <= j.upper))
         fail(joint_line(joint.name), "joint '" + joint.name + "': limit lower > upper");
     }
+    if (joint.limits) {  // velocity and effort limit continuous joints too; 0 (a common placeholder) = none
+      const double v = joint.limits->velocity, f = joint.limits->effort;
+      if (std::isnan(v) || v < 0.0 || std::isnan(f) || f < 0.0)
+        fail(joint_line(joint.name), "joint '" + joint.name + "': limit velocity and effort must be >= 0");
+      if (v > 0.0) j.velocity = v;
+      if (f > 0.0) j.effort = f;
+    }
     return j;
   }
 

@@ -78,9 +78,10 @@ std::vector<MetricDef> metrics(BlockKind kind, const KindContext& context) {
 }
 std::span<const std::string_view> statuses(BlockKind kind) {
   using ik::Status;
-  static const std::array<std::string_view, 5> trajectory{to_string(RunStatus::ok), to_string(RunStatus::unreachable_start),
-                                                          to_string(RunStatus::singular), to_string(RunStatus::diverged),
-                                                          to_string(RunStatus::undersampled)};
+  static const std::array<std::string_view, 7> trajectory{
+      to_string(RunStatus::ok),           to_string(RunStatus::unreachable_start), to_string(RunStatus::singular),
+      to_string(RunStatus::diverged),     to_string(RunStatus::undersampled),      to_string(RunStatus::off_path),
+      to_string(RunStatus::out_of_limits)};
   static const std::array<std::string_view, 9> ik{
       ik::to_string(Status::converged), ik::to_string(Status::stalled),  ik::to_string(Status::singular),
       ik::to_string(Status::max_iter),  ik::to_string(Status::cycle),    ik::to_string(Status::diverged),

@@ -1,4 +1,7 @@
 // The trajectory kind's parameters and metrics (see schema/params.hpp).
+#include <algorithm>
+#include <limits>
+
 #include "methods/seed_cases.hpp"
 #include "schema/kind_tables.hpp"
 #include "schema/table_builders.hpp"
@@ -64,6 +67,24 @@ std::vector<ParamDef> trajectory_params(const KindContext& ctx) {
   t.push_back(real<Run>("torque_bound", FileUnit::none, "Nm", TrajectoryOptions::torque_bound_rule,
                         "|tau_i| above this stops the run (diverged)",
                         [](auto& r) -> auto& { return r.options.torque_bound; }));
+  t.push_back(real<Run>("K_P", FileUnit::none, "1/s^2", TrajectoryOptions::clik_gain_rule,
+                        "closed-loop task feedback: + K_P (path - tip) in the commanded task acceleration (0 = open loop)",
+                        [](auto& r) -> auto& { return r.options.clik_kp; }));
+  t.push_back(real<Run>("K_D", FileUnit::none, "1/s", TrajectoryOptions::clik_gain_rule,
+                        "closed-loop task feedback: + K_D (path velocity - tip velocity) (0 = open loop)",
+                        [](auto& r) -> auto& { return r.options.clik_kd; }));
+  t.push_back(real<Run>("tracking_bound", FileUnit::none, "m", TrajectoryOptions::bound_rule,
+                        "|tip - path| above this at any sample makes the run off_path (see on_violation)",
+                        [](auto& r) -> auto& { return r.options.tracking_bound; }));
+  if (robot.pose_task || robot.vertex_alpha())
+    t.push_back(real<Run>("orientation_bound", FileUnit::deg, "rad", TrajectoryOptions::bound_rule,
+                          "an orientation error above this at any sample makes the run off_path (pose tasks, vertex_alpha)",
+                          [](auto& r) -> auto& { return r.options.orientation_bound; },
+                          robot.pose_task ? EffectRule{} : kVertexOnly));
+  t.push_back(named<Run>("on_violation", names_of<OnViolation>(OnViolation::mark, OnViolation::stop, OnViolation::ignore),
+                         "a sample beyond the tracking bound or the joint limits: mark (status off_path / "
+                         "out_of_limits, run to the end), stop (end there, metrics NaN) or ignore",
+                         [](auto& r) -> auto& { return r.options.on_violation; }));
   if (!robot.chain)
     t.push_back(named<Run>("inertia", names_of<InertiaForm>(InertiaForm::physical, InertiaForm::thesis_m11),
                            "closed form of M(q)", [](auto& r) -> auto& { return r.inertia; }));
@@ -85,8 +106,14 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
                 [](const M& r) { return r.E; }),
       metric<M>("E_M", CellType::f64, "Nm/sqrt(kg m^2)", "mean over samples of sqrt(tau^T M^-1 tau)", true,
                 [](const M& r) { return r.E_M; }),
-      metric<M>("tau_inf", CellType::f64, "Nm", "max over samples and joints of |tau_i|", true,
-                [](const M& r) { return r.tau_inf.maxCoeff(); }),
+      metric<M>("tau_inf", CellType::f64, "Nm", "max over samples and revolute joints of |tau_i|", true,
+                [robot = ctx.robot](const M& r) {
+                  double a = -std::numeric_limits<double>::infinity();
+                  bool any = false;
+                  for (int j = 0; j < r.tau_inf.size(); ++j)
+                    if (!robot.is_prismatic(j)) a = any ? std::max(a, r.tau_inf[j]) : r.tau_inf[j], any = true;
+                  return any ? a : std::numeric_limits<double>::quiet_NaN();
+                }),
       metric<M>("min_manipulability", CellType::f64, "m^2", "min over samples of sqrt(det(J J^T))", true,
                 [](const M& r) { return r.min_manipulability; }),
       metric<M>("torque_sq_integral", CellType::f64, "N^2 m^2 s",
@@ -96,6 +123,8 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
                 false, [](const M& r) { return r.power_sq_integral; }),
       metric<M>("max_tracking_error", CellType::f64, "m", "max over samples of |tip - path| (open-loop drift)", true,
                 [](const M& r) { return r.max_tracking_error; }),
+      metric<M>("mean_tracking_error", CellType::f64, "m", "mean over samples of |tip - path|", true,
+                [](const M& r) { return r.mean_tracking_error; }),
       metric<M>("final_alpha", CellType::f64, "rad", "end-effector orientation at the last sample", false,
                 [](const M& r) { return r.final_alpha; }),
       metric<M>("samples", CellType::i64, "", "samples computed (2001 for the seed's square)", false,
@@ -113,6 +142,36 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
                                }));
   }
   m.insert(m.begin() + 3, joints.begin(), joints.end());
+  const RobotShape& robot = ctx.robot;
+  if (robot.pose_task || robot.vertex_alpha())
+    m.push_back(metric<M>("max_orientation_error", CellType::f64, "rad",
+                          "max over samples of the tip's orientation error (pose tasks, vertex_alpha; NaN otherwise)",
+                          true, [](const M& r) { return r.max_orientation_error; }));
+  bool prismatic = false;
+  for (int j = 0; j < robot.joints; ++j) prismatic = prismatic || robot.is_prismatic(j);
+  if (prismatic) {
+    m.push_back(metric<M>("E_force", CellType::f64, "N",
+                          "mean over samples of sqrt(f^T f) over the prismatic joints (E covers the revolute ones)",
+                          true, [](const M& r) { return r.E_force; }));
+    m.push_back(metric<M>("force_inf", CellType::f64, "N", "max over samples and prismatic joints of |f_i|", true,
+                          [robot](const M& r) {
+                            double a = 0;
+                            for (int j = 0; j < r.tau_inf.size(); ++j)
+                              if (robot.is_prismatic(j)) a = std::max(a, r.tau_inf[j]);
+                            return r.tau_inf.hasNaN() ? std::numeric_limits<double>::quiet_NaN() : a;
+                          }));
+  }
+  if (robot.chain) {
+    m.push_back(metric<M>("max_q_limit_ratio", CellType::f64, "",
+                          "max over samples and joints of |q - mid| / half range (1 = at a position limit; NaN: none)",
+                          false, [](const M& r) { return r.max_q_limit_ratio; }));
+    m.push_back(metric<M>("max_qd_limit_ratio", CellType::f64, "",
+                          "max over samples and joints of |qd| / velocity limit (NaN: none)", false,
+                          [](const M& r) { return r.max_qd_limit_ratio; }));
+    m.push_back(metric<M>("max_tau_limit_ratio", CellType::f64, "",
+                          "max over samples and joints of |tau| / effort limit (NaN: none)", false,
+                          [](const M& r) { return r.max_tau_limit_ratio; }));
+  }
   return m;
 }
 

@@ -1,0 +1,86 @@
+"""Every `ok` run of every shipped study is a run a researcher can publish: read with h5py from the
+results files the regression test wrote (its work dir), each `ok` trajectory run stays within its
+own tracking bound (and orientation bound where the task has one) and within its robot's joint
+limits (every limit ratio <= 1 where the robot has limits); seed 000's Table 4 runs all stay `ok`;
+with closed-loop gains the 5R study keeps >= 90 % of its runs `ok` within 1 mm of the path.
+
+usage: /usr/bin/python3 test_trusted_runs.py RESULTS_DIR
+"""
+import glob
+import os
+import sys
+import unittest
+
+import h5py
+import numpy as np
+
+RESULTS = None
+
+
+def text(col):
+    return np.array([v.decode() if isinstance(v, bytes) else str(v) for v in col[()]])
+
+
+def trajectory_runs(path):
+    """The /runs columns of the trajectory runs of a results file, as numpy arrays (None if none)."""
+    with h5py.File(path, "r") as f:
+        runs = f["runs"]
+        cols = {}
+        for name in runs:
+            d = runs[name]
+            cols[name] = text(d) if d.dtype.kind in "OSU" else d[()]
+    if "tracking_bound" not in cols:
+        return None
+    keep = ~np.isnan(cols["tracking_bound"].astype(float))
+    return {k: v[keep] for k, v in cols.items()} if keep.any() else None
+
+
+class TrustedRuns(unittest.TestCase):
+    def files(self):
+        found = sorted(glob.glob(os.path.join(RESULTS, "*.h5")))
+        self.assertGreater(len(found), 5, f"no results files in {RESULTS}")
+        return found
+
+    def test_every_ok_run_is_on_its_path_and_within_its_limits(self):
+        checked = 0
+        for path in self.files():
+            runs = trajectory_runs(path)
+            if runs is None:
+                continue
+            name = os.path.basename(path)
+            ok = runs["status"] == "ok"
+            with self.subTest(study=name):
+                err = runs["max_tracking_error"][ok]
+                self.assertTrue(np.all(err <= runs["tracking_bound"][ok]), name)
+                if "max_orientation_error" in runs:
+                    o = runs["max_orientation_error"][ok]
+                    has = ~np.isnan(o)
+                    self.assertTrue(np.all(o[has] <= runs["orientation_bound"][ok][has]), name)
+                for ratio in ("max_q_limit_ratio", "max_qd_limit_ratio", "max_tau_limit_ratio"):
+                    if ratio in runs:
+                        r = runs[ratio][ok]
+                        r = r[~np.isnan(r)]
+                        self.assertTrue(np.all(r <= 1.0), f"{name} {ratio} max {r.max() if r.size else 0}")
+                # a run marked off the path is beyond its bound, one out of limits beyond a limit
+                off = runs["status"] == "off_path"
+                if off.any() and "max_orientation_error" not in runs:
+                    self.assertTrue(np.all(runs["max_tracking_error"][off] > runs["tracking_bound"][off]), name)
+                checked += int(ok.sum())
+        self.assertGreater(checked, 1000)
+
+    def test_table4_runs_stay_ok(self):
+        runs = trajectory_runs(os.path.join(RESULTS, "thesis_table4.h5"))
+        self.assertEqual(len(runs["status"]), 21)
+        self.assertEqual(list(runs["status"]), ["ok"] * 21)
+
+    def test_closed_loop_keeps_the_5r_on_its_path(self):
+        runs = trajectory_runs(os.path.join(RESULTS, "redundancy_5r_clik.h5"))
+        closed = runs["K_P"] > 0
+        good = (runs["status"] == "ok") & (runs["max_tracking_error"] < 1e-3)
+        share = good[closed].mean()
+        self.assertGreaterEqual(share, 0.90, f"{share:.3f} of the closed-loop runs ok within 1 mm")
+
+
+if __name__ == "__main__":
+    RESULTS = sys.argv.pop(1)
+    unittest.main()
