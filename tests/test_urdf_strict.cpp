@@ -96,9 +96,10 @@ TEST(UrdfStrict, NumbersAreWholeFiniteNumbers) {
     EXPECT_NE(e.message.find(c.why), std::string::npos) << e.what();
     EXPECT_NE(e.message.find("expected"), std::string::npos) << e.what();
   }
-  // a leading '+' and surrounding spaces are numbers still
-  EXPECT_EQ(parse_urdf(replaced(arm, "<mass value=\"1\"/>", "<mass value=\" +1.0 \"/>"), "base", "l2", kGravityY).joints[0].mass,
-            1.0);
+  // what urdfdom itself refuses (it would log the error and drop the inertial) is an error as well
+  const std::string spaced = replaced(arm, "<mass value=\"1\"/>", "<mass value=\" +1.0 \"/>");
+  const UrdfError u = expect_error([&] { parse_urdf(spaced, "base", "l2", kGravityY); });
+  EXPECT_NE(u.message.find("l1"), std::string::npos) << u.what();
 }
 
 // urdfdom drops an <inertial> it cannot read (the link massless, exit 0): seed3r with link1's mass as
