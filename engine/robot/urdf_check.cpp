@@ -7,6 +7,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <string_view>
@@ -85,6 +86,26 @@ std::string number_problem(std::string_view text, int count) {
   if (found != count)
     return "'" + std::string(text) + "' holds " + std::to_string(found) + (found == 1 ? " number" : " numbers");
   return "";
+}
+
+// Throws at the first byte that is not part of a well-formed UTF-8 sequence, or a NUL: tinyxml 2.6
+// steps over a UTF-8 sequence by its lead byte's length, past the end of a text cut inside one.
+void check_utf8(const std::string& xml, const std::string& file) {
+  int line = 1;
+  for (std::size_t i = 0; i < xml.size();) {
+    const auto c = static_cast<unsigned char>(xml[i]);
+    const std::size_t n = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    bool ok = n > 0 && c != 0 && i + n <= xml.size();
+    for (std::size_t k = 1; ok && k < n; ++k) ok = (static_cast<unsigned char>(xml[i + k]) & 0xC0) == 0x80;
+    if (!ok) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", c);
+      throw UrdfError(file, line, std::string("byte ") + hex + (c == 0 ? " (NUL)" : " does not start a complete UTF-8 character") +
+                                      "; expected a UTF-8 text");
+    }
+    if (c == '\n') ++line;
+    i += n;
+  }
 }
 
 class Checker {
@@ -172,6 +193,7 @@ class Checker {
 }  // namespace
 
 void check_text(const std::string& xml, const std::string& file) {
+  check_utf8(xml, file);
   TiXmlDocument doc;  // urdfdom's own XML parser; its errors carry a line
   doc.Parse(xml.c_str());
   if (doc.Error()) throw UrdfError(file, doc.ErrorRow(), std::string("XML parse error: ") + doc.ErrorDesc());
