@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <cmath>
 #include <fstream>
+#include <iterator>
 
 #include "model/chain_dynamics.hpp"
 #include "model/dynamics.hpp"
@@ -74,6 +76,25 @@ std::string two_link_urdf(const std::string& type2 = "revolute", double mass2 = 
   <joint name="jt" type="fixed"><parent link="l2"/><child link="tool"/><origin xyz="1 0 0"/></joint>
 </robot>
 )";
+}
+
+/// The diagnostic of `text` at `line` (method = "vertex_alpha" on such a robot is an error of its own).
+StudyDiagnostic error_at(const std::string& text, int line) {
+  try {
+    parse_study(text, "bad.toml");
+  } catch (const StudyError& e) {
+    for (const StudyDiagnostic& d : e.diagnostics())
+      if (d.line == line) return d;
+    ADD_FAILURE() << "no error at line " << line << ": " << e.what();
+    return {};
+  }
+  ADD_FAILURE() << "no StudyError for:\n" << text;
+  return {};
+}
+
+std::string replaced_all(std::string text, const std::string& from, const std::string& to) {
+  for (std::size_t p = text.find(from); p != std::string::npos; p = text.find(from, p + to.size())) text.replace(p, from.size(), to);
+  return text;
 }
 
 }  // namespace
@@ -223,4 +244,99 @@ TEST(StudyRobot, SeedPresetOptimisationNeedsTheSeedArmsParameters) {
   EXPECT_EQ(d.line, 8) << d.str();
   EXPECT_NE(d.message.find("preset '1h' optimises alpha1A"), std::string::npos) << d.str();
   EXPECT_NE(d.message.find("expected variables"), std::string::npos) << d.str();
+}
+
+// vertex_alpha = [...] is shorthand for vertex_alpha_2 .. vertex_alpha_5 (the seed square's vertices):
+// taken where the robot has those parameters (a planar 3-joint arm on a position path), refused at the
+// key elsewhere -- in a [[block]] and in an [[optimize]], never a crash.
+TEST(StudyRobot, VertexAlphaShorthandOnEveryRobotKind) {
+  const std::string block = "[[block]]\nname = \"b\"\nkind = \"trajectory\"\nmethod = \"vertex_alpha\"\n"
+                            "vertex_alpha = [10, 20, 30, 40]\n";
+  const std::string optimize = "[[optimize]]\nname = \"o\"\nkind = \"trajectory\"\nmethod = \"vertex_alpha\"\n"
+                               "vertex_alpha = [10, 20, 30, 40]\nvariables = { alpha1A = [-180, 180] }\n"
+                               "[optimize.local]\nalgorithm = \"LN_BOBYQA\"\nmax_evals = 10\n";
+  const std::string urdf = "[robot]\nurdf = \"" + studies_dir() + "robots/";
+  struct Robot {
+    std::string text;  // [robot] (4 lines) or nothing
+    bool takes;
+  };
+  const std::vector<Robot> robots = {
+      {"", true},                                                                       // the seed's closed form
+      {"[robot]\nl = [1, 1, 1]\nm = [5, 2, 1]\ndynamics = \"recursive\"\n", true},      // an n-link arm of 3
+      {"[robot]\nl = [0.9, 0.9, 0.8, 0.6]\nm = [3.6, 3.6, 3.2, 2.4]\nb = 0.06\n", false},  // of 4
+      {urdf + "seed3r.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\n", true},
+      {urdf + "planar4r.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\n", false},
+  };
+  for (const Robot& r : robots) {
+    const int key_line = r.text.empty() ? 5 : 9;  // vertex_alpha's line: after 4 [robot] lines, if any
+    for (const std::string& table : {block, optimize}) {
+      SCOPED_TRACE(r.text + table);
+      if (r.takes) {
+        const Study s = parse_study(r.text + table, "s.toml");
+        const Block& b = table == block ? s.blocks.front() : s.optimizations.front().block();
+        EXPECT_NEAR(std::get<double>(b.value(0, "vertex_alpha_3")), 20 * M_PI / 180, 1e-15);
+        EXPECT_NEAR(std::get<double>(b.value(0, "vertex_alpha_5")), 40 * M_PI / 180, 1e-15);
+      } else {
+        const StudyDiagnostic d = error_at(r.text + table, key_line);
+        EXPECT_EQ(d.column, 1) << d.str();
+        EXPECT_NE(d.message.find("not for a planar arm of 4 joints"), std::string::npos) << d.str();
+        EXPECT_NE(d.message.find("expected no vertex_alpha"), std::string::npos) << d.str();
+      }
+    }
+  }
+  // the 7-DOF arm: a spatial robot
+  const std::string arm7 = urdf + "arm7.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\n[task]\n"
+                                  "vertices = [[0.5, -0.1, 0.4], [0.5, 0.1, 0.4]]\ndurations = [1]\n";
+  for (const std::string& table : {block, optimize}) {
+    const StudyDiagnostic d = error_at(arm7 + replaced_all(table, "[10, 20, 30, 40]", "[10]"), 12);
+    EXPECT_NE(d.message.find("not for a spatial robot"), std::string::npos) << d.str();
+  }
+}
+
+// A robot in error is the only error: its task and blocks are not checked against another robot.
+TEST(StudyRobot, RobotErrorHasNoFollowOnErrors) {
+  Folder f;
+  f.write("bad.urdf", std::string(std::istreambuf_iterator<char>(std::ifstream(std::string(KS_SOURCE_DIR) +
+                                                                              "/tests/fuzz/urdf_bad/mass_unit.urdf").rdbuf()),
+                                  {}));
+  const std::string text = "[robot]\nurdf = \"bad.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\n[task]\n"
+                           "vertices = [[0.5, -0.1, 0.4], [0.5, 0.1, 0.4]]\ndurations = [1]\n" + kTraj + "q0_7 = 10\n";
+  try {
+    parse_study(text, f.study());
+    ADD_FAILURE() << "no error";
+  } catch (const StudyError& e) {
+    ASSERT_EQ(e.diagnostics().size(), 1u) << e.what();
+    EXPECT_EQ(e.diagnostics()[0].line, 2);
+    EXPECT_NE(e.diagnostics()[0].message.find("bad.urdf:"), std::string::npos) << e.what();
+    EXPECT_NE(e.diagnostics()[0].message.find("3.0kg"), std::string::npos) << e.what();
+  }
+}
+
+// The reach bound: the sum of the offsets between successive joints from the first joint to the tip
+// (in the plane for a planar chain). Lengths from the robots' own descriptions.
+TEST(StudyRobot, VertexBeyondTheReachBoundOfEveryRobotKind) {
+  const std::string two = "durations = [1]\n" + kTraj;
+  // the seed's closed form: links of 1 m, reach 3 m; (3.5, 0) is 3.5 m away
+  const StudyDiagnostic seed = first_error("[task]\nvertices = [[1, 0], [3.5, 0]]\n" + two);
+  EXPECT_EQ(seed.line, 2);
+  EXPECT_EQ(seed.column, 21);
+  EXPECT_NE(seed.message.find("vertex 2 is 3.5 m from the first joint's axis"), std::string::npos) << seed.str();
+  EXPECT_NE(seed.message.find("at most 3 m"), std::string::npos) << seed.str();
+  // an n-link arm: 0.9 + 0.9 + 0.8 + 0.6 = 3.2 m
+  const std::string arm4 = "[robot]\nl = [0.9, 0.9, 0.8, 0.6]\nm = [3.6, 3.6, 3.2, 2.4]\nb = 0.06\n";
+  EXPECT_NE(first_error(arm4 + "[task]\nvertices = [[1, 0], [0, 3.3]]\n" + two).message.find("at most 3.2 m"),
+            std::string::npos);
+  EXPECT_NO_THROW(parse_study(arm4 + "[task]\nvertices = [[1, 0], [0, 3.1]]\n" + two, "s.toml"));
+  // planar4r.urdf, the same lengths
+  const std::string p4 = "[robot]\nurdf = \"" + studies_dir() + "robots/planar4r.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\n";
+  EXPECT_NE(first_error(p4 + "[task]\nvertices = [[1, 0], [3.3, 0]]\n" + two).message.find("at most 3.2 m"), std::string::npos);
+  EXPECT_NO_THROW(parse_study(p4 + "[task]\nvertices = [[1, 0], [3.1, 0]]\n" + two, "s.toml"));
+  // arm7.urdf: joint a1 at z = 0.15; then 0.19 + 4 x 0.2 + 0.081 + 0.045 + 0.10 = 1.216 m to the tool
+  const std::string a7 = "[robot]\nurdf = \"" + studies_dir() + "robots/arm7.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\n";
+  const StudyDiagnostic far = first_error(a7 + "[task]\nvertices = [[0.5, 0, 0.6], [0.9, 0, 1.35]]\n" + two);
+  EXPECT_EQ(far.line, 6);
+  EXPECT_EQ(far.column, 28);
+  EXPECT_NE(far.message.find("vertex 2 is 1.5 m from the first joint,"), std::string::npos) << far.str();  // (0.9, 1.2)
+  EXPECT_NE(far.message.find("at most 1.216 m"), std::string::npos) << far.str();
+  EXPECT_NO_THROW(parse_study(a7 + "[task]\nvertices = [[0.5, 0, 0.6], [0.5, 0, 1.2]]\n" + two, "s.toml"));  // 1.163 m
 }

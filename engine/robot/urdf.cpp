@@ -4,7 +4,6 @@
 #include "robot/urdf.hpp"
 
 #include <console_bridge/console.h>
-#include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Eigenvalues>
@@ -18,6 +17,7 @@
 #include <sstream>
 
 #include "model/chain_dynamics.hpp"
+#include "robot/urdf_check.hpp"
 
 namespace ks {
 
@@ -92,6 +92,8 @@ urdf::ModelInterfaceSharedPtr parse_model(const std::string& xml, std::vector<st
   static std::mutex console;  // console_bridge's output handler is process-wide
   std::lock_guard<std::mutex> lock(console);
   LogCapture capture;
+  const console_bridge::LogLevel level = console_bridge::getLogLevel();
+  console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_WARN);  // warnings and errors reach `capture`
   console_bridge::useOutputHandler(&capture);
   urdf::ModelInterfaceSharedPtr model;
   try {
@@ -100,6 +102,7 @@ urdf::ModelInterfaceSharedPtr parse_model(const std::string& xml, std::vector<st
     capture.messages.push_back(e.what());
   }
   console_bridge::restorePreviousOutputHandler();
+  console_bridge::setLogLevel(level);
   messages = std::move(capture.messages);
   return model;
 }
@@ -148,10 +151,7 @@ class Builder {
     const urdf::Inertial& in = *link.inertial;
     M3 Ic;
     Ic << in.ixx, in.ixy, in.ixz, in.ixy, in.iyy, in.iyz, in.ixz, in.iyz, in.izz;
-    if (!std::isfinite(in.mass) || in.mass < 0.0) fail(link_line(link.name), "link '" + link.name + "': mass must be >= 0");
-    if (!Ic.allFinite() ||
-        Eigen::SelfAdjointEigenSolver<M3>(Ic, Eigen::EigenvaluesOnly).eigenvalues()[0] < -1e-12 * std::max(1.0, Ic.norm()))
-      fail(link_line(link.name), "link '" + link.name + "': the inertia (ixx..izz) is not positive semi-definite");
+    check_mass_properties(link.name, in.mass, Ic);
     const Frame f = link_in_body * to_frame(in.origin);
     const V3& c = f.p;
     body.m += in.mass;
@@ -162,11 +162,16 @@ class Builder {
   }
 
   // Adds every link attached to `link` through fixed joints (recursively), except `skip_child`.
+  // A side branch through a moving joint is refused unless it carries no mass (then ignoring it is exact).
   void add_fixed_subtree(Body& body, const urdf::Link& link, const Frame& link_in_body, const std::string& skip_child) const {
     for (const auto& joint : link.child_joints) {
-      if (joint->type != urdf::Joint::FIXED || joint->child_link_name == skip_child) continue;
+      if (joint->child_link_name == skip_child) continue;
       const auto child = model_.getLink(joint->child_link_name);
       if (!child) continue;
+      if (joint->type != urdf::Joint::FIXED) {
+        refuse_side_branch(link, *joint, *child);
+        continue;
+      }
       const Frame f = link_in_body * to_frame(joint->parent_to_joint_origin_transform);
       add_inertial(body, *child, f);
       add_fixed_subtree(body, *child, f, {});
@@ -178,12 +183,14 @@ class Builder {
     const auto tip = find_link(tip_name, "tip");
     std::vector<urdf::JointConstSharedPtr> path;  // tip to base, then reversed
     for (urdf::LinkConstSharedPtr link = tip; link->name != base->name; link = link->getParent()) {
+      if (path.size() > model_.joints_.size()) fail(link_line(tip->name), "the links above the tip form a cycle");
       if (!link->parent_joint || !link->getParent())
         fail(link_line(tip->name), "tip link '" + tip->name + "' is not below base link '" + base->name +
                                        "' (going up from it reaches the root link '" + link->name + "')");
       path.push_back(link->parent_joint);
     }
     std::reverse(path.begin(), path.end());
+    refuse_mimic(path);
 
     Chain chain;
     chain.name = model_.getName();
@@ -253,6 +260,70 @@ class Builder {
   }
 
  private:
+  // A link's mass properties: mass finite and >= 0, inertia finite with principal moments >= 0, each at
+  // most the sum of the other two (a rigid body's: I1 + I2 - I3 = 2 * integral of the squared distance
+  // along the third principal axis >= 0), both within 1e-6 of the trace (rounded printed digits).
+  void check_mass_properties(const std::string& name, double mass, const M3& Ic) const {
+    const int line = link_line(name);
+    if (!std::isfinite(mass) || mass < 0.0)
+      fail(line, "link '" + name + "': <mass value=\"" + num(mass) + "\"> is " + (std::isfinite(mass) ? "negative" : "not finite") +
+                     "; expected a mass >= 0 [kg]");
+    if (!Ic.allFinite()) fail(line, "link '" + name + "': the inertia (ixx..izz) is not finite; expected finite numbers [kg m^2]");
+    const V3 p = Eigen::SelfAdjointEigenSolver<M3>(Ic, Eigen::EigenvaluesOnly).eigenvalues();  // ascending
+    const double tol = 1e-6 * std::max(std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]), 1e-300);
+    const std::string moments = "(" + num(p[0]) + ", " + num(p[1]) + ", " + num(p[2]) + " kg m^2)";
+    if (p[0] < -tol)
+      fail(line, "link '" + name + "': the inertia's principal moments " + moments +
+                     " include a negative one; expected a positive semi-definite inertia (ixx..izz about the centre of mass)");
+    if (p[2] > p[0] + p[1] + tol)
+      fail(line, "link '" + name + "': the inertia's principal moments " + moments + " violate the triangle inequality (" +
+                     num(p[2]) + " > " + num(p[0]) + " + " + num(p[1]) +
+                     "); expected each moment <= the sum of the other two (no rigid body has such an inertia)");
+  }
+
+  static std::string num(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  }
+
+  // Mass or inertia anywhere in the subtree of `link` (through any joints).
+  bool carries_mass(const urdf::Link& link) const {
+    if (link.inertial && (link.inertial->mass != 0.0 || link.inertial->ixx != 0.0 || link.inertial->iyy != 0.0 ||
+                          link.inertial->izz != 0.0))
+      return true;
+    for (const auto& joint : link.child_joints)
+      if (const auto child = model_.getLink(joint->child_link_name); child && carries_mass(*child)) return true;
+    return false;
+  }
+
+  void refuse_side_branch(const urdf::Link& link, const urdf::Joint& joint, const urdf::Link& child) const {
+    if (!carries_mass(child)) return;  // a massless branch (a frame, a sensor mount) does not change the dynamics
+    fail(joint_line(joint.name), "link '" + link.name + "' (moved by the chain) has a side branch through the moving joint '" +
+                                     joint.name + "' to link '" + child.name +
+                                     "' with mass: a serial chain cannot simulate the branch's own motion; expected a chain "
+                                     "from base to tip (make '" + joint.name + "' fixed to merge the branch at its origin, "
+                                     "or choose a tip at the branch's end)");
+  }
+
+  // <mimic> couples a joint to another: the chain's joints move independently, so the coupling could not be honoured.
+  void refuse_mimic(const std::vector<urdf::JointConstSharedPtr>& path) const {
+    for (const auto& joint : path)
+      if (joint->mimic && joint->type != urdf::Joint::FIXED)
+        fail(joint_line(joint->name), "joint '" + joint->name + "' mimics joint '" + joint->mimic->joint_name +
+                                          "' (<mimic>): the engine moves every chain joint independently and cannot "
+                                          "honour the coupling; expected independent joints (remove <mimic>, or make "
+                                          "the joint fixed)");
+    for (const auto& [name, joint] : model_.joints_) {
+      if (!joint->mimic || joint->type == urdf::Joint::FIXED) continue;
+      for (const auto& on_path : path)
+        if (on_path->name == joint->mimic->joint_name && on_path->type != urdf::Joint::FIXED)
+          fail(joint_line(name), "joint '" + name + "' mimics the chain's joint '" + on_path->name +
+                                     "' (<mimic>): the engine cannot honour the coupling; expected no joint "
+                                     "mimicking a chain joint (remove <mimic>, or make '" + name + "' fixed)");
+    }
+  }
+
   ChainJoint make_joint(const urdf::Joint& joint, const Frame& origin) const {
     ChainJoint j;
     j.name = joint.name;
@@ -317,14 +388,10 @@ Chain parse_urdf(std::string_view text, std::string_view base_link, std::string_
                  std::string_view file) {
   const std::string xml(text);
   const std::string file_name(file);
-  {
-    TiXmlDocument doc;  // urdfdom reports XML errors without a line: parse once here for it
-    doc.Parse(xml.c_str());
-    if (doc.Error()) throw UrdfError(file_name, doc.ErrorRow(), std::string("XML parse error: ") + doc.ErrorDesc());
-  }
+  urdf_check::check_text(xml, file_name);  // XML, numbers, loops: located before urdfdom reads the text
   std::vector<std::string> messages;
   const urdf::ModelInterfaceSharedPtr model = parse_model(xml, messages);
-  if (!model) {
+  if (!model || !messages.empty()) {  // a warning or error of urdfdom's means it dropped or guessed something
     std::string joined;
     int line = 0;
     for (const std::string& m : messages) {

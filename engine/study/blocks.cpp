@@ -201,6 +201,17 @@ void Parser::read_fixed_params(BlockDraft& d) {
   for (auto&& [k, n] : ordered(b)) {
     const std::string key(k->str());
     if (key == "vertex_alpha" && d.kind == BlockKind::trajectory) {
+      if (!d.info_of("vertex_alpha_2")) {  // the robot or task has no vertex_alpha_i parameters
+        const RobotShape& r = d.ctx.robot;
+        error(*k, std::string("vertex_alpha = [...] sets the tip angle at vertices 2.." + std::to_string(nverts) +
+                              " (vertex_alpha_2 ..), parameters of the seed's non-redundant vertex_alpha method, "
+                              "defined for a planar 3-joint arm on a position path, not for ") +
+                      (!r.planar             ? "a spatial robot"
+                       : r.pose_task         ? "an orientation path"
+                                             : "a planar arm of " + std::to_string(r.joints) + " joints") +
+                      "; expected no vertex_alpha (the local methods take no vertex angles)");
+        continue;
+      }
       const auto* a = n->as_array();
       if (!a || a->size() + 1 != nverts) {
         error(*n, "vertex_alpha is " + (a ? "an array of " + std::to_string(a->size()) : type_name(*n)) +
@@ -218,7 +229,8 @@ void Parser::read_fixed_params(BlockDraft& d) {
                                     std::to_string(nverts));
           continue;
         }
-        if (auto c = param_value(*d.info_of(pname), *a->get(i))) d.spec.fixed.emplace_back(pname, *c);
+        if (const ParamDef* info = d.info_of(pname))
+          if (auto c = param_value(*info, *a->get(i))) d.spec.fixed.emplace_back(pname, *c);
       }
       continue;
     }

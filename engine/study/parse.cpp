@@ -58,9 +58,19 @@ Study study_parse::Parser::run() {
     error(e.source(), "TOML syntax: " + std::string(e.description()) + "; expected valid TOML (https://toml.io)");
     throw StudyError(diags_);
   }
+  const auto fail = [this] {
+    std::stable_sort(diags_.begin(), diags_.end(), [](const StudyDiagnostic& a, const StudyDiagnostic& b) {
+      return std::pair(a.line, a.column) < std::pair(b.line, b.column);
+    });
+    throw StudyError(diags_);
+  };
   check_keys(root, {"study", "robot", "task", "block", "optimize"}, "the top level");
   parse_study_table(root, s);
+  const std::size_t before_robot = diags_.size();
   parse_robot(root, s);
+  // the task's points, the blocks' parameters and the reach follow from the robot: checked against
+  // a robot in error (another robot in its place) they would only add false errors
+  if (diags_.size() > before_robot) fail();
   parse_task(root, s);
   s.arm_chain = s.robot_chain();
   if (!s.robot_text.empty()) s.sha256 = sha256_hex(std::string(text) + std::string(1, '\0') + s.robot_text);  // the robot is part of the study
@@ -72,12 +82,7 @@ Study study_parse::Parser::run() {
       std::any_of(s.optimizations.begin(), s.optimizations.end(),
                   [&](const OptimizeBlock& o) { return trajectory(o.block()); }))
     check_task_fits_robot(root.get("task") ? root.get("task")->as_table() : nullptr, s);
-  if (!diags_.empty()) {
-    std::stable_sort(diags_.begin(), diags_.end(), [](const StudyDiagnostic& a, const StudyDiagnostic& b) {
-      return std::pair(a.line, a.column) < std::pair(b.line, b.column);
-    });
-    throw StudyError(diags_);
-  }
+  if (!diags_.empty()) fail();
   return s;
 }
 

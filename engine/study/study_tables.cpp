@@ -187,30 +187,74 @@ void Parser::parse_task_orientation(const toml::table& t, Study& s) {
   if (o.size() == a->size()) s.task.orientation = o;
 }
 
-void Parser::check_task_fits_robot(const toml::table* task, Study& s) {
-  if (!s.chain) return;
-  // reach: the distance from the first joint's origin to the tip can not exceed the sum of the
-  // frame offsets (and of the prismatic travels)
-  const Chain& c = *s.chain;
-  double reach = c.tip.p.norm();
+namespace {
+
+/// A sound bound on how far the tip gets from the first joint: no configuration puts it farther.
+struct Reach {
+  double bound = 0.0;            ///< [m]; infinite with an unlimited prismatic joint
+  Eigen::Vector3d centre;        ///< the first joint's origin (base frame)
+  bool in_plane = false;         ///< measured in the base xy plane (from the first joint's axis)
+};
+
+/// Every joint turns about (or slides across) the base z axis: each origin maps z to +-z and each
+/// revolute axis is +-z, so the xy projection of every offset keeps its length in any configuration.
+bool moves_in_xy(const Chain& c) {
+  const auto along_z = [](const Eigen::Vector3d& v) { return std::abs(std::abs(v.z()) - v.norm()) <= 1e-12 * v.norm(); };
+  for (const ChainJoint& j : c.joints)
+    if (!along_z(j.origin.R.col(2)) || (j.type == JointType::revolute && !along_z(j.axis))) return false;
+  return along_z(c.tip.R.col(2));
+}
+
+/// The distance from the first joint to the tip is at most the sum of the frame offsets from the first
+/// joint to the tip and of the prismatic travels (the triangle inequality); in the plane, of their xy parts.
+Reach reach_of(const Chain& c, bool in_plane) {
+  Reach r;
+  r.in_plane = in_plane;
+  r.centre = c.joints.front().origin.p;
+  const auto length = [&](const Eigen::Vector3d& p) { return in_plane ? p.head<2>().norm() : p.norm(); };
+  r.bound = length(c.tip.p);
   for (int j = 0; j < c.dof(); ++j) {
-    if (j > 0) reach += c.joints[j].origin.p.norm();
+    if (j > 0) r.bound += length(c.joints[j].origin.p);
     if (c.joints[j].type == JointType::prismatic)
-      reach += std::max(std::abs(c.joints[j].lower), std::abs(c.joints[j].upper));
+      r.bound += std::max(std::abs(c.joints[j].lower), std::abs(c.joints[j].upper));
   }
-  const Eigen::Vector3d base = c.joints.front().origin.p;
+  return r;
+}
+
+}  // namespace
+
+void Parser::check_task_fits_robot(const toml::table* task, Study& s) {
+  const std::shared_ptr<const Chain> chain = s.robot_chain();  // the seed's 3R as its planar chain too
+  if (!chain || chain->dof() == 0) return;
+  const bool spatial = s.chain && !s.chain->planar();
+  // a planar task's points are (x, y) in the base frame: bounded in the plane only for a chain moving in it
+  if (!spatial && !moves_in_xy(*chain)) return;
+  const Reach reach = reach_of(*chain, !spatial);
+  if (!std::isfinite(reach.bound)) return;
+  const std::string bound = fmt(reach.bound) + " m, the sum of the offsets between successive joints from the first "
+                            "joint to the tip" + std::string(reach.in_plane ? " in the plane of motion" : "") +
+                            (std::any_of(chain->joints.begin(), chain->joints.end(),
+                                         [](const ChainJoint& j) { return j.type == JointType::prismatic; })
+                                 ? " plus the prismatic travels"
+                                 : "");
+  const std::string from = reach.in_plane ? "the first joint's axis" : "the first joint";
   const toml::node* vn = task ? task->get("vertices") : nullptr;
   for (std::size_t i = 0; i < s.task.vertices.size(); ++i) {
-    const double d = (s.task.vertex(i) - base).norm();
-    if (d > reach * (1 + 1e-12)) {
-      const toml::node* at = vn && vn->as_array() ? vn->as_array()->get(i) : vn;
-      if (at) error(*at, "vertex " + std::to_string(i + 1) + " is " + fmt(d) + " m from the first joint; expected a vertex within the "
-                              "robot's reach (" + fmt(reach) + " m)");
-      else {
-        error(Pos{1, 1}, "vertex " + std::to_string(i + 1) + " of the default path (the seed's square) is " + fmt(d) +
-                             " m from the first joint; expected [task] vertices within the robot's reach (" + fmt(reach) + " m)");
-        return;  // one message for the default path
-      }
+    Eigen::Vector3d v = s.task.vertex(i) - reach.centre;
+    if (reach.in_plane) v.z() = 0.0;
+    const double d = v.norm();
+    if (d <= reach.bound * (1 + 1e-12)) continue;
+    const toml::node* at = vn && vn->as_array() ? vn->as_array()->get(i) : nullptr;
+    if (at) {
+      error(*at, "vertex " + std::to_string(i + 1) + " is " + fmt(d) + " m from " + from +
+                     ", beyond the robot's reach (at most " + bound + "); expected a vertex within " + fmt(reach.bound) +
+                     " m of " + from);
+    } else {
+      error(vn ? pos_of(vn->source()) : task ? pos_of(task->source()) : Pos{1, 1},
+            "vertex " + std::to_string(i + 1) + " of the default path (the seed's square) is " + fmt(d) + " m from " +
+                from + ", beyond the robot's reach (at most " + bound + "); expected [task] vertices within " +
+                fmt(reach.bound) + " m of " + from);
+      return;  // one message for the default path
     }
   }
 }
