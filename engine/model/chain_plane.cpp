@@ -1,6 +1,7 @@
 // motion_plane() and in_plane_frame(): a planar chain in any plane of its base frame.
 #include "model/chain_plane.hpp"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <vector>
 

@@ -61,6 +61,7 @@ Study study_parse::Parser::run() {
   check_keys(root, {"study", "robot", "task", "block", "optimize"}, "the top level");
   parse_study_table(root, s);
   parse_robot(root, s);
+  place_robot_in_plane(s);
   parse_task(root, s);
   s.arm_chain = s.robot_chain();
   if (!s.robot_text.empty()) s.sha256 = sha256_hex(std::string(text) + std::string(1, '\0') + s.robot_text);  // the robot is part of the study
@@ -70,8 +71,10 @@ Study study_parse::Parser::run() {
   const auto trajectory = [](const Block& b) { return b.kind() == BlockKind::trajectory; };
   if (std::any_of(s.blocks.begin(), s.blocks.end(), trajectory) ||
       std::any_of(s.optimizations.begin(), s.optimizations.end(),
-                  [&](const OptimizeBlock& o) { return trajectory(o.block()); }))
+                  [&](const OptimizeBlock& o) { return trajectory(o.block()); })) {
     check_task_fits_robot(root.get("task") ? root.get("task")->as_table() : nullptr, s);
+    check_gravity_given(s);
+  }
   if (!diags_.empty()) {
     std::stable_sort(diags_.begin(), diags_.end(), [](const StudyDiagnostic& a, const StudyDiagnostic& b) {
       return std::pair(a.line, a.column) < std::pair(b.line, b.column);
