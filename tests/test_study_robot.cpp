@@ -176,7 +176,9 @@ TEST(StudyRobot, UrdfRobotLoadsRelativeToTheStudy) {
   ASSERT_NE(s.chain, nullptr);
   EXPECT_EQ(s.chain->dof(), 2);
   EXPECT_TRUE(s.chain->planar());
-  EXPECT_NEAR(s.chain->gravity.y(), -9.81, 1e-15);  // planar: the seed's -y unless gravity is given
+  // gravity not given: base -z (URDF's z up), normal to this arm's base xy plane (an IK study needs none)
+  EXPECT_EQ(s.base_chain->gravity, Eigen::Vector3d(0, 0, -9.81));
+  EXPECT_EQ(s.chain->gravity, Eigen::Vector3d::Zero());
   EXPECT_EQ(s.robot_text, two_link_urdf());
   EXPECT_EQ(s.robot_file, "two.urdf");
   // the URDF is part of the study's identity (resume refuses another robot)

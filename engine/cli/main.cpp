@@ -1,4 +1,4 @@
-// kinesweep: the command-line front end (run, table4, schema; info and query read results files).
+// kinesweep: the command-line front end (run, table4, schema, robot; info and query read results files).
 #include <malloc.h>
 
 #include <CLI/CLI.hpp>
@@ -6,6 +6,7 @@
 
 #include "cli/info_command.hpp"
 #include "cli/query_command.hpp"
+#include "cli/robot_command.hpp"
 #include "cli/run_command.hpp"
 #include "cli/schema_command.hpp"
 #include "cli/table4.hpp"
@@ -28,6 +29,7 @@ int main(int argc, char** argv) {
   ks::cli::InfoArgs& info = ks::cli::add_info_command(app);
   ks::cli::QueryArgs& query = ks::cli::add_query_command(app);
   ks::cli::SchemaArgs& schema = ks::cli::add_schema_command(app);
+  ks::cli::RobotArgs& robot = ks::cli::add_robot_command(app);
   auto* table4 = app.add_subcommand("table4", "Print seed 000's Table 4 beside kinesweep's figures (no file)");
   try {
     app.parse(argc, argv);
@@ -44,5 +46,6 @@ int main(int argc, char** argv) {
   if (app.got_subcommand("info")) return ks::cli::info_command(info);
   if (app.got_subcommand("query")) return ks::cli::query_command(query);
   if (app.got_subcommand("schema")) return ks::cli::schema_command(schema);
+  if (app.got_subcommand("robot")) return ks::cli::robot_command(robot, std::cout, std::cerr);
   return 0;
 }

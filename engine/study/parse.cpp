@@ -71,6 +71,7 @@ Study study_parse::Parser::run() {
   // the task's points, the blocks' parameters and the reach follow from the robot: checked against
   // a robot in error (another robot in its place) they would only add false errors
   if (diags_.size() > before_robot) fail();
+  place_robot_in_plane(s);
   parse_task(root, s);
   s.arm_chain = s.robot_chain();
   if (!s.robot_text.empty()) s.sha256 = sha256_hex(std::string(text) + std::string(1, '\0') + s.robot_text);  // the robot is part of the study
@@ -80,8 +81,10 @@ Study study_parse::Parser::run() {
   const auto trajectory = [](const Block& b) { return b.kind() == BlockKind::trajectory; };
   if (std::any_of(s.blocks.begin(), s.blocks.end(), trajectory) ||
       std::any_of(s.optimizations.begin(), s.optimizations.end(),
-                  [&](const OptimizeBlock& o) { return trajectory(o.block()); }))
+                  [&](const OptimizeBlock& o) { return trajectory(o.block()); })) {
     check_task_fits_robot(root.get("task") ? root.get("task")->as_table() : nullptr, s);
+    check_gravity_given(s);
+  }
   if (!diags_.empty()) fail();
   return s;
 }

@@ -107,6 +107,15 @@ class Parser : public ParserCore {
   void parse_robot(const toml::table& root, Study& s);
   void parse_planar_robot(const toml::table& t, Study& s);
   void parse_urdf_robot(const toml::table& t, Study& s);
+  /// After [robot] (robot_plane.cpp): base_chain, plane, and a planar chain in its plane's frame.
+  void place_robot_in_plane(Study& s);
+  /// Trajectory studies: a URDF robot without gravity whose plane is not vertical is refused.
+  void check_gravity_given(Study& s);
+  const toml::node* urdf_without_gravity_ = nullptr;  ///< the urdf key of a URDF robot given no gravity
+  /// The plane coordinates of vertex x (base frame [m]) of a planar robot; nullopt, reported at
+  /// `at`, when x is off the plane by more than kVertexOffPlane.
+  std::optional<Eigen::Vector2d> vertex_in_plane(const toml::node& at, const Eigen::Vector3d& x, const ChainPlane& plane);
+  static constexpr double kVertexOffPlane = 1e-6;  ///< [m]
   /// A list of 2 .. kMaxJoints numbers (or exactly `count` when count > 0); nullopt after reporting.
   std::optional<std::vector<double>> get_joint_numbers(const toml::table& t, std::string_view key, std::size_t count,
                                                        std::string_view what, std::string_view unit);

@@ -195,9 +195,10 @@ void Parser::parse_urdf_robot(const toml::table& t, Study& s) {
     text << in.rdbuf();
   }
   try {
-    // gravity: as given; else the seed's -y when the chain moves in the base xy plane, else -z
-    Chain c = parse_urdf(text.str(), *base, *tip, gravity.value_or(Eigen::Vector3d(0, -9.81, 0)), path.string());
-    if (!gravity && !c.planar()) c.gravity = Eigen::Vector3d(0, 0, -9.81);
+    // gravity: as given, else base -z (URDF's z up; check_gravity_given refuses it for a trajectory
+    // study when the chain's plane is not vertical)
+    Chain c = parse_urdf(text.str(), *base, *tip, gravity.value_or(Eigen::Vector3d(0, 0, -9.81)), path.string());
+    if (!gravity) urdf_without_gravity_ = &at;
     c.prepare();
     s.chain = std::make_shared<const Chain>(std::move(c));
     s.robot_file = *file;

@@ -15,6 +15,7 @@
 #include "methods/trajectory.hpp"
 #include "model/arm.hpp"
 #include "model/chain.hpp"
+#include "model/chain_plane.hpp"
 #include "optimize/optimize.hpp"
 #include "space/space.hpp"
 #include "task/quintic_path.hpp"
@@ -130,6 +131,15 @@ struct Study {
   /// The robot as a chain for the position / pose IK problems: `chain`, or the seed's 3R as a chain
   /// (physical inertia) when that is null. Set by the parser.
   std::shared_ptr<const Chain> arm_chain;
+  /// The chain robot as its description gives it, in its base frame (a URDF file's base link);
+  /// null for the seed's closed-form 3R. `chain` is this chain in its plane's frame when it is planar
+  /// (model/chain_plane.hpp: the same chain, bit for bit, when that plane is the base xy plane).
+  std::shared_ptr<const Chain> base_chain;
+  /// The plane a planar robot moves in, in its base frame: the base xy plane for the seed's 3R and
+  /// the n-link arms; nullopt for a spatial robot. A planar robot's vertices, IK targets, tip
+  /// angles and histories' x are in this plane's coordinates.
+  std::optional<ChainPlane> plane;
+  bool gravity_defaulted = false;  ///< a URDF robot given no gravity: base -z taken (URDF's z up)
   std::string robot_file;   ///< the URDF file as the study names it ("" when none)
   std::string robot_text;   ///< its text, verbatim (kept with the results)
   StudyTask task;

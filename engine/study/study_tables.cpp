@@ -88,7 +88,7 @@ void Parser::parse_task(const toml::table& root, Study& s) {
   check_keys(*t, {"vertices", "durations", "dt", "integrator", "orientation"}, "[task]");
   const bool spatial = s.chain && !s.chain->planar();
   const std::size_t dims = spatial ? 3 : 2;
-  const std::string point = spatial ? "[x, y, z]" : "[x, y]";
+  const std::string point = spatial ? "[x, y, z]" : "[x, y] (plane coordinates) or [x, y, z] (base frame, on the plane)";
   bool vertices_ok = true;
   if (const toml::node* vn = t->get("vertices")) {
     const auto* a = vn->as_array();
@@ -101,7 +101,8 @@ void Parser::parse_task(const toml::table& root, Study& s) {
       std::vector<double> z;
       for (const auto& e : *a) {
         const auto* p = e.as_array();
-        if (!p || p->size() != dims) {
+        const bool base_point = !spatial && s.plane && p && p->size() == 3;  // a planar robot's vertex, base frame
+        if (!p || (p->size() != dims && !base_point)) {
           error(e, "a vertex is " + (p ? "an array of " + std::to_string(p->size()) : type_name(e)) + "; expected " +
                        point + " [m]" + (spatial ? " (the robot is spatial)" : ""));
           vertices_ok = false;
@@ -109,9 +110,15 @@ void Parser::parse_task(const toml::table& root, Study& s) {
         }
         auto x = get_number(*p->get(0), "vertex x");
         auto y = get_number(*p->get(1), "vertex y");
-        std::optional<double> zz = spatial ? get_number(*p->get(2), "vertex z") : std::optional<double>(0.0);
-        if (x && y && zz) v.emplace_back(*x, *y), z.push_back(*zz);
-        else vertices_ok = false;
+        std::optional<double> zz = spatial || base_point ? get_number(*p->get(2), "vertex z") : std::optional<double>(0.0);
+        if (x && y && zz && base_point) {
+          if (const auto u = vertex_in_plane(e, {*x, *y, *zz}, *s.plane)) v.push_back(*u), z.push_back(0.0);
+          else vertices_ok = false;
+        } else if (x && y && zz) {
+          v.emplace_back(*x, *y), z.push_back(*zz);
+        } else {
+          vertices_ok = false;
+        }
       }
       s.task.vertices = v;
       if (spatial) s.task.z = z;

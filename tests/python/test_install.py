@@ -148,7 +148,7 @@ class Install(unittest.TestCase):
         ks = os.path.join(PREFIX, "bin", "kinesweep")
         self.assertEqual(self.complete(ks, "qu"), ["query"])
         # Each subcommand's options are those its --help lists.
-        for sub in ("run", "info", "query", "schema"):
+        for sub in ("run", "info", "query", "schema", "robot"):
             helptext = run([ks, sub, "--help"]).stdout
             listed = set(re.findall(r"(?<![\w-])(--?[a-zA-Z][\w-]*)", helptext.split("Options:", 1)[-1]))
             offered = set(self.complete(ks, sub, "-"))

@@ -47,7 +47,7 @@ class Table4ThroughUrdf(TempDirTest):
         closed = self.write("closed.toml", TABLE4.format(robot=""))
         urdf = os.path.join(STUDIES, "robots", "seed3r.urdf")
         generic = self.write("generic.toml", TABLE4.format(
-            robot=f'[robot]\nurdf = "{urdf}"\nbase = "base_link"\ntip = "tool"\n'))
+            robot=f'[robot]\nurdf = "{urdf}"\nbase = "base_link"\ntip = "tool"\ngravity = [0, -9.81, 0]\n'))
         a, b = os.path.join(self.dir, "a.h5"), os.path.join(self.dir, "b.h5")
         for study, out in ((closed, a), (generic, b)):
             r = run("run", study, "-o", out, "--quiet")
