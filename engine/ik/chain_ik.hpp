@@ -49,7 +49,8 @@ struct ChainIkResult {
   int rejected = 0;         ///< lm_adaptive: rejected trial steps
   double error = 0.0;       ///< ||F(q)|| (m and rad mixed for the pose tasks)
   double min_rcond = 1.0;   ///< smallest reciprocal condition of a matrix solved (inf: none was)
-  VecN q;                   ///< final iterate (chain.dof() entries, not wrapped)
+  VecN q;                   ///< final iterate (chain.dof() entries; converged: revolute joints whose
+                            ///< limits are not enforced wrapped to (-pi, pi], see ik/solve.hpp)
   VecF F;                   ///< F(q)
   ChainIkHistory history;   ///< empty unless Options::keep_history
 

@@ -11,6 +11,12 @@
 //
 // Stop rule (the seed's): after update k, stop as converged when ||F(q_k)|| < tolerance;
 // iterations = number of updates (0 when the start already solves the problem).
+//
+// Converged angles: every revolute joint whose limits the solve does not enforce (a problem without
+// limits, a joint without finite limits, or Options::joint_limits = none) is returned wrapped to
+// (-pi, pi]; joints whose limits are enforced keep their value (clamp: within them; reject: moved by
+// a multiple of 2 pi into them). F and the error are those of the iterate as computed (before the
+// wrap), the history holds the iterates as computed.
 #include <iosfwd>
 #include <string>
 #include <string_view>
@@ -138,7 +144,7 @@ template <int N, int M>
 struct Summary {
   Method method = Method::newton;
   Status status = Status::max_iter;
-  Vec<N> q = Vec<N>::Zero();      ///< final iterate (not wrapped)
+  Vec<N> q = Vec<N>::Zero();      ///< final iterate (converged: unenforced revolute joints wrapped, see above)
   Vec<M> F = Vec<M>::Zero();      ///< F(q)
   double error = 0.0;             ///< ||F(q)||
   int iterations = 0;             ///< updates made

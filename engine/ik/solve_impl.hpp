@@ -74,6 +74,18 @@ inline bool all_finite(const Vec<N>& q, const Vec<M>& F) {
   return q.allFinite() && F.allFinite();
 }
 
+/// True when the solve enforces joint j's limits (the problem has them, joint j has a finite one and
+/// Options::joint_limits is not none): its converged angle is not wrapped.
+template <Problem P>
+inline bool limits_enforced(const P& pb, int j, const Options& o) {
+  if constexpr (HasLimitBounds<P>) {
+    return o.joint_limits != JointLimits::none && (std::isfinite(pb.lower[j]) || std::isfinite(pb.upper[j]));
+  } else {
+    (void)pb, (void)j, (void)o;
+    return false;
+  }
+}
+
 }  // namespace detail
 
 template <Problem P>
@@ -120,6 +132,9 @@ void solve(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P:
     if constexpr (HasJointLimits<P>) {
       if (st == Status::converged && rejecting && !pb.admit(q)) st = Status::out_of_limits;
     }
+    if (st == Status::converged)
+      for (int j = 0; j < N; ++j)
+        if (pb.revolute[j] && !detail::limits_enforced(pb, j, o)) q[j] = wrap_angle(q[j]);
     s.status = st;
     s.q = q;
     s.F = F;

@@ -114,6 +114,7 @@ std::vector<MetricDef> ik_metrics(const KindContext& ctx) {
     const std::string i = std::to_string(j + 1);
     std::string unit = ctx.robot.is_prismatic(j) ? "m" : "rad", what = "final iterate, joint " + i;
     if (j == 2 && !ctx.robot.chain) unit = "rad or mm", what += " (scara: d in mm)";
+    if (unit == "rad") what += " (converged, limits not enforced: wrapped to (-pi, pi])";
     m.push_back(metric<R>("q_final_" + i, CellType::f64, unit, what, false, [j](const R& r) {
       return j < r.q.size() ? r.q[j] : std::numeric_limits<double>::quiet_NaN();
     }));
