@@ -26,7 +26,7 @@
 //       // of 2 pi into them where one exists (Options::joint_limits = reject)
 //   Vec<N> lower, upper;
 //       // the limits themselves (+-infinity: none); with project and admit they also say which
-//       // joints the solve enforces (converged angles are wrapped elsewhere, ik/solve.hpp)
+//       // joints the solve enforces (angle wrapping) and where restarts draw (ik/solve.hpp)
 //
 // Units are the problem's own (the SCARA problem works in mm and rad, the planar arm in m and rad);
 // the solver tolerances are in the same units.
