@@ -33,7 +33,7 @@ const std::array<std::array<Solver, kCounts>, 4> kSolvers{
 void unsupported(const Options& options, const VecN& q0, ChainIkResult& r) {
   r.method = options.method;
   r.status = Status::unsupported;
-  r.iterations = r.rejected = 0;
+  r.iterations = r.rejected = r.restarts_used = 0;
   r.error = std::numeric_limits<double>::quiet_NaN();
   r.min_rcond = std::numeric_limits<double>::infinity();
   r.q = q0;

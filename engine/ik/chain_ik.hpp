@@ -45,11 +45,13 @@ struct ChainIkHistory {
 struct ChainIkResult {
   Method method = Method::newton;
   Status status = Status::max_iter;
-  int iterations = 0;       ///< updates made
-  int rejected = 0;         ///< lm_adaptive: rejected trial steps
+  int iterations = 0;       ///< updates made (summed over all attempts: Options::restarts)
+  int rejected = 0;         ///< lm_adaptive: rejected trial steps (summed over all attempts)
+  int restarts_used = 0;    ///< random restarts made (ik/solve.hpp)
   double error = 0.0;       ///< ||F(q)|| (m and rad mixed for the pose tasks)
   double min_rcond = 1.0;   ///< smallest reciprocal condition of a matrix solved (inf: none was)
-  VecN q;                   ///< final iterate (chain.dof() entries, not wrapped)
+  VecN q;                   ///< final iterate (chain.dof() entries; converged: revolute joints whose
+                            ///< limits are not enforced wrapped to (-pi, pi], see ik/solve.hpp)
   VecF F;                   ///< F(q)
   ChainIkHistory history;   ///< empty unless Options::keep_history
 
@@ -71,7 +73,7 @@ class ChainIkWorkspace {
 };
 
 /// Solve `task` for `chain` from q0 with `options` (ik/solve.hpp: method, tolerances, joint_limits
-/// against the chain's [lower, upper]). \param[in] q0 start (chain.dof() entries) [rad or m].
+/// against the chain's [lower, upper], restarts drawn within them). \param[in] q0 start (chain.dof() entries) [rad or m].
 /// \param[out] result status, final q, F, error, counts and (keep_history) the iterates.
 /// Status::unsupported, without iterating, when: chain.dof() is outside 2 .. kMaxJoints, q0 has
 /// another size, the task is planar_pose and the chain is not planar (Chain::planar()), the method

@@ -22,6 +22,7 @@ void solve_chain_fixed(const Chain& chain, const ChainIkTask& task, const VecN& 
   result.status = s.status;
   result.iterations = s.iterations;
   result.rejected = s.rejected;
+  result.restarts_used = s.restarts_used;
   result.error = s.error;
   result.min_rcond = s.min_rcond;
   result.q = s.q;

@@ -24,6 +24,9 @@
 //   bool admit(Vec<N>& q) const;
 //       // true when q lies within the joint limits, after moving each revolute joint by a multiple
 //       // of 2 pi into them where one exists (Options::joint_limits = reject)
+//   Vec<N> lower, upper;
+//       // the limits themselves (+-infinity: none); with project and admit they also say which
+//       // joints the solve enforces (angle wrapping) and where restarts draw (ik/solve.hpp)
 //
 // Units are the problem's own (the SCARA problem works in mm and rad, the planar arm in m and rad);
 // the solver tolerances are in the same units.
@@ -31,6 +34,8 @@
 #include <array>
 #include <cmath>
 #include <concepts>
+
+#include "common/angles.hpp"
 
 namespace ks::ik {
 
@@ -58,13 +63,7 @@ struct SolutionSet {
   }
 };
 
-/// x wrapped to (-pi, pi] (exact: x itself when already inside, else std::remainder).
-inline double wrap_angle(double x) {
-  constexpr double kPi = 3.14159265358979323846;
-  if (x > -kPi && x <= kPi) return x;  // the common case, without a libm call
-  const double r = std::remainder(x, 2.0 * kPi);  // exact, in [-pi, pi]
-  return r == -kPi ? kPi : r;
-}
+using ks::wrap_angle;  // common/angles.hpp: x wrapped to (-pi, pi]
 
 /// a - b, with the revolute components wrapped to (-pi, pi] (distance on the joint torus).
 template <int N>
@@ -117,6 +116,14 @@ template <class P>
 concept HasJointLimits = Problem<P> && requires(const P& p, Vec<P::unknowns>& q) {
   p.project(q);
   { p.admit(q) } -> std::convertible_to<bool>;
+};
+
+/// The problem has joint limits and exposes them as `lower` and `upper` (one entry per joint,
+/// +-infinity where a joint has none).
+template <class P>
+concept HasLimitBounds = HasJointLimits<P> && requires(const P& p) {
+  { p.lower[0] } -> std::convertible_to<double>;
+  { p.upper[0] } -> std::convertible_to<double>;
 };
 
 }  // namespace ks::ik

@@ -11,6 +11,23 @@
 //
 // Stop rule (the seed's): after update k, stop as converged when ||F(q_k)|| < tolerance;
 // iterations = number of updates (0 when the start already solves the problem).
+//
+// Converged angles: every revolute joint whose limits the solve does not enforce (a problem without
+// limits, a joint without finite limits, or Options::joint_limits = none) is returned wrapped to
+// (-pi, pi]; joints whose limits are enforced keep their value (clamp: within them; reject: moved by
+// a multiple of 2 pi into them). F and the error are those of the iterate as computed (before the
+// wrap), the history holds the iterates as computed.
+//
+// Restarts (Options::restarts = R > 0): when an attempt ends in any status but converged,
+// unsupported or no_solution, the solve starts again from a configuration drawn uniformly within
+// the joint limits (revolute joints without finite limits: (-pi, pi); prismatic ones without them:
+// q0's value), at most R times. The draws come from std::mt19937_64 seeded with
+// Options::restart_seed (raw 64-bit draws mapped to (0, 1) as ((x >> 11) + 0.5) 2^-53, one per joint
+// in joint order), so a solve is a pure function of its inputs. The Summary then reports the last
+// attempt (status, q, F, error, solution), iterations and rejected summed over all attempts,
+// min_rcond over all attempts, restarts_used = attempts - 1, and a history of every attempt one
+// after the other (each attempt's first row is its start, with step 0). R = 0: one attempt.
+#include <cstdint>
 #include <iosfwd>
 #include <string>
 #include <string_view>
@@ -93,6 +110,8 @@ struct Options {
   double match_tolerance = 1e-3;
   bool keep_history = true;       ///< record the history (off: no allocation at all in a solve)
   JointLimits joint_limits = JointLimits::none;  ///< use of the problem's joint limits, if it has any
+  int restarts = 0;               ///< at most this many random restarts after a failed attempt (header comment)
+  std::uint64_t restart_seed = 0; ///< seed of the restarts' draws (header comment)
 
   /// The rules on the fields (checked by IsValid; the study schema reports them at the key).
   static constexpr Domain tolerance_rule = Domain::positive();
@@ -104,6 +123,7 @@ struct Options {
   static constexpr Domain divergence_bound_rule = Domain::positive();
   static constexpr Domain cycle_tolerance_rule = Domain::nonnegative();
   static constexpr Domain match_tolerance_rule = Domain::positive();
+  static constexpr Domain restarts_rule = Domain::within(0, 1e6);
   static constexpr int max_cycle_window = 16;
 
   /// True when every field is finite and within its rule (cycle_window within [0, 16], joint_limits
@@ -138,11 +158,12 @@ template <int N, int M>
 struct Summary {
   Method method = Method::newton;
   Status status = Status::max_iter;
-  Vec<N> q = Vec<N>::Zero();      ///< final iterate (not wrapped)
+  Vec<N> q = Vec<N>::Zero();      ///< final iterate (converged: unenforced revolute joints wrapped, see above)
   Vec<M> F = Vec<M>::Zero();      ///< F(q)
   double error = 0.0;             ///< ||F(q)||
-  int iterations = 0;             ///< updates made
-  int rejected = 0;               ///< lm_adaptive: rejected trial steps
+  int iterations = 0;             ///< updates made (summed over all attempts)
+  int rejected = 0;               ///< lm_adaptive: rejected trial steps (summed over all attempts)
+  int restarts_used = 0;          ///< random restarts made (attempts - 1)
   int solution = -1;              ///< index into problem.known_solutions() matched by q, -1 if none
   double min_rcond = 1.0;         ///< smallest reciprocal condition of a matrix solved (inf: none was)
   History<N, M> history;

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <limits>
 #include <ostream>
+#include <random>
 
 #include "ik/cycle_watch.hpp"
 #include "ik/solve.hpp"
@@ -74,10 +75,40 @@ inline bool all_finite(const Vec<N>& q, const Vec<M>& F) {
   return q.allFinite() && F.allFinite();
 }
 
-}  // namespace detail
-
+/// True when the solve enforces joint j's limits (the problem has them, joint j has a finite one and
+/// Options::joint_limits is not none): its converged angle is not wrapped.
 template <Problem P>
-void solve(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P::unknowns, P::residuals>& s) {
+inline bool limits_enforced(const P& pb, int j, const Options& o) {
+  if constexpr (HasLimitBounds<P>) {
+    return o.joint_limits != JointLimits::none && (std::isfinite(pb.lower[j]) || std::isfinite(pb.upper[j]));
+  } else {
+    (void)pb, (void)j, (void)o;
+    return false;
+  }
+}
+
+/// A restart's start: per joint one draw u in (0, 1) from rng (see ik/solve.hpp), mapped into the
+/// joint's finite limits, else (-pi, pi) for a revolute joint; a prismatic joint without finite
+/// limits keeps q0's value.
+template <Problem P>
+inline Vec<P::unknowns> restart_start(const P& pb, const Vec<P::unknowns>& q0, std::mt19937_64& rng) {
+  constexpr double kPi = 3.14159265358979323846;
+  Vec<P::unknowns> q = q0;
+  for (int j = 0; j < P::unknowns; ++j) {
+    const double u = (static_cast<double>(rng() >> 11) + 0.5) * 0x1p-53;
+    double lo = -std::numeric_limits<double>::infinity(), hi = std::numeric_limits<double>::infinity();
+    if constexpr (HasLimitBounds<P>) lo = pb.lower[j], hi = pb.upper[j];
+    if (std::isfinite(lo) && std::isfinite(hi)) q[j] = lo + (hi - lo) * u;
+    else if (pb.revolute[j]) q[j] = kPi - 2.0 * kPi * u;
+  }
+  return q;
+}
+
+/// One attempt of solve() from q0 (see ik/solve.hpp); `append` keeps the history of the attempts
+/// before it.
+template <Problem P>
+void solve_attempt(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P::unknowns, P::residuals>& s,
+                   bool append) {
   constexpr int N = P::unknowns, M = P::residuals;
   using VecN = Vec<N>;
   using VecM = Vec<M>;
@@ -90,9 +121,9 @@ void solve(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P:
   s.rejected = 0;
   s.solution = -1;
   s.min_rcond = std::numeric_limits<double>::infinity();
-  s.history.clear();
+  if (!append) s.history.clear();
   const bool keep = o.keep_history;
-  if (keep) s.history.reserve(static_cast<std::size_t>(std::max(o.max_iter, 0)) + 1);
+  if (keep) s.history.reserve(s.history.size() + static_cast<std::size_t>(std::max(o.max_iter, 0)) + 1);
 
   VecN q = q0;
   VecM F;
@@ -120,6 +151,9 @@ void solve(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P:
     if constexpr (HasJointLimits<P>) {
       if (st == Status::converged && rejecting && !pb.admit(q)) st = Status::out_of_limits;
     }
+    if (st == Status::converged)
+      for (int j = 0; j < N; ++j)
+        if (pb.revolute[j] && !limits_enforced(pb, j, o)) q[j] = wrap_angle(q[j]);
     s.status = st;
     s.q = q;
     s.F = F;
@@ -287,6 +321,28 @@ void solve(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P:
     if (watch.window > 0 && watch.returned(pb.revolute, o.cycle_tolerance)) return finish(Status::cycle);
   }
   finish(Status::max_iter);
+}
+
+}  // namespace detail
+
+template <Problem P>
+void solve(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Summary<P::unknowns, P::residuals>& s) {
+  s.restarts_used = 0;
+  detail::solve_attempt(pb, q0, o, s, false);
+  auto done = [&] {
+    return s.status == Status::converged || s.status == Status::unsupported || s.status == Status::no_solution;
+  };
+  if (o.restarts <= 0 || o.method == Method::analytic || done()) return;
+  std::mt19937_64 rng(o.restart_seed);
+  int iterations = s.iterations, rejected = s.rejected;
+  double min_rcond = s.min_rcond;
+  for (int r = 1; r <= o.restarts && !done(); ++r) {
+    detail::solve_attempt(pb, detail::restart_start(pb, q0, rng), o, s, true);
+    iterations += s.iterations, rejected += s.rejected;
+    min_rcond = std::min(min_rcond, s.min_rcond);
+    s.restarts_used = r;
+  }
+  s.iterations = iterations, s.rejected = rejected, s.min_rcond = min_rcond;
 }
 
 template <int N, int M>

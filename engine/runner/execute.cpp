@@ -5,6 +5,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <optional>
 #include <vector>
 
@@ -182,12 +184,39 @@ RunOutcome run_trajectory(const Scenario& sc, const TrajectoryRun& run, int stri
   return trajectory_outcome(simulate(arm, path, run.options, h), h);
 }
 
+/// The restarts' generator seed of an IK run: its restart_seed mixed (splitmix64 steps) with the bits
+/// of its problem, start and target, so a run stays a pure function of its parameters (the same
+/// whatever the thread count, rank or run id) while different starts and targets draw independent
+/// restarts. The method is left out: methods compared on one start and target restart from the same
+/// configurations.
+std::uint64_t restart_seed_of(const IkRun& run) {
+  std::uint64_t h = 0x9E3779B97F4A7C15ull ^ static_cast<std::uint64_t>(run.restart_seed);
+  auto mix = [&h](std::uint64_t v) {
+    h += v + 0x9E3779B97F4A7C15ull;
+    std::uint64_t z = h;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    h = z ^ (z >> 31);
+  };
+  auto bits = [](double x) {
+    std::uint64_t u;
+    std::memcpy(&u, &x, sizeof u);
+    return u;
+  };
+  mix(static_cast<std::uint64_t>(run.problem));
+  for (Eigen::Index j = 0; j < run.q0.size(); ++j) mix(bits(run.q0[j]));
+  for (int j = 0; j < 3; ++j) mix(bits(run.target[j]));
+  mix(bits(run.target_alpha));
+  for (int j = 0; j < 3; ++j) mix(bits(run.target_rpy[j]));
+  return h;
+}
+
 template <class P, int M>
 RunOutcome solve_ik(const P& problem, const VecN& q0, const ik::Options& o, int stride, ik::Summary<3, M>& s,
                     const char* q3_unit) {
   ik::solve(problem, Vec3(q0.head<3>()), o, s);
   RunOutcome out;
-  out.result = IkResult{s.status, s.iterations, s.rejected, s.solution, s.error, s.min_rcond, s.q};
+  out.result = IkResult{s.status, s.iterations, s.rejected, s.solution, s.error, s.min_rcond, s.q, s.restarts_used};
   if (stride > 0 && s.history.size() > 0) {
     const std::size_t n = s.history.size();
     std::vector<std::size_t> rows;
@@ -229,7 +258,7 @@ RunOutcome run_chain_ik(const Scenario& sc, const IkRun& run, const ik::Options&
   ik::ChainIkResult& r = ws.chain_result;
   ik::solve_chain(chain, task, run.q0, o, r, ws.chain_ik);
   RunOutcome out;
-  out.result = IkResult{r.status, r.iterations, r.rejected, -1, r.error, r.min_rcond, r.q};
+  out.result = IkResult{r.status, r.iterations, r.rejected, -1, r.error, r.min_rcond, r.q, r.restarts_used};
   if (stride > 0 && r.history.size() > 0) {
     const std::size_t n = r.history.size(), nq = static_cast<std::size_t>(chain.dof());
     const std::size_t m = static_cast<std::size_t>(ik::residual_count(task.kind));
@@ -257,6 +286,7 @@ RunOutcome run_chain_ik(const Scenario& sc, const IkRun& run, const ik::Options&
 RunOutcome run_ik(const Scenario& sc, const IkRun& run, int stride, RunWorkspace::Impl& ws) {
   ik::Options o = run.options;
   o.keep_history = stride > 0;
+  if (o.restarts > 0) o.restart_seed = restart_seed_of(run);
   switch (run.problem) {
     case IkProblem::position:
     case IkProblem::pose:

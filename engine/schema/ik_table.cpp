@@ -17,8 +17,10 @@ IkRun IkRun::planar_defaults() {
   return r;
 }
 
-IkRun IkRun::chain_defaults(const std::vector<bool>& prismatic, int joints, const Eigen::Vector3d& target) {
+IkRun IkRun::chain_defaults(const std::vector<bool>& prismatic, int joints, const Eigen::Vector3d& target,
+                            bool limited) {
   IkRun r;
+  r.options.joint_limits = limited ? ik::JointLimits::clamp : ik::JointLimits::none;
   r.problem = IkProblem::position;
   r.q0 = VecN::Zero(joints);
   for (int j = 0; j < joints; ++j) r.q0[j] = j < int(prismatic.size()) && prismatic[j] ? 0.0 : 30.0 * kDeg;
@@ -87,8 +89,15 @@ std::vector<ParamDef> ik_params(const KindContext& ctx) {
   t.push_back(named<Run>("joint_limits",
                          names_of<ik::JointLimits>(ik::JointLimits::none, ik::JointLimits::clamp, ik::JointLimits::reject),
                          "the robot's joint limits: ignored, iterates clamped into them, or a solution outside "
-                         "them ends out_of_limits (position, pose)",
+                         "them ends out_of_limits (position, pose; default clamp when the robot has limits)",
                          [](auto& r) -> auto& { return r.options.joint_limits; }, EffectRule{"problem", {"position", "pose"}}));
+  t.push_back(integer<Run>("restarts", "", ik::Options::restarts_rule,
+                           "random restarts after a failed attempt, from starts drawn within the joint limits "
+                           "((-180, 180) deg for unlimited revolute joints); iterations are summed over attempts",
+                           [](auto& r) -> auto& { return r.options.restarts; }, from_start));
+  t.push_back(integer<Run>("restart_seed", "", IkRun::restart_seed_rule,
+                           "seed of the restarts' draws (mixed with the run's start and target)",
+                           [](auto& r) -> auto& { return r.restart_seed; }, from_start));
   t.push_back(named<Run>("z_mode", names_of<ZMode>(ZMode::thesis, ZMode::physical),
                          "SCARA z residual: thesis (+q3) or physical", [](auto& r) -> auto& { return r.z_mode; },
                          EffectRule{"problem", {"scara"}}));
@@ -98,7 +107,7 @@ std::vector<ParamDef> ik_params(const KindContext& ctx) {
 std::vector<MetricDef> ik_metrics(const KindContext& ctx) {
   using R = IkResult;
   std::vector<MetricDef> m{
-      metric<R>("iterations", CellType::i64, "", "updates made (the seed's count)", true,
+      metric<R>("iterations", CellType::i64, "", "updates made (the seed's count; summed over restarts)", true,
                 [](const R& r) { return std::int64_t(r.iterations); }),
       metric<R>("error", CellType::f64, "problem units", "||F|| at the final iterate (mm for scara, m/rad for planar3r)",
                 true, [](const R& r) { return r.error; }),
@@ -108,12 +117,15 @@ std::vector<MetricDef> ik_metrics(const KindContext& ctx) {
                 [](const R& r) { return std::int64_t(r.rejected); }),
       metric<R>("min_rcond", CellType::f64, "", "smallest reciprocal condition number met", false,
                 [](const R& r) { return r.min_rcond; }),
+      metric<R>("restarts_used", CellType::i64, "", "random restarts made (0: the first attempt's outcome)", true,
+                [](const R& r) { return std::int64_t(r.restarts_used); }),
   };
   const int n = ctx.scara ? 3 : ctx.robot.joints;
   for (int j = 0; j < n; ++j) {
     const std::string i = std::to_string(j + 1);
     std::string unit = ctx.robot.is_prismatic(j) ? "m" : "rad", what = "final iterate, joint " + i;
     if (j == 2 && !ctx.robot.chain) unit = "rad or mm", what += " (scara: d in mm)";
+    if (unit == "rad") what += " (converged, limits not enforced: wrapped to (-pi, pi])";
     m.push_back(metric<R>("q_final_" + i, CellType::f64, unit, what, false, [j](const R& r) {
       return j < r.q.size() ? r.q[j] : std::numeric_limits<double>::quiet_NaN();
     }));

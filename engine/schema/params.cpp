@@ -93,7 +93,7 @@ std::span<const std::string_view> statuses(BlockKind kind) {
 RunSpec default_run(BlockKind kind, const KindContext& c) {
   if (kind == BlockKind::ik) {
     if (c.scara) return IkRun{};
-    if (c.robot.chain) return IkRun::chain_defaults(c.robot.prismatic, c.robot.joints, c.first_vertex);
+    if (c.robot.chain) return IkRun::chain_defaults(c.robot.prismatic, c.robot.joints, c.first_vertex, c.robot.limited);
     return IkRun::planar_defaults();
   }
   TrajectoryRun r;

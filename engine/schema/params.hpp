@@ -28,6 +28,7 @@ struct RobotShape {
   bool chain = false;              ///< a generic chain (n-link planar, URDF); false: the seed's closed-form 3R
   bool planar = true;              ///< the tip moves in the xy plane (orientation: one angle alpha)
   bool pose_task = false;          ///< the path prescribes the tip's orientation too ([task] orientation)
+  bool limited = false;            ///< a joint has a finite position limit (URDF <limit>, n-link `limits`)
   bool is_prismatic(int j) const { return j < static_cast<int>(prismatic.size()) && prismatic[j]; }
   /// vertex_alpha (the seed's non-redundant baseline) is defined: a planar 3-joint arm, position path.
   bool vertex_alpha() const { return planar && joints == 3 && !pose_task; }

@@ -59,13 +59,21 @@ struct IkRun {
   /// spatial pose: the tip orientation as roll, pitch, yaw about the base x, y, z axes (R = Rz Ry Rx) [rad]
   Eigen::Vector3d target_rpy = Eigen::Vector3d::Zero();
   ZMode z_mode = ZMode::thesis;
+  /// Seed of the random restarts (ik::Options::restarts); the solve's generator is seeded with it
+  /// mixed with the run's start and target (restart_seed_of in runner/execute.cpp).
+  int restart_seed = 0;
+  static constexpr Domain restart_seed_rule = Domain::within(0, 2147483647);
 
   /// The defaults of the planar 3R problems (the seed arm reaching (1.5, 1.5) m, alpha 0, from
   /// (0, 90, -90) deg).
   static IkRun planar_defaults();
   /// The defaults of the chain problems for a robot of `joints` joints: position of the tip at
-  /// `target` (the path's first vertex) from q0 = 30 deg at every revolute joint, 0 m at every prismatic one.
-  static IkRun chain_defaults(const std::vector<bool>& prismatic, int joints, const Eigen::Vector3d& target);
+  /// `target` (the path's first vertex) from q0 = 30 deg at every revolute joint, 0 m at every
+  /// prismatic one.
+  /// `limited`: the robot has position limits; chain problems then enforce them by default
+  /// (joint_limits = clamp), else joint_limits = none.
+  static IkRun chain_defaults(const std::vector<bool>& prismatic, int joints, const Eigen::Vector3d& target,
+                              bool limited = false);
   bool scara() const { return problem == IkProblem::scara; }
   bool chain() const { return problem == IkProblem::position || problem == IkProblem::pose; }
 };
@@ -78,6 +86,7 @@ struct IkResult {
   int iterations = 0, rejected = 0, solution = -1;
   double error = 0.0, min_rcond = 1.0;
   VecN q = VecN::Zero(3);  ///< final iterate (one per joint)
+  int restarts_used = 0;   ///< random restarts made
 };
 
 /// The outcome of one run: its metrics with an enum status, and its history (empty when off).

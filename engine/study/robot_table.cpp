@@ -23,7 +23,10 @@ RobotShape Study::robot_shape() const {
   r.joints = chain->dof();
   r.planar = chain->planar();
   r.prismatic.clear();
-  for (const ChainJoint& j : chain->joints) r.prismatic.push_back(j.type == JointType::prismatic);
+  for (const ChainJoint& j : chain->joints) {
+    r.prismatic.push_back(j.type == JointType::prismatic);
+    r.limited = r.limited || j.limited();
+  }
   return r;
 }
 
