@@ -2,6 +2,8 @@
 // every bad input located at FILE:LINE:COL with what was expected.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <filesystem>
 #include <cmath>
 #include <fstream>
@@ -259,18 +261,18 @@ TEST(StudyRobot, VertexAlphaShorthandOnEveryRobotKind) {
                                "[optimize.local]\nalgorithm = \"LN_BOBYQA\"\nmax_evals = 10\n";
   const std::string urdf = "[robot]\nurdf = \"" + studies_dir() + "robots/";
   struct Robot {
-    std::string text;  // [robot] (4 lines) or nothing
+    std::string text;  // [robot] or nothing
     bool takes;
   };
   const std::vector<Robot> robots = {
       {"", true},                                                                       // the seed's closed form
       {"[robot]\nl = [1, 1, 1]\nm = [5, 2, 1]\ndynamics = \"recursive\"\n", true},      // an n-link arm of 3
       {"[robot]\nl = [0.9, 0.9, 0.8, 0.6]\nm = [3.6, 3.6, 3.2, 2.4]\nb = 0.06\n", false},  // of 4
-      {urdf + "seed3r.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\n", true},
-      {urdf + "planar4r.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\n", false},
+      {urdf + "seed3r.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\ngravity = [0, -9.81, 0]\n", true},
+      {urdf + "planar4r.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\ngravity = [0, -9.81, 0]\n", false},
   };
   for (const Robot& r : robots) {
-    const int key_line = r.text.empty() ? 5 : 9;  // vertex_alpha's line: after 4 [robot] lines, if any
+    const int key_line = 5 + static_cast<int>(std::count(r.text.begin(), r.text.end(), '\n'));  // vertex_alpha's
     for (const std::string& table : {block, optimize}) {
       SCOPED_TRACE(r.text + table);
       if (r.takes) {
@@ -330,7 +332,7 @@ TEST(StudyRobot, VertexBeyondTheReachBoundOfEveryRobotKind) {
             std::string::npos);
   EXPECT_NO_THROW(parse_study(arm4 + "[task]\nvertices = [[1, 0], [0, 3.1]]\n" + two, "s.toml"));
   // planar4r.urdf, the same lengths
-  const std::string p4 = "[robot]\nurdf = \"" + studies_dir() + "robots/planar4r.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\n";
+  const std::string p4 = "[robot]\nurdf = \"" + studies_dir() + "robots/planar4r.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\ngravity = [0, -9.81, 0]\n";
   EXPECT_NE(first_error(p4 + "[task]\nvertices = [[1, 0], [3.3, 0]]\n" + two).message.find("at most 3.2 m"), std::string::npos);
   EXPECT_NO_THROW(parse_study(p4 + "[task]\nvertices = [[1, 0], [3.1, 0]]\n" + two, "s.toml"));
   // arm7.urdf: joint a1 at z = 0.15; then 0.19 + 4 x 0.2 + 0.081 + 0.045 + 0.10 = 1.216 m to the tool

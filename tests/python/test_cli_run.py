@@ -153,7 +153,7 @@ class Reproducibility(Base):
             text = f["study"]["text"][()]
             self.assertEqual(text.decode() if isinstance(text, bytes) else text, SWEEP)
             self.assertIn("engine_version", f.attrs)
-            self.assertTrue(all(s in (b"ok", b"diverged", b"singular", b"unreachable_start") for s in table["status"][:561]))
+            self.assertTrue(all(s in (b"ok", b"diverged", b"singular", b"unreachable_start", b"off_path") for s in table["status"][:561]))
             E = table["E"][:561]
             ok = table["status"][:561] == b"ok"
             self.assertTrue(np.all(np.isfinite(E[ok])))

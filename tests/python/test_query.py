@@ -294,7 +294,7 @@ class QueryTest(unittest.TestCase):
         with ksread.open_results(self.h5) as r:
             self.assertEqual(r.roles(), {c: a["role"] for c, a in attrs.items() if c != "done"})
             self.assertEqual(r.metrics("ik"), ["iterations", "error", "solution", "rejected", "min_rcond",
-                                               "q_final_1", "q_final_2", "q_final_3"])
+                                               "restarts_used", "q_final_1", "q_final_2", "q_final_3"])
             self.assertIn("method", r.parameters("trajectory"))
             self.assertIn("method", r.parameters("ik"))
             self.assertEqual(r.bookkeeping(), ["run_id", "block", "status", "wall_time"])
