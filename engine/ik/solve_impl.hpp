@@ -244,7 +244,9 @@ void solve_attempt(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Su
             predicted = delta.dot(mu * delta - g);  // > 0 by the damped normal equations
           }
           const double en = Fn.norm();
-          const double rho = std::isfinite(en) ? (f2 - en * en) / predicted : -1.0;
+          // a clamped step can predict an increase (predicted <= 0): rejected like a failed trial, so
+          // that a larger mu turns it towards the projected gradient
+          const double rho = std::isfinite(en) && predicted > 0.0 ? (f2 - en * en) / predicted : -1.0;
           if (rho > 0.0) {
             lambda_used = mu;
             const double t = 2.0 * rho - 1.0;
