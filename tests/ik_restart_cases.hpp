@@ -51,7 +51,8 @@ inline VecN draw_within(const Chain& c, std::mt19937_64& rng) {
 inline std::vector<RestartCase> restart_cases(const Chain& c, int count, std::uint64_t target_seed,
                                               std::uint64_t start_seed) {
   std::mt19937_64 targets(target_seed), starts(start_seed);
-  KDL::ChainFkSolverPos_recursive fk(kdl_chain(c));
+  const KDL::Chain kchain = kdl_chain(c);  // the solver keeps a reference: it must outlive fk
+  KDL::ChainFkSolverPos_recursive fk(kchain);
   std::vector<RestartCase> v(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i) {
     RestartCase& k = v[static_cast<std::size_t>(i)];

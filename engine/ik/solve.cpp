@@ -25,7 +25,8 @@ bool Options::IsValid(std::string* why) const {
                      {"divergence_bound", divergence_bound, divergence_bound_rule},
                      {"cycle_tolerance", cycle_tolerance, cycle_tolerance_rule},
                      {"match_tolerance", match_tolerance, match_tolerance_rule},
-                     {"restarts", double(restarts), restarts_rule}},
+                     {"restarts", double(restarts), restarts_rule},
+                     {"stall_window", double(stall_window), stall_window_rule}},
                     why))
     return false;
   if (!(cycle_window >= 0 && cycle_window <= max_cycle_window)) {

@@ -56,7 +56,8 @@ enum class Method {
 
 enum class Status {
   converged,    ///< ||F|| < tolerance
-  stalled,      ///< ||delta|| < step_floor before convergence (a non-root minimum of ||F||, or roundoff)
+  stalled,      ///< ||delta|| < step_floor before convergence (a non-root minimum of ||F||, or roundoff),
+                ///< or ||F|| not halved over Options::stall_window updates
   singular,     ///< the matrix to solve had reciprocal condition < rcond_min (see Options)
   max_iter,     ///< max_iter updates without convergence
   cycle,        ///< an iterate came back to one of the last cycle_window iterates (see Options)
@@ -104,6 +105,11 @@ struct Options {
   /// compared, and none while ||F|| keeps halving its best value. cycle_window = 0: no check.
   int cycle_window = 8;
   double cycle_tolerance = 1e-8;
+  /// stalled when, after every stall_window-th update of an attempt, ||F|| is above half of its value
+  /// stall_window updates earlier: an attempt stuck near a non-root minimum of ||F|| ends early (and,
+  /// with restarts, gives way to the next attempt). 0: no check (the seed's behaviour: such an attempt
+  /// runs to max_iter).
+  int stall_window = 0;
   /// max |q - q*| (max-norm, mod 2 pi) to name the known solution q* reached. Generous on purpose: a
   /// converged q is only within about tolerance / sigma_min(J) of q*, while distinct solutions are
   /// far apart except near a singularity.
@@ -124,6 +130,7 @@ struct Options {
   static constexpr Domain cycle_tolerance_rule = Domain::nonnegative();
   static constexpr Domain match_tolerance_rule = Domain::positive();
   static constexpr Domain restarts_rule = Domain::within(0, 1e6);
+  static constexpr Domain stall_window_rule = Domain::within(0, 1e6);
   static constexpr int max_cycle_window = 16;
 
   /// True when every field is finite and within its rule (cycle_window within [0, 16], joint_limits

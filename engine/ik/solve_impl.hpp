@@ -196,6 +196,7 @@ void solve_attempt(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Su
   watch.push(q, 0.0, e);
   watch.best_error = e;
 
+  double e_checkpoint = e;  // ||F|| at the last multiple of stall_window updates
   VecN delta = VecN::Zero();
   VecN qt = q;             // clamping: the (clamped) next iterate
   VecM Fn = VecM::Zero();  // lm_adaptive trial point
@@ -319,6 +320,10 @@ void solve_attempt(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Su
     if (!detail::all_finite<N, M>(q, F) || !(q.norm() <= o.divergence_bound)) return finish(Status::diverged);
     if (e < o.tolerance) return finish(Status::converged);
     if (!(step >= o.step_floor)) return finish(Status::stalled);
+    if (o.stall_window > 0 && s.iterations % o.stall_window == 0) {
+      if (!(e <= 0.5 * e_checkpoint)) return finish(Status::stalled);
+      e_checkpoint = e;
+    }
     watch.push(q, step, e);
     if (watch.window > 0 && watch.returned(pb.revolute, o.cycle_tolerance)) return finish(Status::cycle);
   }

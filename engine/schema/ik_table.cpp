@@ -95,6 +95,10 @@ std::vector<ParamDef> ik_params(const KindContext& ctx) {
                            "random restarts after a failed attempt, from starts drawn within the joint limits "
                            "((-180, 180) deg for unlimited revolute joints); iterations are summed over attempts",
                            [](auto& r) -> auto& { return r.options.restarts; }, from_start));
+  t.push_back(integer<Run>("stall_window", "", ik::Options::stall_window_rule,
+                           "an attempt whose residual norm has not halved over this many updates ends stalled "
+                           "(and gives way to a restart); 0: no check",
+                           [](auto& r) -> auto& { return r.options.stall_window; }, from_start));
   t.push_back(integer<Run>("restart_seed", "", IkRun::restart_seed_rule,
                            "seed of the restarts' draws (mixed with the run's start and target)",
                            [](auto& r) -> auto& { return r.restart_seed; }, from_start));

@@ -7,8 +7,9 @@
 // limits; starts uniform within the limits, from another stream.
 // Ours: tolerance 1e-6 on ||F|| (m, rad), the robot's limits enforced as `joint_limits` says
 // (default clamp: a study's default for a robot with limits), at most `max_iter` updates per
-// attempt, up to R restarts (default 20, max_iter 100), lm with lambda = 1e-3. KDL LMA: weights 1, precision 1e-6, the same max_iter per attempt; it
-// restarts when it reports a failure.
+// attempt, up to R restarts (default 20, max_iter 100), lm with lambda = 1e-3 (--lambda),
+// lm_adaptive's lambda_scale and the stall_window as given (defaults: ik::Options'). KDL LMA:
+// weights 1, precision 1e-6, the same max_iter per attempt; it restarts when it reports a failure.
 // Success: KDL's forward kinematics puts the final q within 1e-6 of the target (sqrt(|dp|^2 +
 // angle^2)); "in limits" also asks q within the joint limits (mod 2 pi). Ours enforce the limits,
 // so their success counts only solutions within them; KDL's is given both ways.
@@ -16,7 +17,8 @@
 // us per solve = the round's wall time / C; min and median over the rounds, and KDL's time over
 // ours (min over min, median over median) as the speed-up.
 // Usage: bench_ik_restarts [--cases C] [--rounds N] [--restarts R] [--max-iter K]
-//                          [--limits none|clamp|reject] [--lambda L] [--urdf FILE]
+//                          [--limits none|clamp|reject] [--lambda L] [--lambda-scale T]
+//                          [--stall-window W] [--urdf FILE]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -54,6 +56,8 @@ double median(std::vector<double> v) {
 int main(int argc, char** argv) {
   int cases = 1000, rounds = 7, restarts = 20, max_iter = 100;
   double lambda = 1e-3;  // lm's fixed damping: the default 0.1 converges linearly, slowly, at 1e-6
+  double lambda_scale = Options{}.lambda_scale;  // lm_adaptive's initial damping (the default)
+  int stall_window = 0;                          // ik::Options::stall_window (0: off, the default)
   JointLimits limits = JointLimits::clamp;
   std::string urdf = KS_SOURCE_DIR "/studies/robots/panda_like.urdf";
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -63,6 +67,8 @@ int main(int argc, char** argv) {
     else if (a == "--restarts") restarts = std::max(0, std::atoi(v.c_str()));
     else if (a == "--max-iter") max_iter = std::max(1, std::atoi(v.c_str()));
     else if (a == "--lambda") lambda = std::atof(v.c_str());
+    else if (a == "--lambda-scale") lambda_scale = std::atof(v.c_str());
+    else if (a == "--stall-window") stall_window = std::max(0, std::atoi(v.c_str()));
     else if (a == "--urdf") urdf = v;
     else if (a == "--limits" && parse(v, limits)) continue;
     else return std::fprintf(stderr, "unknown option %s %s\n", a.c_str(), v.c_str()), 2;
@@ -83,6 +89,8 @@ int main(int argc, char** argv) {
     o.tolerance = kTol;
     o.max_iter = max_iter;
     o.lambda = lambda;
+    o.lambda_scale = lambda_scale;
+    o.stall_window = stall_window;
     o.keep_history = false;
     o.joint_limits = limits;
     o.restarts = restarts;
