@@ -70,7 +70,7 @@ std::string expected_units(const Family& f, const std::string& name) {
     if (name == "K_N") return "1/s";
     if (name == "dt") return "s";
     if (name == "torque_bound") return "Nm";
-    if (name == "K_P") return "1/s^2";
+    if (name == "K_P" || name == "K_L") return "1/s^2";
     if (name == "K_D") return "1/s";
     if (name == "tracking_bound") return "m";
     if (name == "orientation_bound") return "deg/rad";

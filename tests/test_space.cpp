@@ -34,7 +34,7 @@ TEST(Space, ColumnsCoverEveryParameterOfTheKind) {
   Block t({"t", BlockKind::trajectory, {}, {}, {}}, KindContext{});
   std::vector<std::string> names;
   for (const auto& c : t.columns()) names.push_back(c.name);
-  EXPECT_EQ(names, (std::vector<std::string>{"preset", "method", "k", "alpha1A", "K_N", "vertex_alpha_2",
+  EXPECT_EQ(names, (std::vector<std::string>{"preset", "method", "k", "alpha1A", "K_N", "K_L", "vertex_alpha_2",
                                              "vertex_alpha_3", "vertex_alpha_4", "vertex_alpha_5", "integrator",
                                              "dt", "torque_bound", "K_P", "K_D", "tracking_bound", "orientation_bound",
                                              "on_violation", "inertia"}));
@@ -48,7 +48,7 @@ TEST(Space, ColumnsCoverEveryParameterOfTheKind) {
   for (const auto& c : ik.columns()) names.push_back(c.name);
   EXPECT_EQ(names, (std::vector<std::string>{"problem", "method", "lambda", "q0_1", "q0_2", "q0_3", "target_x",
                                              "target_y", "target_z", "target_alpha", "tol", "max_iter", "joint_limits",
-                                             "restarts", "restart_seed", "z_mode"}));
+                                             "restarts", "stall_window", "restart_seed", "z_mode"}));
   EXPECT_EQ(ik.columns()[ik.column_index("q0_3")].unit, "mm");
   EXPECT_EQ(ik.columns()[ik.column_index("max_iter")].type, CellType::i64);
   // Seed 001 defaults.

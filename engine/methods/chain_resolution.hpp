@@ -168,7 +168,7 @@ struct SmallLdlt {
 using InertiaFactor = SmallLdlt<kMaxJoints>;
 
 /// Local (instantaneous) resolution at acceleration level for a chain (seed Eqs. 51, 56, generalised):
-///   qdd = J_W+ b - (I - J_W+ J) v,  J_W+ = W^-1 J^T (J W^-1 J^T)^-1,  v = M^-1 (c + k g) + K_N qd,
+///   qdd = J_W+ b - (I - J_W+ J) v,  J_W+ = W^-1 J^T (J W^-1 J^T)^-1,  v = M^-1 (c + k g) + K_N qd + w,
 /// computed as qdd = Y A^-1 (b + J v) - v with Y = W^-1 J^T (n x m, solves with the factor of M) and
 /// A = J Y (m x m, an LDL^T factor of its own).
 /// W = M (Weighting::inertia) minimises (qdd + v)^T M (qdd + v), i.e. with k = 1 and K_N = 0 the torque
@@ -176,10 +176,11 @@ using InertiaFactor = SmallLdlt<kMaxJoints>;
 /// (qdd + v)^T M^2 (qdd + v), with k = 1 and K_N = 0 tau^T tau.
 /// Inputs: Mf, the factor of M [kg m^2]; J (m x n), the task Jacobian [m or rad per joint unit];
 /// b (m) = task acceleration - task rows of J̇ q̇ [m/s^2 or rad/s^2]; u = c + k g (n) [Nm]; K_N [1/s];
-/// qd (n) [rad/s]. Output: qdd (n) [rad/s^2]. Non-finite input or a singular J gives non-finite output.
+/// qd (n) [rad/s]; w (n, optional) [rad/s^2], a further null-space term (the limit spring
+/// K_L (q - q_mid)). Output: qdd (n) [rad/s^2]. Non-finite input or a singular J gives non-finite output.
 template <int m>
 VecN local_acceleration(Weighting w, const InertiaFactor& Mf, const TaskJacobian<m>& J, const TaskVec<m>& b,
-                        const VecN& u, double K_N, const VecN& qd) {
+                        const VecN& u, double K_N, const VecN& qd, const double* extra = nullptr) {
   const int n = static_cast<int>(J.cols());
   double Y[m][kMaxJoints], v[kMaxJoints];
   for (int s = 0; s < m; ++s) {
@@ -191,6 +192,8 @@ VecN local_acceleration(Weighting w, const InertiaFactor& Mf, const TaskJacobian
   Mf.solve(v);
   if (K_N != 0.0)
     for (int j = 0; j < n; ++j) v[j] += K_N * qd[j];
+  if (extra)
+    for (int j = 0; j < n; ++j) v[j] += extra[j];
   TaskMat<m> A;
   double r[m];
   for (int s = 0; s < m; ++s) {

@@ -3,6 +3,8 @@
 
 #include <Eigen/LU>
 
+#include <cmath>
+
 #include "methods/chain_resolution.hpp"
 #include "model/chain_kinematics.hpp"
 
@@ -40,10 +42,39 @@ class StartRows {
   Mat6N J6_;
 };
 
+/// Position-limit violation of joint j at value x [rad or m]: 0 within [lower, upper].
+double violation(const ChainJoint& J, double x) {
+  if (x > J.upper) return x - J.upper;
+  if (x < J.lower) return x - J.lower;
+  return 0.0;
+}
+
+bool within_limits(const Chain& chain, const VecN& q) {
+  for (int j = 0; j < q.size(); ++j)
+    if (violation(chain.joints[static_cast<std::size_t>(j)], q[j]) != 0.0) return false;
+  return true;
+}
+
+/// Each revolute joint outside its limits moved by the multiple of 2 pi that brings it nearest to
+/// the centre of [lower, upper] (the same pose, the least violation).
+void shift_into_limits(const Chain& chain, VecN& q) {
+  constexpr double two_pi = 2.0 * 3.14159265358979323846;
+  for (int j = 0; j < q.size(); ++j) {
+    const ChainJoint& J = chain.joints[static_cast<std::size_t>(j)];
+    if (J.type != JointType::revolute || violation(J, q[j]) == 0.0 || !std::isfinite(J.lower) || !std::isfinite(J.upper))
+      continue;
+    const double centre = 0.5 * (J.lower + J.upper);
+    q[j] -= two_pi * std::round((q[j] - centre) / two_pi);
+  }
+}
+
 }  // namespace
 
-std::optional<VecN> solve_start(const Chain& chain, const StartTarget& target, const VecN& q0,
-                                const StartSolveOptions& o) {
+namespace {
+
+/// The damped Newton / minimum-norm iteration from q0 (solve_start's first stage).
+std::optional<VecN> place_on_target(const Chain& chain, const StartTarget& target, const VecN& q0,
+                                    const StartSolveOptions& o) {
   StartRows rows(chain, target);
   VecN q = q0, trial;
   RowVec e, e_trial;
@@ -72,6 +103,74 @@ std::optional<VecN> solve_start(const Chain& chain, const StartTarget& target, c
   }
   if (!(norm <= o.tolerance) || !q.allFinite()) return std::nullopt;
   return q;
+}
+
+/// Null-space steps that pull the joints outside their position limits towards a margin inside them
+/// while the tip stays on the target: dq = J^+ e - (I - J^+ J) v, v_j = the joint's violation of
+/// [lower + m_j, upper - m_j] (m_j = 2 % of its range), each followed by the task's correction.
+/// Returns the iterate with the least total violation of the true limits (q itself if none is better).
+VecN pull_into_limits(const Chain& chain, const StartTarget& target, const VecN& q_start, int steps) {
+  StartRows rows(chain, target);
+  VecN q = q_start, best = q_start, v(q.size());
+  RowVec e;
+  RowJac J;
+  auto total = [&](const VecN& x) {
+    double t = 0.0;
+    for (int j = 0; j < x.size(); ++j) t += std::abs(violation(chain.joints[static_cast<std::size_t>(j)], x[j]));
+    return t;
+  };
+  double best_total = total(q);
+  for (int it = 0; it < steps && best_total > 0.0; ++it) {
+    rows.residual(q, e, &J);
+    for (int j = 0; j < q.size(); ++j) {
+      const ChainJoint& Jt = chain.joints[static_cast<std::size_t>(j)];
+      const double m = std::isfinite(Jt.upper - Jt.lower) ? 0.02 * (Jt.upper - Jt.lower) : 0.0;
+      ChainJoint inner = Jt;
+      inner.lower += m, inner.upper -= m;
+      v[j] = violation(inner, q[j]);
+    }
+    const Eigen::PartialPivLU<RowMat> lu(J * J.transpose());
+    const VecN null_step = v - J.transpose() * lu.solve(J * v);
+    q += J.transpose() * lu.solve(e) - null_step;
+    if (!q.allFinite()) break;
+    const double t = total(q);
+    if (t < best_total) best = q, best_total = t;
+  }
+  return best;
+}
+
+}  // namespace
+
+std::optional<VecN> solve_start(const Chain& chain, const StartTarget& target, const VecN& q0,
+                                const StartSolveOptions& o) {
+  std::optional<VecN> q = place_on_target(chain, target, q0, o);
+  if (!q || !o.respect_limits || within_limits(chain, *q)) return q;
+  // the same pose with revolute joints shifted by 2 pi: never worse than q
+  VecN shifted = *q;
+  shift_into_limits(chain, shifted);
+  if (within_limits(chain, shifted)) {
+    const std::optional<VecN> polished = place_on_target(chain, target, shifted, o);
+    return polished && within_limits(chain, *polished) ? *polished : shifted;
+  }
+  // null-space steps, then the moved joints put back on the target to the start's tolerance
+  const auto pulled_from = [&](const VecN& from) -> std::optional<VecN> {
+    const std::optional<VecN> p = place_on_target(chain, target, pull_into_limits(chain, target, from, o.limit_steps), o);
+    return p && within_limits(chain, *p) ? p : std::nullopt;
+  };
+  if (std::optional<VecN> p = pulled_from(shifted)) return p;
+  // again from the middle of the limits (joints without both limits: the guess's value)
+  VecN centre = q0;
+  for (int j = 0; j < centre.size(); ++j) {
+    const ChainJoint& J = chain.joints[static_cast<std::size_t>(j)];
+    if (std::isfinite(J.lower) && std::isfinite(J.upper)) centre[j] = 0.5 * (J.lower + J.upper);
+  }
+  if (std::optional<VecN> c = place_on_target(chain, target, centre, o)) {
+    if (within_limits(chain, *c)) return c;
+    shift_into_limits(chain, *c);
+    if (within_limits(chain, *c)) return c;
+    if (std::optional<VecN> p = pulled_from(*c)) return p;
+  }
+  return place_on_target(chain, target, shifted, o).value_or(shifted);
 }
 
 VecN planar_start_guess(int n) {

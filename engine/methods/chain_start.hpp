@@ -21,6 +21,10 @@ struct StartTarget {
 struct StartSolveOptions {
   double tolerance = 1e-13;  ///< converged when the residual's 2-norm [m, rad mixed] is at most this
   int max_iterations = 200;  ///< attempted steps, accepted or not
+  /// when the solution lies outside the chain's position limits: revolute joints shifted by 2 pi
+  /// into them, then null-space steps towards them (limit_steps at most), then the solve again
+  bool respect_limits = true;
+  int limit_steps = 200;
 };
 
 /// Solve for q with the tip on `target`, starting from q0 (n = chain.dof() values [rad or m]).
@@ -28,9 +32,17 @@ struct StartSolveOptions {
 /// Jacobian: for a square J and lambda = 0, Newton's step; for more joints than rows, the
 /// minimum-norm step. lambda^2 starts at 0; while a step does not reduce |e| it is set to 1e-6, then
 /// grows tenfold; after each accepted step it shrinks tenfold (to 0 below 1e-12). Once |e| <= tolerance, up to two more
-/// steps are taken while they reduce |e| (the last bits of a quadratic convergence). Joint limits are
-/// not enforced. Output: q, or std::nullopt when |e| > tolerance after max_iterations (out of reach,
-/// or a guess that does not lead there).
+/// steps are taken while they reduce |e| (the last bits of a quadratic convergence).
+/// Joint position limits (options.respect_limits): a solution within them is returned as found (so a
+/// chain without limits, or a start already within them, is unaffected). Otherwise each revolute joint
+/// outside them is moved by a multiple of 2 pi into them where one exists (the same pose); if some
+/// joint is still outside, null-space steps dq = J^+ e - (I - J^+ J) v pull every violating joint
+/// towards 2 % inside its range (v = its violation of that inner range) while the tip stays on the
+/// target; the result is put back on the target by the iteration above. That start is returned when
+/// it lies within the limits; else the same is tried from the middle of the limits as the guess;
+/// else the first solution, shifted (the run then reports its limit ratios).
+/// Output: q, or std::nullopt when |e| > tolerance after max_iterations (out of reach, or a guess
+/// that does not lead there).
 ///
 /// For the seed arm (n = 3, planar) the solution is the analytic IK's branch nearest
 /// q0 in Newton's sense; from planar_start_guess(3) it is the positive-elbow one for every start of

@@ -87,7 +87,13 @@ class ChainResolver {
 
   ChainResolver(const Chain& chain, const QuinticPath<3>& path, const TrajectoryOptions& o,
                 const std::optional<Profile1>& alpha)
-      : chain_(chain), path_(path), o_(o), alpha_(alpha) {}
+      : chain_(chain), path_(path), o_(o), alpha_(alpha) {
+    if (o.limit_centring != 0.0) {
+      const LimitTable L = LimitTable::of(chain);
+      for (int j = 0; j < L.n; ++j) centre_[j] = L.mid[j], sprung_[j] = L.inv_half[j] != 0.0;
+      spring_ = L.any_position;
+    }
+  }
 
   /// The task acceleration at time t on segment `segment` (RK4's stages).
   TaskVec<m> task(double t, std::size_t segment) const { return task_of(path_.sample_on(segment, t).a, segment, t); }
@@ -137,7 +143,12 @@ class ChainResolver {
       u_.resize(n);
       for (int j = 0; j < n; ++j) u_[j] = e.st.c[j] + o_.k * e.st.g[j];
       constexpr Weighting w = R == Resolution::unweighted ? Weighting::inertia_squared : Weighting::inertia;
-      e.qdd = local_acceleration<m>(w, e.Mf, e.Jt, b, u_, o_.null_damping, qd);
+      const double* extra = nullptr;
+      if (spring_) {
+        for (int j = 0; j < n; ++j) spring_term_[j] = sprung_[j] ? o_.limit_centring * (q[j] - centre_[j]) : 0.0;
+        extra = spring_term_;
+      }
+      e.qdd = local_acceleration<m>(w, e.Mf, e.Jt, b, u_, o_.null_damping, qd, extra);
       return true;
     }
   }
@@ -163,6 +174,10 @@ class ChainResolver {
   const std::optional<Profile1>& alpha_;
   ChainData data_;
   VecN u_;  // c + k g
+  // the limit spring K_L (q - q_mid) (TrajectoryOptions::limit_centring), on joints with both limits
+  bool spring_ = false;
+  bool sprung_[kMaxJoints] = {};
+  double centre_[kMaxJoints] = {}, spring_term_[kMaxJoints] = {};
 };
 
 /// The loop of one run from the start q_start at rest.

@@ -41,6 +41,7 @@ bool TrajectoryOptions::IsValid(std::string* why) const {
   if (!fields_valid({{"k", k, Domain::any()},
                      {"alpha1A", alpha1A, Domain::any()},
                      {"null_damping", null_damping, null_damping_rule},
+                     {"limit_centring", limit_centring, limit_centring_rule},
                      {"dt", dt, dt_rule},
                      {"torque_bound", torque_bound, torque_bound_rule},
                      {"singular_tolerance", singular_tolerance, singular_tolerance_rule},

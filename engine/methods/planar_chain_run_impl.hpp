@@ -60,8 +60,11 @@ class Stepper {
   static constexpr int m = task_dimension(S);
 
   Stepper(const PlanarChainConstants<N>& k, const QuinticPath<3>& path, const TrajectoryOptions& o,
-          const std::optional<Profile1>& alpha)
-      : k_(k), path_(path), o_(o), alpha_(alpha) {}
+          const std::optional<Profile1>& alpha, const LimitTable& limits)
+      : k_(k), path_(path), o_(o), alpha_(alpha) {
+    spring_ = o.limit_centring != 0.0 && limits.any_position;
+    for (int j = 0; j < N; ++j) centre_[j] = k.sigma[j] * limits.mid[j], sprung_[j] = limits.inv_half[j] != 0.0;
+  }
 
   /// Task acceleration xdd (m) at time t [s] on path segment `segment`.
   void task(double t, std::size_t segment, double* xdd) const { task_of(path_.sample_on(segment, t).a, segment, t, xdd); }
@@ -81,12 +84,13 @@ class Stepper {
     }
   }
 
-  /// Joint accelerations e.qdd for task acceleration xdd (m) at the frames' trig (s, c) and qd (N);
+  /// Joint accelerations e.qdd for task acceleration xdd (m) at u (N, the kernel's coordinates), the
+  /// frames' trig of u (s, c) and qd (N);
   /// fills every intermediate in `e`. With fb (closed loop: the path's position and velocity as
   /// desired() gives them, then the arm's tip angle at this state), xdd + K_D (v - J qd) + K_P (p - x)
   /// is commanded instead. Returns false when the task Jacobian is singular.
-  bool evaluate(const double* xdd, const double* s, const double* c, const double* qd, Evaluation<N, m>& e,
-                const double* fb = nullptr) const {
+  bool evaluate(const double* xdd, const double* u, const double* s, const double* c, const double* qd,
+                Evaluation<N, m>& e, const double* fb = nullptr) const {
     planar_chain_state<N, m>(k_, s, c, qd, e.st);
     double b[m];
     for (int r = 0; r < m; ++r) b[r] = xdd[r] - e.st.bias[r];
@@ -116,15 +120,15 @@ class Stepper {
     } else {
       e.w2 = gram_det<m>(e.st.J);
       if (!(e.w2 >= o_.singular_tolerance * o_.singular_tolerance)) return false;
-      local_acceleration(e, b, qd);
+      local_acceleration(e, b, u, qd);
       return true;
     }
   }
 
  private:
-  /// qdd = Y A^-1 (b + J v) - v with Y = W^-1 J^T, A = J Y, v = M^-1 (c + k g) + K_N qd (see
-  /// local_acceleration in methods/chain_resolution.hpp).
-  void local_acceleration(Evaluation<N, m>& e, const double* b, const double* qd) const {
+  /// qdd = Y A^-1 (b + J v) - v with Y = W^-1 J^T, A = J Y, v = M^-1 (c + k g) + K_N qd + K_L (u - u_mid)
+  /// (see local_acceleration in methods/chain_resolution.hpp).
+  void local_acceleration(Evaluation<N, m>& e, const double* b, const double* u, const double* qd) const {
     const auto& J = e.st.J;
     double Y[m][N], v[N];
     for (int s = 0; s < m; ++s) {
@@ -136,6 +140,9 @@ class Stepper {
     e.Mf.solve(v);
     if (o_.null_damping != 0.0)
       for (int j = 0; j < N; ++j) v[j] += o_.null_damping * qd[j];
+    if (spring_)
+      for (int j = 0; j < N; ++j)
+        if (sprung_[j]) v[j] += o_.limit_centring * (u[j] - centre_[j]);
     double A[m][m], r[m];
     for (int s = 0; s < m; ++s) {
       for (int t = 0; t <= s; ++t) {
@@ -167,6 +174,10 @@ class Stepper {
   const QuinticPath<3>& path_;
   const TrajectoryOptions& o_;
   const std::optional<Profile1>& alpha_;
+  // the limit spring (TrajectoryOptions::limit_centring): the limits' middle in u = sigma q
+  bool spring_ = false;
+  bool sprung_[N] = {};
+  double centre_[N] = {};
 };
 
 /// The loop of one run from q_start at rest.
@@ -180,7 +191,8 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
   const std::size_t n = sampled.size();
   const PlanarChainConstants<N> k(chain);
   const double alpha_offset = PlanarAngle(chain).offset;
-  const Stepper<N, S, R> stepper(k, path, o, alpha_profile);
+  const LimitTable limits = LimitTable::of(chain);
+  const Stepper<N, S, R> stepper(k, path, o, alpha_profile, limits);
   const auto alpha_of = [&](const double* u) {  // the tip angle at u [rad]
     double a = 0;
     for (int j = 0; j < N; ++j) a += u[j];
@@ -188,7 +200,6 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
   };
   const bool closed = o.closed_loop();
   constexpr bool oriented = m == 3;
-  const LimitTable limits = LimitTable::of(chain);
   const RunShape shape{N, oriented, false, limits.any() ? &limits : nullptr};
 
   RunStatus status = RunStatus::ok;
@@ -211,7 +222,7 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
     if (closed || oriented) stepper.desired(t, sampled.segment(i), fb, fb + 3);
     const double alpha = alpha_of(q);
     fb[6] = alpha;
-    if (!stepper.evaluate(xdd, trig.s, trig.c, qd, e, closed ? fb : nullptr)) {
+    if (!stepper.evaluate(xdd, q, trig.s, trig.c, qd, e, closed ? fb : nullptr)) {
       status = RunStatus::singular;
       break;
     }
@@ -297,7 +308,7 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       }
       stage.reset(k, yq);
       fh[6] = alpha_of(yq);
-      bool good = stepper.evaluate(xh, stage.s, stage.c, yv, s, closed ? fh : nullptr);
+      bool good = stepper.evaluate(xh, yq, stage.s, stage.c, yv, s, closed ? fh : nullptr);
       for (int j = 0; j < N; ++j) {
         k2v[j] = s.qdd[j];
         yq[j] = q[j] + h * k2q[j];
@@ -305,7 +316,7 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       }
       stage.reset(k, yq);
       fh[6] = alpha_of(yq);
-      good = good && stepper.evaluate(xh, stage.s, stage.c, yv, s, closed ? fh : nullptr);
+      good = good && stepper.evaluate(xh, yq, stage.s, stage.c, yv, s, closed ? fh : nullptr);
       for (int j = 0; j < N; ++j) {
         k3v[j] = s.qdd[j];
         yq[j] = q[j] + dt * k3q[j];
@@ -313,7 +324,7 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       }
       stage.reset(k, yq);
       f1[6] = alpha_of(yq);
-      good = good && stepper.evaluate(x1, stage.s, stage.c, yv, s, closed ? f1 : nullptr);
+      good = good && stepper.evaluate(x1, yq, stage.s, stage.c, yv, s, closed ? f1 : nullptr);
       if (!good) {
         status = RunStatus::singular;
         break;

@@ -64,6 +64,10 @@ struct TrajectoryOptions {
   double alpha1A = 0.0;               ///< orientation at the start (first vertex) [rad]
   std::vector<double> vertex_alpha;   ///< vertex_alpha: alpha at vertices 2..n [rad] (n - 1 values)
   double null_damping = 0.0;          ///< K_N [1/s]: adds -(I - J+ J) K_N qd to qdd (local methods)
+  /// K_L [1/s^2]: adds -(I - J+ J) K_L (q - q_mid) to qdd (local methods), q_mid the middle of each
+  /// joint's position limits (joints without both limits: no term); a null-space spring that keeps
+  /// the joints away from their limits. 0: no term (bitwise the run without it).
+  double limit_centring = 0.0;
   Integrator integrator = Integrator::semi_implicit_euler;
   double dt = 1e-3;                   ///< sample / integration step [s]
   Elbow elbow = Elbow::positive;      ///< branch of the start IK (the seed's sin(theta2) >= 0)
@@ -81,6 +85,7 @@ struct TrajectoryOptions {
 
   /// The rules on the fields (checked by IsValid; the study schema reports them at the key).
   static constexpr Domain null_damping_rule = Domain::nonnegative();
+  static constexpr Domain limit_centring_rule = Domain::nonnegative();
   static constexpr Domain dt_rule = Domain::positive();
   static constexpr Domain torque_bound_rule = Domain::positive();
   static constexpr Domain singular_tolerance_rule = Domain::nonnegative();

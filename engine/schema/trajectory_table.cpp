@@ -54,6 +54,10 @@ std::vector<ParamDef> trajectory_params(const KindContext& ctx) {
                           [](auto& r) -> auto& { return r.options.alpha1A; }));
   t.push_back(real<Run>("K_N", FileUnit::none, "1/s", TrajectoryOptions::null_damping_rule, "null-space damping",
                         [](auto& r) -> auto& { return r.options.null_damping; }, kLocalOnly));
+  t.push_back(real<Run>("K_L", FileUnit::none, "1/s^2", TrajectoryOptions::limit_centring_rule,
+                        "null-space spring towards the middle of each joint's position limits (joints with "
+                        "both limits; 0 = none)",
+                        [](auto& r) -> auto& { return r.options.limit_centring; }, kLocalOnly));
   for (std::size_t v = 2; robot.vertex_alpha() && v <= ctx.path_vertices; ++v) {
     const std::size_t i = v - 2;
     t.push_back(real<Run>("vertex_alpha_" + std::to_string(v), FileUnit::deg, "rad", Domain::any(),
