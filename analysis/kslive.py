@@ -6,6 +6,7 @@ while a commit is being applied), else the file's size and modification time. `c
 method of an object with `path`, `f` and `_reopen()` retry from a fresh open until that holds.
 Run with Debian's interpreter: /usr/bin/python3.
 """
+import fcntl
 import functools
 import os
 import time
@@ -14,18 +15,38 @@ LIVE_READ_TIMEOUT = 60.0  # seconds a read keeps retrying while commits keep lan
 _PAUSE = 0.01             # seconds between attempts
 
 
+def writer_alive(fh):
+    """True while a writer holds the journal's lock (FORMAT.md "Crash safety": a writer keeps an
+    exclusive flock on its journal for its whole life). A shared lock taken and dropped at once
+    tells; any other error counts as alive (the caller then waits, as for a live writer)."""
+    try:
+        fcntl.flock(fh.fileno(), fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except OSError:
+        return True
+    fcntl.flock(fh.fileno(), fcntl.LOCK_UN)
+    return False
+
+
 def stamp(path):
     """The file's stamp (FORMAT.md): ("journal", header bytes) while `path.journal` exists, ("static",
-    size, mtime) without one; None while a commit is being applied (a journal longer than its header)."""
+    size, mtime) without one; None while a commit is being applied (a journal longer than its header
+    whose writer lives). A longer journal left by a writer that died mid-commit will not change:
+    ("stranded", its bytes' length, its tail) - the file is read as it is (it may be torn until
+    `kinesweep run --resume` applies the commit)."""
     try:
         with open(path + ".journal", "rb") as fh:
             head = fh.read(64)
+            if (head[:8], len(head)) in ((b"KSJRNL02", 56), (b"KSJRNL01", 48)):
+                return ("journal", head)
+            if writer_alive(fh):
+                return None
+            fh.seek(0, os.SEEK_END)
+            size = fh.tell()
+            fh.seek(max(0, size - 64))
+            return ("stranded", size, fh.read(64))
     except FileNotFoundError:
         st = os.stat(path)
         return ("static", st.st_size, st.st_mtime_ns)
-    if (head[:8], len(head)) not in ((b"KSJRNL02", 56), (b"KSJRNL01", 48)):
-        return None
-    return ("journal", head)
 
 
 def settled_stamp(path, deadline):
