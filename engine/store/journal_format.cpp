@@ -177,15 +177,30 @@ std::string mismatch(const Parsed& p, int fd) {
 bool recover_locked(int fd, int jfd, std::uint64_t dev, std::uint64_t ino, std::string* why) {
   why->clear();
   Parsed p = parse_journal(jfd);
-  if (p.version == 0) return true;  // empty, or no journal at all: nothing to recover
+  if (p.version == 0) {  // empty (a writer stopped before its header): nothing to recover
+    struct stat js{};
+    if (::fstat(jfd, &js) == 0 && js.st_size == 0) return true;
+    *why = "the journal is not a kinesweep journal (no KSJRNL header)";
+    return false;
+  }
   if (p.dev != dev || p.ino != ino) {
     if (!p.commit_ok) return true;  // another file's journal with nothing committed: nothing of this file
     *why = "the journal holds a commit for another file (device/inode differ: the file was replaced after its "
            "writer stopped)";
     return false;
   }
+  // Every results file is larger than an HDF5 superblock: a journal committing fewer bytes was not
+  // written for this file (recovery would truncate it)
+  if (p.committed < kMinCommittedSize) {
+    *why = "the journal claims a committed size of " + std::to_string(p.committed) +
+           " bytes, less than any results file (not a journal of this file)";
+    return false;
+  }
   *why = mismatch(p, fd);
-  if (!why->empty()) return false;
+  if (!why->empty()) {
+    *why += "; the file was changed after its writer stopped";
+    return false;
+  }
   struct stat st{};
   if (::fstat(fd, &st) != 0) return false;
   const std::uint64_t size = static_cast<std::uint64_t>(st.st_size);

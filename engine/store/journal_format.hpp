@@ -21,6 +21,7 @@ inline constexpr char kHeadMagicV1[8] = {'K', 'S', 'J', 'R', 'N', 'L', '0', '1'}
 inline constexpr char kTailMagic[8] = {'K', 'S', 'J', 'C', 'M', 'T', '0', '1'};
 inline constexpr std::size_t kHeadSizeV1 = 48;  // magic, dev, ino, committed size, commit sequence, session id
 inline constexpr std::size_t kHeadSize = 56;    // ... + crc32 of the first and of the last committed page
+inline constexpr std::uint64_t kMinCommittedSize = 48;  // bytes of an HDF5 superblock v2: no results file is smaller
 inline constexpr std::size_t kTailSize = 32;    // magic, n records, new size, crc32 (+4 pad)
 
 /// Records the driver's last error (journal_last_error() returns it); err: an errno value or 0.

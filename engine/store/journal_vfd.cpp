@@ -181,8 +181,8 @@ H5FD_t* j_open(const char* name, unsigned flags, hid_t fapl, haddr_t /*maxaddr*/
   std::string why;
   if (!recover_locked(f->fd, f->jfd, f->dev, f->ino, &why)) {
     if (why.empty()) set_error("cannot recover " + f->path + " from its journal", errno);
-    else set_error(f->path + " does not match its journal " + jp + " (" + why + "): the file was changed after "
-                   "its writer stopped; nothing was written (delete the journal to use the file as it is)", 0);
+    else set_error(f->path + " does not match its journal " + jp + " (" + why + "): nothing was written (delete "
+                   "the journal to use the file as it is)", 0);
     ::close(f->jfd); ::close(f->fd); delete f; return nullptr;
   }
   pause_point("recovered");

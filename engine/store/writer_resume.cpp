@@ -43,16 +43,21 @@ void require_resumable_format(const std::string& path, const FormatStamp& s) {
 }
 
 /// Checks the format read-only, before anything opens the file for writing (which would touch it).
-/// Skipped when the file cannot be opened read-only as it is (a commit waiting in its journal): the
-/// check after the recovering open below catches that case.
+/// A file that does not open read-only is refused untouched unless a journal exists beside it (a
+/// commit waiting in its journal: the check after the recovering open below catches that case).
 void check_format_read_only(const std::string& path) {
   Hid f(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
+  struct stat st{};
   if (!f.ok()) {
     H5Eclear2(H5E_DEFAULT);
-    return;
+    if (::stat(journal_path(path).c_str(), &st) == 0) return;
+    struct stat fs{};
+    const long long bytes = ::stat(path.c_str(), &fs) == 0 ? static_cast<long long>(fs.st_size) : -1;
+    throw StoreError(path, "not a kinesweep results file (not an HDF5 file" +
+                               (bytes >= 0 ? ", " + std::to_string(bytes) + " bytes" : std::string()) +
+                               "); nothing was written");
   }
   const FormatStamp s = read_format_stamp(f);
-  struct stat st{};
   // Root attributes that do not read as a results file's while a journal exists: the file may have
   // been changed after its writer stopped, which the recovering open reports as such.
   if (s.format != kFormatName && ::stat(journal_path(path).c_str(), &st) == 0) return;

@@ -9,6 +9,7 @@ usage: /usr/bin/python3 test_readonly.py KINESWEEP_BINARY
 import hashlib
 import os
 import signal
+import struct
 import subprocess
 import sys
 import time
@@ -129,6 +130,60 @@ class ReadOnly(TempDirTest):
         r = run("run", self.study, "-o", out, "--resume", "-q")
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertTrue(same_tables(runs_table(out), self.ref))
+
+
+class ResumeRefusals(TempDirTest):
+    """`run --resume` refuses what is not its own, leaving every byte as it was (exit 1, a message
+    naming the file or the journal)."""
+
+    def setUp(self):
+        super().setUp()
+        self.study = self.write("s.toml", SWEEP)
+
+    def test_a_zero_byte_file_is_refused_untouched(self):
+        out = os.path.join(self.dir, "empty.h5")
+        open(out, "wb").close()
+        r = run("run", self.study, "-o", out, "--resume", "-q")
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn("not a kinesweep results file", r.stderr)
+        self.assertEqual(os.path.getsize(out), 0)
+        self.assertFalse(os.path.exists(out + ".journal"))
+
+    def finished(self, name):
+        out = os.path.join(self.dir, name)
+        self.assertEqual(run("run", self.study, "-o", out, "-q").returncode, 0)
+        self.assertFalse(os.path.exists(out + ".journal"))
+        return out
+
+    def refused(self, out, journal_bytes, expect):
+        with open(out + ".journal", "wb") as f:
+            f.write(journal_bytes)
+        before = digest(out), digest(out + ".journal")
+        r = run("run", self.study, "-o", out, "--resume", "-q")
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn(out + ".journal", r.stderr)
+        self.assertIn(expect, r.stderr)
+        self.assertEqual((digest(out), digest(out + ".journal")), before, r.stderr)
+
+    def test_a_journal_committing_zero_bytes_is_refused(self):
+        out = self.finished("zero.h5")
+        st = os.stat(out)
+        # FORMAT.md "Crash safety": a version-1 header (magic, device, inode, committed size,
+        # sequence, session) for this very file, claiming 0 committed bytes
+        head = b"KSJRNL01" + struct.pack("<QQQQQ", st.st_dev, st.st_ino, 0, 0, 0)
+        self.refused(out, head, "committed size of 0 bytes")
+
+    def test_a_journal_of_another_format_is_refused(self):
+        out = self.finished("foreign.h5")
+        self.refused(out, b"not a journal at all\n" * 8, "not a kinesweep journal")
+
+    def test_an_empty_journal_holds_nothing(self):
+        out = self.finished("emptyj.h5")
+        ref = runs_table(out)
+        open(out + ".journal", "wb").close()
+        r = run("run", self.study, "-o", out, "--resume", "-q")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertTrue(same_tables(runs_table(out), ref))
 
 
 if __name__ == "__main__":
