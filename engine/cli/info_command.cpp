@@ -24,11 +24,7 @@ struct BlockSummary {
   std::int64_t rows = 0;  ///< all rows of the block (done or not)
   std::int64_t done = 0, good = 0;  ///< good: done runs whose status is ok / converged
   std::vector<std::pair<std::string, std::int64_t>> statuses;  ///< first-seen order
-  struct Candidate {
-    double key, tie;
-    std::int64_t run;
-  };
-  std::vector<Candidate> best;  ///< the lowest (key, tie, run id) among its good runs, at most --best
+  std::vector<RankKey> best;    ///< its best good runs under ranking(kind), at most --best
   RunsTable first;              ///< its first done row (parameters that differ from it vary)
   std::vector<bool> varies;     ///< per column
 };
@@ -203,11 +199,15 @@ std::string axis_text(const store::LandscapeAxis& a) {
   return o.str();
 }
 
-/// Ranking key of a row for "best rows": iterations (ik) or E (trajectory); NaN sorts last.
-double rank_value(const RunsColumn* c, std::int64_t r) {
-  if (!c) return 0.0;
-  const double v = c->type == CellType::i64 ? static_cast<double>(c->i[r]) : c->f[r];
-  return std::isnan(v) ? std::numeric_limits<double>::infinity() : v;
+/// The value of numeric column c at row r, as a double.
+double value_at(const RunsColumn* c, std::int64_t r) {
+  return c->type == CellType::i64 ? static_cast<double>(c->i[r]) : c->f[r];
+}
+
+/// The metric column `name` of kind `kind` in t, or null.
+const RunsColumn* metric_column(const RunsTable& t, const std::string& kind, std::string_view name) {
+  const RunsColumn* c = t.find(std::string(name));
+  return c && c->role == Role::metric && c->applies_to(kind) ? c : nullptr;
 }
 
 int run_info(const InfoArgs& args) {
@@ -259,22 +259,17 @@ int run_info(const InfoArgs& args) {
       for (std::size_t c = 0; c < p.cols.size(); ++c)
         if (!b.varies[c] && p.cols[c].role == Role::parameter && !same_value(p.cols[c], r, b.first.cols[c], 0))
           b.varies[c] = true;
-      // Best rows: trajectory lowest E among ok runs; ik fewest iterations among converged, then error.
-      const bool ik = b.kind == "ik";
-      auto metric = [&](const char* mname) {  // a metric column of the block's kind, or null
-        const RunsColumn* c = p.find(mname);
-        return c && c->role == Role::metric && c->applies_to(b.kind) ? c : nullptr;
-      };
-      if ((ik || b.kind == "trajectory") && st == (ik ? "converged" : "ok")) {
-        const RunsColumn* key = metric(ik ? "iterations" : "E");
+      // Best rows: the kind's ranking (ranking(kind)) among its good runs.
+      BlockKind kind;
+      if (parse(b.kind, kind) && st == statuses(kind).front()) {
+        const Ranking rank = ranking(kind);
+        const RunsColumn* key = metric_column(p, b.kind, rank.objective);
         if (key) ++b.good;
         if (key && n_best > 0) {
-          const BlockSummary::Candidate c{rank_value(key, r), rank_value(ik ? metric("error") : nullptr, r), id};
-          auto less = [](const BlockSummary::Candidate& x, const BlockSummary::Candidate& y) {
-            return std::tie(x.key, x.tie, x.run) < std::tie(y.key, y.tie, y.run);
-          };
-          if (b.best.size() < n_best || less(c, b.best.back())) {
-            b.best.insert(std::upper_bound(b.best.begin(), b.best.end(), c, less), c);
+          const RunsColumn* tie = rank.tie.empty() ? nullptr : metric_column(p, b.kind, rank.tie);
+          const RankKey c = rank_key(value_at(key, r), tie ? value_at(tie, r) : 0.0, static_cast<std::uint64_t>(id));
+          if (b.best.size() < n_best || c < b.best.back()) {
+            b.best.insert(std::upper_bound(b.best.begin(), b.best.end(), c), c);
             if (b.best.size() > n_best) b.best.pop_back();
           }
         }
@@ -322,25 +317,28 @@ int run_info(const InfoArgs& args) {
   }
 
   // Best rows per block: the candidates' rows read back by run id.
-  os << "\nbest rows per block (trajectory: lowest E among ok runs; ik: fewest iterations among converged runs,\n"
-        "then smallest error)\n";
+  os << "\nbest rows per block (the lowest objective among the runs of the good status, ties by the\n"
+        "second metric, then run id:";
+  for (const BlockKind k : block_kinds()) {
+    const Ranking rank = ranking(k);
+    os << (k == block_kinds().front() ? " " : "; ") << to_string(k) << ": " << rank.objective << " among "
+       << statuses(k).front() << " runs" << (rank.tie.empty() ? "" : ", then " + std::string(rank.tie));
+  }
+  os << ")\n";
   for (const auto& b : blocks) {
     if (b.done == 0 || b.name == "(pending)") continue;
-    const bool ik = b.kind == "ik";
-    if (!ik && b.kind != "trajectory") continue;  // no ranking defined for another kind
-    auto metric = [&](const char* name) {
-      const RunsColumn* c = t.find(name);
-      return c && c->role == Role::metric && c->applies_to(b.kind) ? c : nullptr;
-    };
-    const RunsColumn* key = metric(ik ? "iterations" : "E");
-    const RunsColumn* tie = ik ? metric("error") : nullptr;
+    BlockKind kind;
+    if (!parse(b.kind, kind)) continue;  // no ranking defined for another kind
+    const Ranking rank = ranking(kind);
+    const RunsColumn* key = metric_column(t, b.kind, rank.objective);
+    const RunsColumn* tie = rank.tie.empty() ? nullptr : metric_column(t, b.kind, rank.tie);
     if (!key || !status) continue;
     if (b.good == 0) {
-      os << "  " << b.name << ": no " << (ik ? "converged" : "ok") << " run\n";
+      os << "  " << b.name << ": no " << statuses(kind).front() << " run\n";
       continue;
     }
     std::vector<std::int64_t> ids;
-    for (const auto& c : b.best) ids.push_back(c.run);
+    for (const auto& c : b.best) ids.push_back(static_cast<std::int64_t>(c.run));
     std::vector<std::int64_t> sorted = ids;
     std::sort(sorted.begin(), sorted.end());
     load_ids(reader, t, sorted);
@@ -348,7 +346,7 @@ int run_info(const InfoArgs& args) {
       const auto r = static_cast<std::int64_t>(std::lower_bound(sorted.begin(), sorted.end(), id) - sorted.begin());
       os << "  " << std::left << std::setw(static_cast<int>(wn)) << b.name << std::right << "  run " << std::setw(6)
          << id << "  " << key->name << " = " << cell_for_humans(*key, r) << (key->unit.empty() ? "" : " " + key->unit);
-      if (tie) os << ", error = " << cell_for_humans(*tie, r) << " " << tie->unit;
+      if (tie) os << ", " << tie->name << " = " << cell_for_humans(*tie, r) << " " << tie->unit;
       std::string label;  // the varying parameters that have an effect on this row (the tables' rules)
       for (std::size_t c = 0; c < t.cols.size(); ++c)
         if (b.varies[c] && t.cols[c].applies_to(b.kind) && has_effect_in_row(t, b.kind, t.cols[c], r))

@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <map>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -67,15 +68,15 @@ class Accumulator {
     for (std::size_t b = 0; b < study.blocks.size(); ++b) {  // column indices, looked up once
       const Block& block = study.blocks[b];
       Columns c;
+      const Ranking rank = ranking(block.kind());
+      c.value = metric(b, rank.objective);
+      if (!rank.tie.empty()) c.tie = metric(b, rank.tie);
       if (block.kind() == BlockKind::trajectory) {
-        c.value = metric(b, "E");
         for (int j = 0; j < 3; ++j) c.tau[j] = metric(b, "tau" + std::to_string(j + 1) + "_inf");
         c.preset = schema.param_column[b][block.column_index("preset")];
         const std::size_t inertia = block.column_index("inertia");  // the seed's closed-form 3R only
         c.inertia = inertia == Block::npos ? Columns::npos : schema.param_column[b][inertia];
         c.seed_arm = block.context().robot.joints == 3 && block.context().robot.planar;
-      } else {
-        c.value = metric(b, "iterations");
       }
       columns_.push_back(c);
     }
@@ -90,7 +91,9 @@ class Accumulator {
     const bool traj = block.kind() == BlockKind::trajectory;
     const bool good = status == statuses(block.kind()).front();
     const Columns& c = columns_[ref.block];
-    if (good) consider_best(br, id, as_f64(row.cells[c.value]), row, ref.block);
+    if (good)
+      consider_best(br, rank_key(as_f64(row.cells[c.value]), c.tie == Columns::npos ? 0.0 : as_f64(row.cells[c.tie]), id),
+                    row, ref.block);
     if (traj) {
       const std::string& preset = as_str(row.cells[c.preset]);
       if (c.seed_arm && !preset.empty() && seed_.size() < 1000 && find_seed_case(preset)) {
@@ -113,16 +116,15 @@ class Accumulator {
   SweepReport& report() { return report_; }
 
  private:
-  void consider_best(BlockReport& br, std::uint64_t id, double v, const Record& row, std::size_t b) {
-    if (!std::isfinite(v)) return;
-    if (br.best.size() == 3 && !(v < br.best.back().value)) return;
-    BestRun r{id, v, label(row, b)};
-    br.best.insert(std::upper_bound(br.best.begin(), br.best.end(), r,
-                                    [](const BestRun& a, const BestRun& c) {
-                                      return a.value < c.value || (a.value == c.value && a.run_id < c.run_id);
-                                    }),
-                   std::move(r));
-    if (br.best.size() > 3) br.best.pop_back();
+  /// The run keyed `k` among the block's best three (ranking(kind): NaN objectives never are).
+  void consider_best(BlockReport& br, const RankKey& k, const Record& row, std::size_t b) {
+    if (!std::isfinite(k.objective)) return;
+    auto& keys = best_keys_[b];
+    if (keys.size() == 3 && !(k < keys.back())) return;
+    const auto at = std::upper_bound(keys.begin(), keys.end(), k) - keys.begin();
+    keys.insert(keys.begin() + at, k);
+    br.best.insert(br.best.begin() + at, BestRun{k.run, k.objective, label(row, b)});
+    if (keys.size() > 3) keys.pop_back(), br.best.pop_back();
   }
   /// The swept parameters of the run, in file units (angles in degrees).
   std::string label(const Record& row, std::size_t b) const {
@@ -150,10 +152,11 @@ class Accumulator {
   std::map<std::uint64_t, SeedRow> seed_;
   struct Columns {  // schema columns a block's rows are read at
     static constexpr std::size_t npos = std::size_t(-1);
-    std::size_t value = 0, preset = 0, inertia = 0, tau[3] = {0, 0, 0};
+    std::size_t value = 0, tie = npos, preset = 0, inertia = 0, tau[3] = {0, 0, 0};
     bool seed_arm = true;  ///< a planar 3-joint arm: its preset rows are compared with the thesis' Table 4
   };
   std::vector<Columns> columns_;
+  std::map<std::size_t, std::vector<RankKey>> best_keys_;  // per block: the keys of report_'s best rows
 };
 
 }  // namespace
@@ -292,9 +295,13 @@ void print_report(std::ostream& os, const Study& study, const SweepReport& r) {
     os << "block " << b.name << " (" << to_string(b.kind) << ", " << b.runs << " runs):";
     for (const auto& [status, n] : b.by_status) os << ' ' << status << '=' << n;
     os << '\n';
+    // the ranking objective with its unit, as the kind's metric table gives it
+    std::string objective(ranking(b.kind).objective);
+    for (const MetricDef& m : metrics(b.kind))
+      if (m.name == objective && !m.unit.empty()) objective += " [" + m.unit + "]";
     for (const BestRun& best : b.best) {
       std::snprintf(line, sizeof line, "  best: run %llu  %s = %.6g  (%s)\n", static_cast<unsigned long long>(best.run_id),
-                    b.kind == BlockKind::trajectory ? "E [Nm]" : "iterations", best.value, best.label.c_str());
+                    objective.c_str(), best.value, best.label.c_str());
       os << line;
     }
   }

@@ -47,7 +47,7 @@ struct SweepOptions {
 /// One notable row for the summary.
 struct BestRun {
   std::uint64_t run_id = 0;
-  double value = 0.0;    ///< E (trajectory) or iterations (ik)
+  double value = 0.0;    ///< the kind's ranking objective (ranking(kind): E, iterations)
   std::string label;     ///< "method=..., alpha1A=..., k=..." or "method=..., lambda=..."
 };
 

@@ -2,6 +2,8 @@
 #include "schema/params.hpp"
 
 #include <array>
+#include <cmath>
+#include <limits>
 
 #include "common/name_table.hpp"
 #include "schema/kind_tables.hpp"
@@ -75,6 +77,14 @@ const ParamDef* find_param(const std::vector<ParamDef>& table, std::string_view 
 }
 std::vector<MetricDef> metrics(BlockKind kind, const KindContext& context) {
   return kind == BlockKind::trajectory ? trajectory_metrics(context) : ik_metrics(context);
+}
+Ranking ranking(BlockKind kind) {
+  if (kind == BlockKind::trajectory) return {"E", ""};
+  return {"iterations", "error"};
+}
+RankKey rank_key(double objective, double tie, std::uint64_t run) {
+  constexpr double last = std::numeric_limits<double>::infinity();
+  return {std::isnan(objective) ? last : objective, std::isnan(tie) ? last : tie, run};
 }
 std::span<const std::string_view> statuses(BlockKind kind) {
   using ik::Status;

@@ -7,6 +7,7 @@
 // Everything that lists parameters or metrics reads these tables: the study parser (keys,
 // validation, did-you-mean, block defaults), the /runs column specs and their attributes,
 // `kinesweep schema` / `info` / `query`, and engine/store/FORMAT.md (checked by a test).
+#include <cstdint>
 #include <functional>
 #include <span>
 #include <string>
@@ -101,6 +102,28 @@ const ParamDef* find_param(const std::vector<ParamDef>& table, std::string_view 
 std::vector<MetricDef> metrics(BlockKind kind, const KindContext& context = {});
 /// The status names of a kind, in enum order (the first is the good one: ok / converged).
 std::span<const std::string_view> statuses(BlockKind kind);
+/// How the runs of a kind are ranked ("best"): the lowest `objective` metric among the runs whose
+/// status is the kind's good one (statuses(kind).front()), ties broken by the `tie` metric (lower
+/// first; none when empty), then by run id. Trajectory: E; ik: iterations, then error. The one
+/// rule of the run summary and `kinesweep info`.
+struct Ranking {
+  std::string_view objective;
+  std::string_view tie;
+};
+Ranking ranking(BlockKind kind);
+
+/// The ordering key of a good run under ranking(): NaN values sort after every number.
+struct RankKey {
+  double objective = 0.0, tie = 0.0;
+  std::uint64_t run = 0;
+  friend bool operator<(const RankKey& a, const RankKey& b) {
+    return a.objective < b.objective ||
+           (a.objective == b.objective && (a.tie < b.tie || (a.tie == b.tie && a.run < b.run)));
+  }
+};
+/// The key of run `run` with metric values `objective` and `tie` (0 when the kind has no tie).
+RankKey rank_key(double objective, double tie, std::uint64_t run);
+
 /// A run of the kind with every default (the typed structs' own, with the context's study defaults).
 RunSpec default_run(BlockKind kind, const KindContext& context = {});
 /// True when parameter `p` of `table` has an effect on run `r` (its EffectRule).

@@ -163,6 +163,35 @@ class Reproducibility(Base):
             self.assertEqual(f["landscapes"]["newton_basin"]["converged"].shape, (21, 21))
 
 
+class BestRuns(Base):
+    def test_summary_and_info_name_the_same_best_runs_as_h5py_ranks_them(self):
+        """One ranking rule: the lowest objective among the good runs, ties by the second metric, then
+        run id (trajectory: E among ok; ik: iterations among converged, then error) - recomputed here
+        with h5py, and equal to what `run` prints and what `info` lists."""
+        study = self.write("s.toml", SWEEP)
+        out = os.path.join(self.dir, "s.h5")
+        r = run("run", study, "-o", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        printed = [int(m) for m in re.findall(r"best: run (\d+)", r.stdout)]
+        info = run("info", out)
+        self.assertEqual(info.returncode, 0, info.stderr)
+        listed = [int(m) for m in re.findall(r"^  \S+\s+run\s+(\d+)  ", info.stdout, re.M)]
+        with h5py.File(out, "r") as f:
+            runs = f["runs"]
+            text = lambda c: np.array([v.decode() for v in runs[c][()]])
+            block, status = text("block"), text("status")
+            expected = []
+            for name, good, key, tie in (("weighted", "ok", "E", None),
+                                         ("newton_basin", "converged", "iterations", "error")):
+                ids = np.nonzero((block == name) & (status == good))[0]
+                k = runs[key][()][ids].astype(float)
+                t = runs[tie][()][ids] if tie else np.zeros(len(ids))
+                order = sorted(range(len(ids)), key=lambda i: (k[i], t[i], ids[i]))
+                expected += [int(ids[i]) for i in order[:3]]
+        self.assertEqual(printed, expected)
+        self.assertEqual(listed, expected)
+
+
 class CrashAndResume(Base):
     def reference(self, study):
         ref = os.path.join(self.dir, "ref.h5")
