@@ -335,8 +335,9 @@ TEST(ChainIk, UnreachablePlanarTargetDoesNotConverge) {
     q0 << 0.3, 0.2, -0.1, 0.4;
     solve_chain(c, t, q0, o, r, ws);
     EXPECT_NE(r.status, Status::converged) << to_string(m);
-    if (m == Method::lm || m == Method::lm_adaptive)
+    if (m == Method::lm || m == Method::lm_adaptive) {
       EXPECT_TRUE(r.status == Status::stalled || r.status == Status::max_iter) << to_string(r.status);
+    }
     EXPECT_GT(r.error, 1.56 - 1.4 - 1e-6);  // |target| - reach
   }
 }

@@ -128,7 +128,9 @@ TEST(IkRestarts, AttemptsAreDeterministicAndStartWithinTheLimits) {
     }
     EXPECT_GE(a.restarts_used, 1);
     EXPECT_LE(a.restarts_used, 8);
-    if (a.restarts_used < 8) EXPECT_TRUE(a.converged());
+    if (a.restarts_used < 8) {
+      EXPECT_TRUE(a.converged());
+    }
     restarted += 1;
     ASSERT_EQ(a.history.size(), static_cast<std::size_t>(a.iterations + 1 + a.restarts_used));
     int starts = 0;
@@ -161,7 +163,9 @@ TEST(IkRestarts, RestartsDoNotLoseSolutions) {
     o.restarts = 10;
     o.restart_seed = k.seed;
     solve_chain(c, k.task, k.q0, o, r, ws);
-    if (r0.converged()) EXPECT_TRUE(r.converged());
+    if (r0.converged()) {
+      EXPECT_TRUE(r.converged());
+    }
     ok0 += r0.converged(), ok += r.converged();
   }
   EXPECT_GT(ok, ok0);

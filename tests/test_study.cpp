@@ -91,13 +91,13 @@ TEST(StudyErrors, ZipWithUnequalLengths) {
 
 TEST(StudyErrors, TooManyRuns) {
   const std::string t = kTraj + "[block.axes]\nalpha1A = { from = 0, to = 99, step = 1 }\nk = { from = 0, to = 1, count = 11 }\n";
-  expect_error_at(t, 1, 1, "too many runs", StudyOptions{1000});
-  EXPECT_NO_THROW(parse_study(t, "ok.toml", StudyOptions{1100}));
+  expect_error_at(t, 1, 1, "too many runs", StudyOptions{.max_runs = 1000, .robot_text = {}});
+  EXPECT_NO_THROW(parse_study(t, "ok.toml", StudyOptions{.max_runs = 1100, .robot_text = {}}));
   // The default limit is 50 million; the caller raises it, [study] max_runs only lowers it.
   const std::string big = kTraj + "[block.axes]\nalpha1A = { from = 0, to = 9999, step = 1 }\n"
                                   "k = { from = 0, to = 1, count = 10000 }\n";  // 1e8 runs
   expect_error_at(big, 1, 1, "expected at most 50000000");
-  EXPECT_EQ(parse_study(big, "ok.toml", StudyOptions{200000000}).run_count(), 100000000u);
+  EXPECT_EQ(parse_study(big, "ok.toml", StudyOptions{.max_runs = 200000000, .robot_text = {}}).run_count(), 100000000u);
   expect_error_at("[study]\nmax_runs = 200000000\n" + big, 2, 12, "a study may only lower the limit");
   // A single range with too many values is refused before it is materialised.
   expect_error_at(kTraj + "[block.axes]\nk = { from = 0, to = 1, step = 1e-12 }\n", 5, 5, "values; expected at most");

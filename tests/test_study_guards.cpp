@@ -34,26 +34,26 @@ TEST(StudyGuards, FiveHugeAxesAreRefusedFromTheirCounts) {
 TEST(StudyGuards, TheStudyTotalCountsEveryBlockBeforeGeneratingTheLast) {
   const std::string b2 = "[[block]]\nname = \"c\"\nkind = \"trajectory\"\n[block.axes]\nk = { from = 0, to = 1, count = 600 }\n";
   const std::string t = kTraj + "[block.axes]\nk = { from = 0, to = 1, count = 600 }\n" + b2;
-  expect_error_at(t, 6, 1, "block 'c' has 600 runs, the study 1200", StudyOptions{1000});
-  EXPECT_EQ(parse_study(t, "ok.toml", StudyOptions{1200}).run_count(), 1200u);
+  expect_error_at(t, 6, 1, "block 'c' has 600 runs, the study 1200", StudyOptions{.max_runs = 1000, .robot_text = {}});
+  EXPECT_EQ(parse_study(t, "ok.toml", StudyOptions{.max_runs = 1200, .robot_text = {}}).run_count(), 1200u);
 }
 
 TEST(StudyGuards, ZipAndLhsGroupsCountOnce) {
   const std::string zip = kTraj + "zip = [[\"alpha1A\", \"k\"]]\n[block.axes]\nalpha1A = { from = 0, to = 9, count = 10 }\n"
                                   "k = { from = 0, to = 1, count = 10 }\n";
-  EXPECT_EQ(parse_study(zip, "ok.toml", StudyOptions{10}).run_count(), 10u);
+  EXPECT_EQ(parse_study(zip, "ok.toml", StudyOptions{.max_runs = 10, .robot_text = {}}).run_count(), 10u);
   const std::string lhs = kTraj + "lhs = { count = 50, seed = 1 }\n[block.axes]\nalpha1A = { lhs = { from = 0, to = 9 } }\n"
                                   "k = { lhs = { from = 0, to = 1 } }\n";
-  EXPECT_EQ(parse_study(lhs, "ok.toml", StudyOptions{50}).run_count(), 50u);
-  expect_error_at(lhs, 4, 17, "lhs count = 50; expected at most 49 runs", StudyOptions{49});
+  EXPECT_EQ(parse_study(lhs, "ok.toml", StudyOptions{.max_runs = 50, .robot_text = {}}).run_count(), 50u);
+  expect_error_at(lhs, 4, 17, "lhs count = 50; expected at most 49 runs", StudyOptions{.max_runs = 49, .robot_text = {}});
   // two LHS-sized dimensions: each within the limit, their product not
-  expect_error_at(lhs + "dt = [0.001, 0.002]\n", 1, 1, "has 100 runs", StudyOptions{99});
+  expect_error_at(lhs + "dt = [0.001, 0.002]\n", 1, 1, "has 100 runs", StudyOptions{.max_runs = 99, .robot_text = {}});
 }
 
 TEST(StudyGuards, AStudyMayLowerTheCallersLimitButNotRaiseIt) {
   const std::string t = kTraj + "[block.axes]\nk = { from = 0, to = 1, count = 11 }\n";
   expect_error_at("[study]\nmax_runs = 10\n" + t, 7, 33, "the study's max_runs; the caller allows up to 50000000");
-  expect_error_at("[study]\nmax_runs = 100\n" + t, 2, 12, "above the caller's limit of 20", StudyOptions{20});
+  expect_error_at("[study]\nmax_runs = 100\n" + t, 2, 12, "above the caller's limit of 20", StudyOptions{.max_runs = 20, .robot_text = {}});
   EXPECT_EQ(parse_study("[study]\nmax_runs = 11\n" + t).run_count(), 11u);
 }
 
@@ -61,7 +61,7 @@ TEST(StudyGuards, OptimizeBlocksAreBoundedPerEvaluation) {
   const std::string t = "[[optimize]]\nname = \"o\"\nobjective = \"E\"\nvariables = { k = [0, 1] }\n"
                         "local = { algorithm = \"LN_BOBYQA\", max_evals = 5 }\n[optimize.axes]\n"
                         "alpha1A = { from = 0, to = 1, count = 50 }\ndt = [0.001, 0.002]\n";
-  expect_error_at(t, 1, 1, "too many runs per evaluation", StudyOptions{99});
+  expect_error_at(t, 1, 1, "too many runs per evaluation", StudyOptions{.max_runs = 99, .robot_text = {}});
 }
 
 // ---- the samples of a run ----

@@ -125,9 +125,13 @@ TEST(TrajectoryBounds, ClosedLoopFeedbackTracksThePath) {
       ASSERT_EQ(closed.status, RunStatus::ok);
       // RK4: within 1 mm; semi-implicit Euler's first-order step error is only divided by the gains
       // (measured 16-29 mm here, against the open loop's drift)
-      if (integ == Integrator::rk4) EXPECT_LT(closed.max_tracking_error, 1e-3);
+      if (integ == Integrator::rk4) {
+        EXPECT_LT(closed.max_tracking_error, 1e-3);
+      }
       EXPECT_LE(closed.max_tracking_error, open.max_tracking_error);
-      if (space == TaskSpace::planar_pose && integ == Integrator::rk4) EXPECT_LT(closed.max_orientation_error, 1e-3);
+      if (space == TaskSpace::planar_pose && integ == Integrator::rk4) {
+        EXPECT_LT(closed.max_orientation_error, 1e-3);
+      }
     }
 }
 

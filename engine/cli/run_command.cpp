@@ -127,7 +127,7 @@ int run_command(const RunArgs& a) {
   store::print_hdf5_error_stack(a.verbose);
   Study study;
   try {
-    study = load_study(a.study, StudyOptions{a.max_runs});
+    study = load_study(a.study, StudyOptions{.max_runs = a.max_runs, .robot_text = {}});
   } catch (const StudyError& e) {
     std::cerr << e.what() << '\n';
     return 2;

@@ -35,7 +35,7 @@ struct Domain {
   }
   /// The rule applied to `name`: "name > 0", "name >= 0", "name >= 1"; "" for any.
   std::string str(std::string_view name) const {
-    char b[32];
+    char b[64];  // two %.12g values: at most 2 x 19 characters and the brackets
     switch (rule) {
       case Rule::any: return "";
       case Rule::positive: return std::string(name) + " > 0";

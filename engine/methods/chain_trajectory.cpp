@@ -162,8 +162,9 @@ class ChainResolver {
       x << a[0], a[1], alpha_->sample_on(segment, t).a[0];
     } else if constexpr (S == TaskSpace::spatial_position) {
       x = a;
-    } else {
-      x << a, Eigen::Vector3d::Zero();
+    } else {  // fixed-size halves: no 4-wide packet reads past the 3 values of a
+      x.template head<3>() = a;
+      x.template tail<3>().setZero();
     }
     return x;
   }

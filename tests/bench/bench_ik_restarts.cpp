@@ -99,10 +99,11 @@ int main(int argc, char** argv) {
                          solve_chain(chain, k.task, k.q0, o, result, ws);
                          q = result.q;
                          return result.restarts_used;
-                       }});
+                       },
+                       {}, {}, {}});
   }
   test::KdlLmaRestarts lma(chain, kTol, max_iter);
-  solvers.push_back({"KDL LMA", [&](const test::RestartCase& k, VecN& q) { return lma.solve(k, restarts, q); }});
+  solvers.push_back({"KDL LMA", [&](const test::RestartCase& k, VecN& q) { return lma.solve(k, restarts, q); }, {}, {}, {}});
 
   for (Solver& s : solvers) s.out.resize(set.size()), s.restarts.resize(set.size());
   for (int r = 0; r < rounds; ++r)
