@@ -36,8 +36,8 @@ def stamp(path):
     try:
         with open(path + ".journal", "rb") as fh:
             head = fh.read(64)
-            if (head[:8], len(head)) in ((b"KSJRNL02", 56), (b"KSJRNL01", 48)):
-                return ("journal", head)
+            if (head[:8], len(head)) in ((b"KSJRNL02", 56), (b"KSJRNL01", 48)) or len(head) < 48:
+                return ("journal", head)  # (shorter: a journal being created; no lock is asked)
             if writer_alive(fh):
                 return None
             fh.seek(0, os.SEEK_END)

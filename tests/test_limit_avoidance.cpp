@@ -80,6 +80,40 @@ TEST(LimitAwareStart, StartsOnTheTargetWithinTheLimits) {
   EXPECT_GT(unchanged, 5);
 }
 
+// A planar target's angle row counts turns (a 2 pi shift is not the same start there): from random
+// guesses every start returned puts the tip on the point (1e-12 m) with the joint sum equal to the
+// target angle (1e-12 rad, unwrapped), within the limits whenever the plain solve's was not but
+// a start within them was found.
+TEST(LimitAwareStart, PlanarStartsStayOnTheTargetAngle) {
+  Chain c = planar_chain(planar_bars({1.0, 0.5, 0.5, 0.5, 0.5}, {5, 1, 1, 0.5, 0.5}, 0.1));
+  for (ChainJoint& j : c.joints) j.lower = -2.0, j.upper = 2.0;
+  c.prepare();
+  const KDL::Chain k = test::kdl_chain(c);
+  KDL::ChainFkSolverPos_recursive fk(k);
+  StartTarget t;
+  t.position = {1.5, 1.2, 0.0};
+  t.angle = 0.4;
+  std::mt19937_64 rng(99);
+  std::uniform_real_distribution<double> u(-6.0, 6.0);
+  int moved = 0;
+  StartSolveOptions plain;
+  plain.respect_limits = false;
+  for (int i = 0; i < 200; ++i) {
+    VecN q0(5);
+    for (int j = 0; j < 5; ++j) q0[j] = u(rng);
+    const std::optional<VecN> a = solve_start(c, t, q0, plain);
+    const std::optional<VecN> b = solve_start(c, t, q0);
+    ASSERT_EQ(a.has_value(), b.has_value());
+    if (!b) continue;
+    KDL::Frame f;
+    ASSERT_GE(fk.JntToCart(test::kdl_array(*b), f), 0);
+    EXPECT_LT(std::hypot(f.p.x() - 1.5, f.p.y() - 1.2), 1e-12);
+    EXPECT_LT(std::abs(b->sum() - t.angle), 1e-12) << b->transpose();
+    if (!within(c, *a) && within(c, *b)) ++moved;
+  }
+  EXPECT_GT(moved, 10);
+}
+
 // The spring's contribution to qdd lies in the null space of the task Jacobian: with and without
 // it, J qdd = b (the task is unaffected), and it changes qdd.
 TEST(LimitSpring, ActsInTheNullSpaceOnly) {

@@ -268,7 +268,8 @@ int run_info(const InfoArgs& args) {
         if (key && n_best > 0) {
           const RunsColumn* tie = rank.tie.empty() ? nullptr : metric_column(p, b.kind, rank.tie);
           const RankKey c = rank_key(value_at(key, r), tie ? value_at(tie, r) : 0.0, static_cast<std::uint64_t>(id));
-          if (b.best.size() < n_best || c < b.best.back()) {
+          // as the run summary: a good run without a finite objective is never a best one
+          if (std::isfinite(c.objective) && (b.best.size() < n_best || c < b.best.back())) {
             b.best.insert(std::upper_bound(b.best.begin(), b.best.end(), c), c);
             if (b.best.size() > n_best) b.best.pop_back();
           }

@@ -143,34 +143,41 @@ VecN pull_into_limits(const Chain& chain, const StartTarget& target, const VecN&
 
 std::optional<VecN> solve_start(const Chain& chain, const StartTarget& target, const VecN& q0,
                                 const StartSolveOptions& o) {
-  std::optional<VecN> q = place_on_target(chain, target, q0, o);
+  const std::optional<VecN> q = place_on_target(chain, target, q0, o);
   if (!q || !o.respect_limits || within_limits(chain, *q)) return q;
-  // the same pose with revolute joints shifted by 2 pi: never worse than q
-  VecN shifted = *q;
-  shift_into_limits(chain, shifted);
-  if (within_limits(chain, shifted)) {
-    const std::optional<VecN> polished = place_on_target(chain, target, shifted, o);
-    return polished && within_limits(chain, *polished) ? *polished : shifted;
-  }
-  // null-space steps, then the moved joints put back on the target to the start's tolerance
-  const auto pulled_from = [&](const VecN& from) -> std::optional<VecN> {
-    const std::optional<VecN> p = place_on_target(chain, target, pull_into_limits(chain, target, from, o.limit_steps), o);
-    return p && within_limits(chain, *p) ? p : std::nullopt;
+  // Every candidate is put back on the target by place_on_target (which checks the residual) and
+  // kept only within the limits. A 2 pi shift is the same pose in space; for a planar target it is
+  // not (the start's angle row counts turns), so planar starts are only pulled.
+  const auto on_target_within = [&](const VecN& from) -> std::optional<VecN> {
+    std::optional<VecN> c = place_on_target(chain, target, from, o);
+    return c && within_limits(chain, *c) ? c : std::nullopt;
   };
-  if (std::optional<VecN> p = pulled_from(shifted)) return p;
+  const auto moved_from = [&](VecN from) -> std::optional<VecN> {
+    if (!target.planar) {
+      shift_into_limits(chain, from);
+      if (within_limits(chain, from))
+        if (std::optional<VecN> c = on_target_within(from)) return c;
+    }
+    return on_target_within(pull_into_limits(chain, target, from, o.limit_steps));
+  };
+  if (std::optional<VecN> c = moved_from(*q)) return c;
   // again from the middle of the limits (joints without both limits: the guess's value)
   VecN centre = q0;
   for (int j = 0; j < centre.size(); ++j) {
     const ChainJoint& J = chain.joints[static_cast<std::size_t>(j)];
     if (std::isfinite(J.lower) && std::isfinite(J.upper)) centre[j] = 0.5 * (J.lower + J.upper);
   }
-  if (std::optional<VecN> c = place_on_target(chain, target, centre, o)) {
+  if (const std::optional<VecN> c = place_on_target(chain, target, centre, o)) {
     if (within_limits(chain, *c)) return c;
-    shift_into_limits(chain, *c);
-    if (within_limits(chain, *c)) return c;
-    if (std::optional<VecN> p = pulled_from(*c)) return p;
+    if (std::optional<VecN> m = moved_from(*c)) return m;
   }
-  return place_on_target(chain, target, shifted, o).value_or(shifted);
+  // none within the limits: the spatial start as the same pose nearest to them, else the first
+  if (!target.planar) {
+    VecN shifted = *q;
+    shift_into_limits(chain, shifted);
+    if (std::optional<VecN> c = place_on_target(chain, target, shifted, o)) return c;
+  }
+  return q;
 }
 
 VecN planar_start_guess(int n) {

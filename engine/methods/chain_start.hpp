@@ -34,13 +34,14 @@ struct StartSolveOptions {
 /// grows tenfold; after each accepted step it shrinks tenfold (to 0 below 1e-12). Once |e| <= tolerance, up to two more
 /// steps are taken while they reduce |e| (the last bits of a quadratic convergence).
 /// Joint position limits (options.respect_limits): a solution within them is returned as found (so a
-/// chain without limits, or a start already within them, is unaffected). Otherwise each revolute joint
-/// outside them is moved by a multiple of 2 pi into them where one exists (the same pose); if some
-/// joint is still outside, null-space steps dq = J^+ e - (I - J^+ J) v pull every violating joint
+/// chain without limits, or a start already within them, is unaffected). Otherwise, for spatial
+/// targets each revolute joint outside them is first moved by the multiple of 2 pi nearest to their
+/// middle (the same pose); then null-space steps dq = J^+ e - (I - J^+ J) v pull every violating joint
 /// towards 2 % inside its range (v = its violation of that inner range) while the tip stays on the
-/// target; the result is put back on the target by the iteration above. That start is returned when
-/// it lies within the limits; else the same is tried from the middle of the limits as the guess;
-/// else the first solution, shifted (the run then reports its limit ratios).
+/// target (planar targets: these steps only, as their angle row counts turns); each candidate is put
+/// back on the target by the iteration above and kept when within the limits; else the same from the
+/// middle of the limits as the guess; else the first solution (spatial: 2 pi-shifted, on the target),
+/// whose run then reports its limit ratios. Every q returned is on the target to the tolerance.
 /// Output: q, or std::nullopt when |e| > tolerance after max_iterations (out of reach, or a guess
 /// that does not lead there).
 ///

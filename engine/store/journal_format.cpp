@@ -177,9 +177,21 @@ std::string mismatch(const Parsed& p, int fd) {
 bool recover_locked(int fd, int jfd, std::uint64_t dev, std::uint64_t ino, std::string* why) {
   why->clear();
   Parsed p = parse_journal(jfd);
-  if (p.version == 0) {  // empty (a writer stopped before its header): nothing to recover
+  if (p.version == 0) {
+    // Empty, or shorter than a header and either zeros or the start of one (a writer stopped while
+    // writing its header): nothing to recover. Anything else is not a kinesweep journal.
     struct stat js{};
-    if (::fstat(jfd, &js) == 0 && js.st_size == 0) return true;
+    if (::fstat(jfd, &js) != 0) return false;
+    const std::size_t n = static_cast<std::size_t>(js.st_size);
+    if (n == 0) return true;
+    if (n < kHeadSize) {
+      unsigned char b[kHeadSize] = {};
+      if (!read_all(jfd, b, n, 0)) return false;
+      bool zeros = true;
+      for (std::size_t i = 0; i < n; ++i) zeros = zeros && b[i] == 0;
+      const std::size_t m = std::min<std::size_t>(n, 7);  // "KSJRNL0" of either version
+      if (zeros || std::memcmp(b, kHeadMagic, m) == 0) return true;
+    }
     *why = "the journal is not a kinesweep journal (no KSJRNL header)";
     return false;
   }

@@ -123,13 +123,14 @@ int acquire_lock(const std::string& jp, const std::function<bool(int jfd)>& init
       set_error("cannot create journal " + jp, errno);
       return -1;
     }
-    if (::flock(jfd, LOCK_EX | LOCK_NB) != 0 || !still_named(jfd, jp)) {
+    if (!lock_briefly(jfd) || !still_named(jfd, jp)) {  // (a reader's shared lock may be held a moment)
       ::close(jfd);
       set_error(busy, 0);
       return -1;
     }
     if (!init(jfd)) {
       set_error("cannot write journal " + jp, errno);
+      ::unlink(jp.c_str());  // ours, locked, and holding no commit: no partial header left behind
       ::close(jfd);
       return -1;
     }

@@ -177,6 +177,17 @@ class ResumeRefusals(TempDirTest):
         out = self.finished("foreign.h5")
         self.refused(out, b"not a journal at all\n" * 8, "not a kinesweep journal")
 
+    def test_a_journal_cut_within_its_header_holds_nothing(self):
+        # a writer stopped while writing its header: zeros or the start of the magic
+        for i, head in enumerate((b"KSJRN", b"\0" * 20)):
+            out = self.finished(f"cut{i}.h5")
+            ref = runs_table(out)
+            with open(out + ".journal", "wb") as f:
+                f.write(head)
+            r = run("run", self.study, "-o", out, "--resume", "-q")
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertTrue(same_tables(runs_table(out), ref))
+
     def test_an_empty_journal_holds_nothing(self):
         out = self.finished("emptyj.h5")
         ref = runs_table(out)
