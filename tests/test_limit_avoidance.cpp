@@ -38,6 +38,29 @@ Path3 arm7_square(double side) {
   return Path3({a, b, c, d, a}, {side, side, side, side});
 }
 
+/// For 200 guesses uniform in [-r, r] per joint: the start solved without and with the limits (found
+/// both or neither) and, when found, KDL's tip frame of the limit-aware one, given to check.
+template <class Check>
+void for_random_starts(const Chain& c, const StartTarget& t, double r, std::uint64_t seed, Check&& check) {
+  const KDL::Chain k = test::kdl_chain(c);
+  KDL::ChainFkSolverPos_recursive fk(k);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-r, r);
+  StartSolveOptions plain;
+  plain.respect_limits = false;
+  for (int i = 0; i < 200; ++i) {
+    VecN q0(c.dof());
+    for (int j = 0; j < c.dof(); ++j) q0[j] = u(rng);
+    const std::optional<VecN> a = solve_start(c, t, q0, plain);
+    const std::optional<VecN> b = solve_start(c, t, q0);
+    ASSERT_EQ(a.has_value(), b.has_value());
+    if (!b) continue;
+    KDL::Frame f;
+    ASSERT_GE(fk.JntToCart(test::kdl_array(*b), f), 0);
+    check(q0, *a, *b, f);
+  }
+}
+
 }  // namespace
 
 // From random guesses the start solve ends on the target (KDL's forward kinematics, 1e-12 m) and
@@ -46,35 +69,21 @@ Path3 arm7_square(double side) {
 // is returned unchanged (bitwise).
 TEST(LimitAwareStart, StartsOnTheTargetWithinTheLimits) {
   const Chain c = arm7();
-  const KDL::Chain k = test::kdl_chain(c);
-  KDL::ChainFkSolverPos_recursive fk(k);
   StartTarget t;
   t.planar = false;
   t.position = {0.5, -0.1, 0.4};
-  std::mt19937_64 rng(20261203);
-  std::uniform_real_distribution<double> u(-3.0, 3.0);
-  StartSolveOptions plain;
-  plain.respect_limits = false;
   int outside_plain = 0, found = 0, unchanged = 0;
-  for (int i = 0; i < 200; ++i) {
-    VecN q0(7);
-    for (int j = 0; j < 7; ++j) q0[j] = u(rng);
-    const std::optional<VecN> a = solve_start(c, t, q0, plain);
-    const std::optional<VecN> b = solve_start(c, t, q0);
-    ASSERT_EQ(a.has_value(), b.has_value());
-    if (!b) continue;
-    KDL::Frame f;
-    ASSERT_GE(fk.JntToCart(test::kdl_array(*b), f), 0);
+  for_random_starts(c, t, 3.0, 20261203, [&](const VecN& q0, const VecN& a, const VecN& b, const KDL::Frame& f) {
     EXPECT_LT((Eigen::Vector3d(f.p.x(), f.p.y(), f.p.z()) - t.position).norm(), 1e-12);
     ++found;
-    if (within(c, *a)) {
-      EXPECT_EQ(*a, *b);
+    if (within(c, a)) {
+      EXPECT_EQ(a, b);
       ++unchanged;
     } else {
       ++outside_plain;
     }
-    EXPECT_TRUE(within(c, *b)) << b->transpose() << " | plain " << a->transpose() << " | q0 " << q0.transpose();
-  }
+    EXPECT_TRUE(within(c, b)) << b.transpose() << " | plain " << a.transpose() << " | q0 " << q0.transpose();
+  });
   EXPECT_GT(found, 150);
   EXPECT_GT(outside_plain, 50);  // the limits matter from these guesses
   EXPECT_GT(unchanged, 5);
@@ -88,29 +97,15 @@ TEST(LimitAwareStart, PlanarStartsStayOnTheTargetAngle) {
   Chain c = planar_chain(planar_bars({1.0, 0.5, 0.5, 0.5, 0.5}, {5, 1, 1, 0.5, 0.5}, 0.1));
   for (ChainJoint& j : c.joints) j.lower = -2.0, j.upper = 2.0;
   c.prepare();
-  const KDL::Chain k = test::kdl_chain(c);
-  KDL::ChainFkSolverPos_recursive fk(k);
   StartTarget t;
   t.position = {1.5, 1.2, 0.0};
   t.angle = 0.4;
-  std::mt19937_64 rng(99);
-  std::uniform_real_distribution<double> u(-6.0, 6.0);
   int moved = 0;
-  StartSolveOptions plain;
-  plain.respect_limits = false;
-  for (int i = 0; i < 200; ++i) {
-    VecN q0(5);
-    for (int j = 0; j < 5; ++j) q0[j] = u(rng);
-    const std::optional<VecN> a = solve_start(c, t, q0, plain);
-    const std::optional<VecN> b = solve_start(c, t, q0);
-    ASSERT_EQ(a.has_value(), b.has_value());
-    if (!b) continue;
-    KDL::Frame f;
-    ASSERT_GE(fk.JntToCart(test::kdl_array(*b), f), 0);
+  for_random_starts(c, t, 6.0, 99, [&](const VecN&, const VecN& a, const VecN& b, const KDL::Frame& f) {
     EXPECT_LT(std::hypot(f.p.x() - 1.5, f.p.y() - 1.2), 1e-12);
-    EXPECT_LT(std::abs(b->sum() - t.angle), 1e-12) << b->transpose();
-    if (!within(c, *a) && within(c, *b)) ++moved;
-  }
+    EXPECT_LT(std::abs(b.sum() - t.angle), 1e-12) << b.transpose();
+    if (!within(c, a) && within(c, b)) ++moved;
+  });
   EXPECT_GT(moved, 10);
 }
 
