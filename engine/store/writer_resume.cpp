@@ -1,5 +1,6 @@
 // ResultsWriter::open_for_resume (see store.hpp, FORMAT.md "Creation, overwrite, resume").
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -51,6 +52,7 @@ void check_format_read_only(const std::string& path) {
   if (!f.ok()) {
     H5Eclear2(H5E_DEFAULT);
     if (::stat(journal_path(path).c_str(), &st) == 0) return;
+    if (::access(path.c_str(), R_OK | W_OK) != 0) throw StoreError(path, std::string("cannot resume: ") + std::strerror(errno));
     struct stat fs{};
     const long long bytes = ::stat(path.c_str(), &fs) == 0 ? static_cast<long long>(fs.st_size) : -1;
     throw StoreError(path, "not a kinesweep results file (not an HDF5 file" +
