@@ -58,16 +58,11 @@ std::vector<std::string> find_shards(const std::string& output) {
   return out;
 }
 
-void remove_results_file(const std::string& path) {
-  std::error_code ec;
-  fs::remove(path, ec);
-  fs::remove(path + ".journal", ec);
-}
-
 /// Rank 0 after the sweep: final file (or a new one) + every shard -> the final file, in run-id
 /// order; then landscapes via run_sweep (which computes nothing, every run being done); then the
 /// shards are deleted. Returns the report and the final file, still open.
-SweepResult merge(const Study& study, const StudySchema& schema, const RunRequest& run, int threads) {
+SweepResult merge(const Study& study, const StudySchema& schema, const RunRequest& run, const HistoryPolicy& histories,
+                  int threads) {
   const std::string& out = run.output;
   const std::uint64_t total = study.run_count();
   // Commits are the store's main cost (each journals every dirty page of /runs); the merge can be
@@ -75,7 +70,7 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
   store::StoreOptions so;
   so.flush_every_runs = 0;
   so.flush_every_seconds = 30.0;
-  OpenedResults opened = open_results(study, schema, out, true, so, run.options.histories, false);
+  OpenedResults opened = open_results(study, schema, out, true, so, histories, false);
   std::unique_ptr<store::ResultsWriter> writer = std::move(opened.writer);
   PreviousRuns all;
   if (opened.previous) all = std::move(*opened.previous);
@@ -132,12 +127,12 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
 
   SweepOptions o;
   o.threads = threads;
-  o.histories = run.options.histories;
+  o.histories = histories;
   o.compression = level;
   SweepResult res;
   res.report = run_sweep(study, schema, *writer, o, &all);
   writer->flush();
-  for (const auto& s : shards) remove_results_file(s);
+  for (const auto& s : shards) store::remove_results_file(s);
   res.writer = std::move(writer);
   return res;
 }
@@ -182,11 +177,12 @@ class MpiBackend final : public SweepBackend {
     // 1. Rank 0 checks the files and collects the done set; everybody learns it.
     const std::uint64_t total = study.run_count();
     int code = 0;
-    done_.assign(total, 0);
+    done_.assign(total, false);
+    histories_ = r.options.histories;
     if (rank_ == 0) {
       std::string msg;
       try {
-        code = prepare(study, r, msg);
+        code = prepare(study, schema, r, msg);
       } catch (const std::exception& e) {  // every rank must reach the Bcast
         code = 1, msg = e.what();
       }
@@ -194,7 +190,10 @@ class MpiBackend final : public SweepBackend {
     }
     MPI_Bcast(&code, 1, MPI_INT, 0, comm_);
     if (code) return code;
-    bcast_bytes(done_, comm_);
+    bcast_bits(done_, comm_);
+    std::string policy = histories_.str();
+    bcast_string(policy, comm_);
+    HistoryPolicy::parse(policy, histories_);
     // 2. Every rank opens its shard (reopens it when resuming). Shards commit every 512 runs or 2 s:
     // commits are the writer's main cost, and a killed rank loses at most that much.
     int local = 0;
@@ -205,9 +204,9 @@ class MpiBackend final : public SweepBackend {
       const std::string sp = shard_path(r.output, rank_);
       if (fs::exists(sp)) {
         shard_ = std::move(store::ResultsWriter::open_for_resume(sp, study.sha256, so).writer);
-        require_recorded_histories(*shard_, sp, r.options.histories);
+        resume_histories(sp, shard_->recorded_histories(), histories_, false);
       } else {
-        shard_ = store::ResultsWriter::create(sp, store_meta(study, r.options.histories), schema.columns,
+        shard_ = store::ResultsWriter::create(sp, store_meta(study, histories_), schema.columns,
                                               static_cast<std::int64_t>(total), so);
       }
     } catch (const std::exception& e) {  // every rank must reach the Allreduce
@@ -246,8 +245,9 @@ class MpiBackend final : public SweepBackend {
     return allowed < cores ? allowed : std::max(1, cores / node_ranks);
   }
 
-  /// Rank 0 before the sweep: check what exists, apply --overwrite, collect the done set of --resume.
-  int prepare(const Study& study, const RunRequest& run, std::string& msg) {
+  /// Rank 0 before the sweep: check what exists, apply --overwrite, collect the done set of --resume
+  /// and the history policy the files record (every file must record the same one).
+  int prepare(const Study& study, const StudySchema& schema, const RunRequest& run, std::string& msg) {
     const std::string& out = run.output;
     const bool exists = fs::exists(out);
     const std::vector<std::string> shards = find_shards(out);
@@ -256,8 +256,8 @@ class MpiBackend final : public SweepBackend {
       msg = refuse_existing(out, true, "has shards of an unfinished distributed run (" + shards.front() + ")", run);
     if (!msg.empty()) return 1;
     if (run.overwrite) {
-      if (exists) remove_results_file(out);
-      for (const auto& s : shards) remove_results_file(s);
+      if (exists) store::remove_results_file(out);
+      for (const auto& s : shards) store::remove_results_file(s);
     } else if (run.resume) {
       std::vector<std::string> files = shards;
       if (exists) files.insert(files.begin(), out);
@@ -268,11 +268,14 @@ class MpiBackend final : public SweepBackend {
           msg = f + " holds another study (study_sha256 " + rd.meta().study_sha256 + ", this study " + study.sha256 + ")";
           return 1;
         }
+        histories_ = resume_histories(f, rd.meta().histories, histories_, !run.histories_given && f == files.front());
         const auto mask = rd.done_mask();
-        for (std::size_t i = 0; i < done_.size() && i < mask.size(); ++i) done_[i] |= mask[i];
+        for (std::size_t i = 0; i < done_.size() && i < mask.size(); ++i)
+          if (mask[i]) done_[i] = true;
       }
     }
     if (!fs::path(out).parent_path().empty()) fs::create_directories(fs::path(out).parent_path());
+    if (!run.resume || (!exists && shards.empty())) check_free_space(out, schema, done_.size(), size_ + 1);
     return 0;
   }
 
@@ -280,7 +283,8 @@ class MpiBackend final : public SweepBackend {
   int rank_ = 0, size_ = 1, threads_ = 1;
   bool serialized_ = false;
   Clock::time_point start_;
-  std::vector<std::uint8_t> done_;
+  std::vector<bool> done_;  // one bit per run: done in the results file or a shard
+  HistoryPolicy histories_;  // the policy of the files resumed, else the request's
   std::unique_ptr<store::ResultsWriter> shard_;
 };
 
@@ -288,13 +292,10 @@ SweepResult MpiBackend::sweep(const Study& study, const StudySchema& schema, con
                               std::ostream& err) {
   // 3. The sweep: rank 0 coordinates (a thread) and computes; the others compute what it hands out.
   const std::uint64_t total = study.run_count();
-  std::vector<std::uint64_t> todo;
-  for (std::uint64_t id = 0; id < total; ++id)
-    if (!done_[id]) todo.push_back(id);
-  const std::uint64_t todo_n = todo.size();
-  std::vector<std::uint8_t>().swap(done_);
+  const auto todo_n = static_cast<std::uint64_t>(std::count(done_.begin(), done_.end(), false));
   SweepOptions o = r.options;
   o.threads = threads_;
+  o.histories = histories_;
   // shards compress as the results file does: the merge copies their chunks without decoding them
   o.source_runs = todo_n;
   std::unique_ptr<WorkPool> pool;
@@ -302,7 +303,7 @@ SweepResult MpiBackend::sweep(const Study& study, const StudySchema& schema, con
   std::vector<std::atomic<std::uint64_t>> remote_done(size_);
   std::thread coordinator;
   if (rank_ == 0) {
-    pool = std::make_unique<WorkPool>(std::move(todo), size_);
+    pool = std::make_unique<WorkPool>(std::move(done_), size_);
     o.source = [&](std::vector<std::uint64_t>& ids, std::size_t max) {
       ids = pool->take(max);
       return !ids.empty();
@@ -314,6 +315,7 @@ SweepResult MpiBackend::sweep(const Study& study, const StudySchema& schema, con
     };
     if (size_ > 1) coordinator = std::thread([&] { coordinate(comm_, size_, o.batch, *pool, remote_done, o.stop); });
   } else {
+    std::vector<bool>().swap(done_);
     remote = std::make_unique<RemoteSource>(comm_, threads_, o.batch);
     o.source = [&](std::vector<std::uint64_t>& ids, std::size_t max) { return remote->next(ids, max); };
     o.on_progress = [&](const SweepProgress& p) { remote->written.store(p.done); };
@@ -353,7 +355,7 @@ SweepResult MpiBackend::sweep(const Study& study, const StudySchema& schema, con
   // 4. Rank 0 merges (the others wait in finish()).
   const auto t0 = Clock::now();
   try {
-    res = merge(study, schema, r, threads_);
+    res = merge(study, schema, r, histories_, threads_);
   } catch (const store::StoreError& e) {
     throw store::StoreError(r.output, std::string(e.what()) + " (the shards are kept: run again with --resume)");
   }

@@ -24,6 +24,26 @@ void bcast_bytes(std::vector<std::uint8_t>& v, MPI_Comm comm) {
     MPI_Bcast(v.data() + at, static_cast<int>(std::min(slice, v.size() - at)), MPI_UINT8_T, 0, comm);
 }
 
+void bcast_bits(std::vector<bool>& v, MPI_Comm comm) {
+  std::uint64_t n = v.size();
+  MPI_Bcast(&n, 1, MPI_UINT64_T, 0, comm);
+  std::vector<std::uint8_t> packed((n + 7) / 8, 0);
+  for (std::uint64_t i = 0; i < v.size(); ++i)
+    if (v[i]) packed[i / 8] |= static_cast<std::uint8_t>(1u << (i % 8));
+  bcast_bytes(packed, comm);
+  v.assign(n, false);
+  for (std::uint64_t i = 0; i < n; ++i) v[i] = (packed[i / 8] >> (i % 8)) & 1u;
+}
+
+void bcast_string(std::string& s, MPI_Comm comm) {
+  std::uint64_t n = s.size();
+  MPI_Bcast(&n, 1, MPI_UINT64_T, 0, comm);
+  std::vector<std::uint8_t> bytes(s.begin(), s.end());
+  bytes.resize(n);
+  bcast_bytes(bytes, comm);
+  s.assign(bytes.begin(), bytes.end());
+}
+
 /// Rank 0's coordinator thread: answers chunk requests until every other rank has retired (got an
 /// empty chunk or said it quits). Request: {quit, runs written so far, threads}.
 void coordinate(MPI_Comm comm, int size, std::size_t batch, WorkPool& pool, std::vector<std::atomic<std::uint64_t>>& remote_done,

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <deque>
 #include <mutex>
+#include <string>
 #include <vector>
 
 namespace ks::mpi {
@@ -23,20 +24,30 @@ inline constexpr std::uint64_t kMaxChunk = 1024;  ///< largest chunk of run ids 
 void wait_gently(MPI_Request& request, MPI_Status* status);
 /// MPI_Bcast of a byte vector of any size (in slices of 1 GiB) from rank 0.
 void bcast_bytes(std::vector<std::uint8_t>& v, MPI_Comm comm);
+/// MPI_Bcast from rank 0 of a bit vector (its size included), packed 8 bits per byte.
+void bcast_bits(std::vector<bool>& v, MPI_Comm comm);
+/// MPI_Bcast from rank 0 of a string (its size included).
+void bcast_string(std::string& s, MPI_Comm comm);
 
-/// The run ids still to do, handed out in ascending order (rank 0).
+/// The run ids not done yet, handed out in ascending order (rank 0). Holds one bit per run.
 class WorkPool {
  public:
-  WorkPool(std::vector<std::uint64_t> todo, int ranks) : todo_(std::move(todo)), ranks_(ranks) {}
+  WorkPool(std::vector<bool> done, int ranks) : done_(std::move(done)), ranks_(ranks) {
+    for (bool d : done_) remaining_ += d ? 0 : 1;
+  }
+  /// The number of ids not handed out yet.
+  std::uint64_t remaining() const { return remaining_; }
   /// Up to `max` ids for rank 0's own pipeline.
-  std::vector<std::uint64_t> take(std::size_t max) { return slice(max); }
+  std::vector<std::uint64_t> take(std::size_t max) {
+    std::lock_guard<std::mutex> lock(m_);
+    return slice_locked(max);
+  }
   /// A chunk for a remote rank with `threads` threads: guided (remaining / 4 ranks), at least two
   /// rounds of its pipeline, at most kMaxChunk.
   std::vector<std::uint64_t> take_chunk(std::uint64_t threads, std::size_t batch) {
     std::lock_guard<std::mutex> lock(m_);
-    const std::uint64_t remaining = todo_.size() - next_;
     const std::uint64_t lo = std::max<std::uint64_t>(1, 2 * threads * batch);
-    const std::uint64_t n = std::min(kMaxChunk, std::max(lo, remaining / (4 * static_cast<std::uint64_t>(ranks_))));
+    const std::uint64_t n = std::min(kMaxChunk, std::max(lo, remaining_ / (4 * static_cast<std::uint64_t>(ranks_))));
     return slice_locked(n);
   }
   void halt() {
@@ -45,20 +56,19 @@ class WorkPool {
   }
 
  private:
-  std::vector<std::uint64_t> slice(std::size_t n) {
-    std::lock_guard<std::mutex> lock(m_);
-    return slice_locked(n);
-  }
   std::vector<std::uint64_t> slice_locked(std::size_t n) {
-    if (halted_) return {};
-    n = std::min<std::size_t>(n, todo_.size() - next_);
-    std::vector<std::uint64_t> ids(todo_.begin() + next_, todo_.begin() + next_ + n);
-    next_ += n;
+    std::vector<std::uint64_t> ids;
+    if (halted_) return ids;
+    n = static_cast<std::size_t>(std::min<std::uint64_t>(n, remaining_));
+    ids.reserve(n);
+    for (; ids.size() < n; ++next_)
+      if (!done_[next_]) ids.push_back(next_);
+    remaining_ -= n;
     return ids;
   }
   std::mutex m_;
-  std::vector<std::uint64_t> todo_;
-  std::size_t next_ = 0;
+  std::vector<bool> done_;
+  std::uint64_t next_ = 0, remaining_ = 0;
   int ranks_;
   bool halted_ = false;
 };

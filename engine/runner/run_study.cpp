@@ -40,19 +40,23 @@ std::uint64_t skeleton_bytes(const StudySchema& schema, std::uint64_t runs) {
   return runs * row + (1u << 20);
 }
 
-/// Refuses (StoreError) a new file whose skeleton would not fit in its directory's free space.
-void check_free_space(const std::string& out, const StudySchema& schema, std::uint64_t runs) {
+}  // namespace
+
+void check_free_space(const std::string& out, const StudySchema& schema, std::uint64_t runs, int files) {
   const fs::path dir = fs::path(out).parent_path().empty() ? fs::path(".") : fs::path(out).parent_path();
   std::error_code ec;
   const fs::space_info sp = fs::space(dir, ec);
   if (ec) return;  // unknown: the writer reports a full disk as it happens
-  const std::uint64_t need = skeleton_bytes(schema, runs);
+  const std::uint64_t need = skeleton_bytes(schema, runs) * static_cast<std::uint64_t>(files);
   if (need > sp.available)
-    throw store::StoreError(out, "the file needs " + std::to_string(need) + " bytes for its " + std::to_string(runs) +
-                                     " run rows before any run, but " + dir.string() + " has " +
+    throw store::StoreError(out, (files == 1 ? "the file needs " : "the file and its shards need ") +
+                                     std::to_string(need) + " bytes for their " + std::to_string(runs) +
+                                     " run rows each before any run, but " + dir.string() + " has " +
                                      std::to_string(sp.available) + " bytes free; expected more free space "
                                      "(or fewer runs)");
 }
+
+namespace {
 /// Refuses (StoreError) to resume a file whose /runs columns are not the study's (the same study
 /// text under a kinesweep whose tables differ): its rows could not be read as this schema's.
 void require_same_columns(const std::string& out, const std::vector<ColumnSpec>& file, const StudySchema& schema) {
@@ -67,13 +71,15 @@ void require_same_columns(const std::string& out, const std::vector<ColumnSpec>&
 }
 }  // namespace
 
-void require_recorded_histories(const store::ResultsWriter& writer, const std::string& path,
-                                const HistoryPolicy& histories) {
-  const std::string was = writer.recorded_histories();
-  if (!was.empty() && was != histories.str())
-    throw store::StoreError(path, "its runs were written with histories = " + was + ", this run asks for " +
-                                      histories.str() + " ([study] histories or --histories): resume with --histories " +
-                                      was + " (refusing to resume: rerun with --overwrite to replace the file)");
+HistoryPolicy resume_histories(const std::string& path, const std::string& recorded, const HistoryPolicy& asked,
+                               bool adopt) {
+  HistoryPolicy p = asked;
+  if (adopt && HistoryPolicy::parse(recorded, p)) return p;
+  if (!recorded.empty() && recorded != asked.str())
+    throw store::StoreError(path, "its runs were written with histories = " + recorded + ", this run asks for " +
+                                      asked.str() + " ([study] histories or --histories): resume with --histories " +
+                                      recorded + " (refusing to resume: rerun with --overwrite to replace the file)");
+  return asked;
 }
 
 std::string histories_argument(const RunRequest& request) {
@@ -86,14 +92,13 @@ OpenedResults open_results(const Study& study, const StudySchema& schema, const 
   r.histories = histories;
   if (resume && fs::exists(out)) {
     r.writer = std::move(store::ResultsWriter::open_for_resume(out, study.sha256, so).writer);
-    if (!adopt_recorded || !HistoryPolicy::parse(r.writer->recorded_histories(), r.histories))
-      require_recorded_histories(*r.writer, out, histories);
+    r.histories = resume_histories(out, r.writer->recorded_histories(), histories, adopt_recorded);
     require_same_columns(out, r.writer->columns(), schema);
     r.previous = previous_runs(*r.writer);
     return r;
   }
   if (!fs::path(out).parent_path().empty()) fs::create_directories(fs::path(out).parent_path());
-  check_free_space(out, schema, study.run_count());
+  check_free_space(out, schema, study.run_count(), 1);
   r.writer = store::ResultsWriter::create(out, store_meta(study, histories), schema.columns,
                                          static_cast<std::int64_t>(study.run_count()), so);
   return r;

@@ -31,9 +31,11 @@ int run_study(const Study& study, const RunRequest& request, std::ostream& out, 
 /// The StoreMeta of a study's results file (or shard) whose runs are written with `histories`.
 store::StoreMeta store_meta(const Study& study, const HistoryPolicy& histories);
 
-/// Throws store::StoreError when the results file `path` open in `writer` records another history
-/// policy than `histories` (a resume must not mix two in one file; files that record none pass).
-void require_recorded_histories(const store::ResultsWriter& writer, const std::string& path,
-                                const HistoryPolicy& histories);
+/// The history policy a resume of the file `path`, which records `recorded` ("" in files from
+/// before it was recorded), writes its runs with: the recorded one when `adopt` (no --histories
+/// given) and it parses, else `asked`, which must then equal the recorded one (a file never mixes
+/// two policies). Throws store::StoreError naming both policies and the option that resumes.
+HistoryPolicy resume_histories(const std::string& path, const std::string& recorded, const HistoryPolicy& asked,
+                               bool adopt);
 
 }  // namespace ks

@@ -68,6 +68,10 @@ OpenedResults open_results(const Study& study, const StudySchema& schema, const 
                            const store::StoreOptions& options, const HistoryPolicy& histories,
                            bool adopt_recorded);
 
+/// Throws store::StoreError when `files` new results files (a file and its shards) of `runs` rows
+/// would not fit, before any run, in the free space of `out`'s directory.
+void check_free_space(const std::string& out, const StudySchema& schema, std::uint64_t runs, int files);
+
 /// " --histories X" when the request gave --histories X (so a printed resume command repeats it).
 std::string histories_argument(const RunRequest& request);
 

@@ -180,6 +180,88 @@ class KillOneRank(Base):
         self.assertEqual(glob.glob(out + ".rank*"), [])
 
 
+def wait_for_done_runs(test, proc, path):
+    """Wait until the results file or shard `path` shows committed runs (a read that meets a
+    commit under way raises and is retried)."""
+    deadline = time.time() + 120
+    while time.time() < deadline and proc.poll() is None:
+        try:
+            with h5py.File(path, "r") as f:
+                if int(f["runs"]["done"][()].sum()) > 0:
+                    return
+        except (OSError, KeyError):
+            pass
+        time.sleep(0.1)
+    test.fail(f"{path} showed no done run before the job ended: make LONG longer")
+
+
+class ResumeAdoptsRecordedHistories(Base):
+    """`mpirun ... --resume` without --histories writes the rest of the runs with the history policy
+    the file (or its shards) records, as the same command without mpirun does. The files are begun
+    with --histories every=3, not the study's every=5."""
+
+    def setUp(self):
+        super().setUp()
+        self.study = self.write("long.toml", LONG)
+        self.ref = os.path.join(self.dir, "ref.h5")
+        t0 = time.time()
+        r = run("run", self.study, "-o", self.ref, "-q", "--histories", "every=3", "--threads", "1")
+        self.ref_seconds = time.time() - t0
+        self.assertEqual(r.returncode, 0, r.stderr)
+
+    def resume_and_compare(self, out):
+        r = mpirun("run", self.study, "-o", out, "-q", "--threads", "1", "--resume")
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        m = re.search(r"(\d+) computed now, (\d+) already in the file", r.stdout)
+        self.assertIsNotNone(m, r.stdout)
+        self.assertGreater(int(m.group(1)), 0)
+        self.assertGreater(int(m.group(2)), 0)
+        with h5py.File(out, "r") as f:
+            self.assertEqual(f.attrs["histories"], "every=3")
+        self.assertSameFile(self.ref, out)
+        self.assertEqual(glob.glob(out + ".rank*"), [])
+
+    def test_a_file_begun_by_one_process(self):
+        out = os.path.join(self.dir, "local.h5")
+        p = subprocess.Popen([KS, "run", self.study, "-o", out, "-q", "--threads", "1", "--histories", "every=3"],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        time.sleep(self.ref_seconds / 2)  # the writer holds the file: interrupt about half way
+        p.send_signal(signal.SIGINT)
+        stdout, stderr = p.communicate(timeout=120)
+        self.assertEqual(p.returncode, 130, stdout + stderr)
+        self.assertIn("--histories every=3", stdout)  # the printed resume command repeats the option
+        self.resume_and_compare(out)
+
+    def test_shards_begun_by_mpirun(self):
+        out = os.path.join(self.dir, "mpi.h5")
+        p = subprocess.Popen([*MPIRUN, KS, "run", self.study, "-o", out, "-q", "--threads", "1", "--histories",
+                              "every=3"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        wait_for_done_runs(self, p, out + ".rank1.h5")
+        for rank in (0, 1):
+            pid = rank_pid(p.pid, rank)
+            if pid:
+                os.kill(pid, signal.SIGTERM)
+        p.wait(timeout=120)
+        self.assertEqual(p.returncode, 130)
+        self.assertFalse(os.path.exists(out))
+        self.assertEqual(len(glob.glob(out + ".rank*.h5")), 2)
+        self.resume_and_compare(out)
+
+
+class FreeSpace(Base):
+    def test_a_file_and_shards_larger_than_the_free_space_are_not_started(self):
+        from test_cli_guards import Tmpfs
+        study = self.write("big.toml", "[[block]]\nname = \"b\"\nkind = \"ik\"\n[block.axes]\n"
+                                       "q0_1 = { from = 0, to = 1, count = 2000 }\nq0_2 = { from = 0, to = 1, count = 1000 }\n")
+        with Tmpfs(self, "1m") as mnt:
+            out = os.path.join(mnt, "big.h5")
+            r = mpirun("run", study, "-o", out, "-q")
+            self.assertEqual(r.returncode, 1, r.stderr)
+            self.assertIn("the file and its shards need", r.stderr)
+            self.assertIn("bytes free; expected more free space", r.stderr)
+            self.assertEqual(os.listdir(mnt), [])
+
+
 class SignalBeforeTheSweep(Base):
     def test_sigterm_to_the_ranks_before_the_sweep_exits_130_with_nothing_written(self):
         study = self.write("s.toml", SWEEP)
