@@ -140,3 +140,23 @@ TEST(StudyGuards, ADirectoryIsNotAStudy) {
   }
   std::filesystem::remove_all(dir);
 }
+
+// ---- what an [[optimize]] block may minimise: every numeric metric of its robot ----
+TEST(StudyGuards, AnObjectiveMayBeAnyMetricOfTheRobot) {
+  const std::string robot = "[robot]\nl = [1.0, 1.0, 0.5, 0.5]\nm = [5.0, 2.0, 0.5, 0.5]\nb = 0.1\n";  // lines 1-4
+  auto opt = [&](const std::string& objective) {
+    return robot + "[[optimize]]\nname = \"o\"\nobjective = " + objective +
+           "\nvariables = { k = [0, 1] }\nlocal = { algorithm = \"LN_BOBYQA\", max_evals = 5 }\n";
+  };
+  // the fourth joint's peak torque of a 4R arm, and a weighted sum with a tracking metric
+  const Study s = parse_study(opt("\"tau4_inf\""));
+  ASSERT_EQ(s.optimizations.size(), 1u);
+  EXPECT_EQ(s.optimizations[0].objective_text, "tau4_inf");
+  EXPECT_EQ(parse_study(opt("{ tau4_inf = 1, max_tracking_error = 100 }")).optimizations[0].objective.size(), 2u);
+  // a fifth joint it does not have: refused, naming the metrics it has
+  expect_error_at(opt("\"tau5_inf\""), 7, 13, "unknown objective 'tau5_inf' for trajectory runs");
+  expect_error_at(opt("\"tau5_inf\""), 7, 13, "tau4_inf");
+  // text metrics (the status) are not objectives; failure_rate is
+  expect_error_at(opt("\"status\""), 7, 13, "unknown objective 'status'");
+  EXPECT_EQ(parse_study(opt("\"failure_rate\"")).optimizations[0].objective_text, "failure_rate");
+}

@@ -119,6 +119,10 @@ int dry_run(const Study& study, const StudySchema& schema, const DryRunOptions& 
   out << "output " << opt.output << (fs::exists(opt.output) ? " (exists: --resume completes it, --overwrite replaces it)" : "")
       << '\n';
   const HistoryPolicy& h = opt.histories;
+  if (const std::string why = history_memory_problem(study, h); !why.empty()) {
+    err << "kinesweep run: " << why << '\n';
+    return 1;
+  }
   const int stride = h.mode == HistoryPolicy::Mode::none ? 0 : h.stride;
   const Scenario scenario = Scenario::of(study);
   RunWorkspace ws;

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cassert>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -15,6 +16,7 @@
 #include "methods/chain_trajectory.hpp"
 #include "methods/trajectory.hpp"
 #include "methods/trajectory_lanes.hpp"
+#include "schema/history_arrays.hpp"
 
 namespace ks {
 
@@ -22,12 +24,53 @@ namespace {
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 
-/// A row-major rows x cols history array from the first `rows` columns of a cols x N matrix
-/// (column-major storage: the same bytes).
-template <class M>
-HistoryArray array_of(std::string name, std::string unit, const M& m, Eigen::Index rows) {
-  HistoryArray a{std::move(name), std::move(unit), static_cast<std::size_t>(rows), static_cast<std::size_t>(m.rows()), {}};
-  a.data.assign(m.data(), m.data() + rows * m.rows());
+/// The history arrays `defs` declares, from a run's buffers (TrajectoryHistory or ChainHistory:
+/// column-major cols x N matrices, so their first `size` columns are the row-major array's bytes),
+/// in the declared order t, q, qd, qdd, tau, x, alpha.
+template <class H>
+std::vector<HistoryArray> trajectory_arrays(const std::vector<HistoryArrayDef>& defs, const H& h) {
+  const double* src[] = {h.t.data(), h.q.data(), h.qd.data(), h.qdd.data(), h.tau.data(), h.x.data(), h.alpha.data()};
+  const Eigen::Index rows[] = {1, h.q.rows(), h.qd.rows(), h.qdd.rows(), h.tau.rows(), h.x.rows(), 1};
+  std::vector<HistoryArray> out;
+  out.reserve(defs.size());
+  const auto n = static_cast<std::size_t>(h.size);
+  for (std::size_t i = 0; i < defs.size(); ++i) {
+    assert(static_cast<std::size_t>(rows[i]) == defs[i].columns);
+    out.push_back({defs[i].name, defs[i].unit, n, defs[i].columns,
+                   std::vector<double>(src[i], src[i] + n * static_cast<std::size_t>(rows[i]))});
+  }
+  return out;
+}
+
+/// The shape of a chain robot, as the tables see it.
+RobotShape shape_of(const Chain& chain) {
+  RobotShape r;
+  r.joints = chain.dof();
+  for (const ChainJoint& j : chain.joints) r.prismatic.push_back(j.type == JointType::prismatic);
+  r.chain = true;
+  r.planar = chain.planar();
+  return r;
+}
+
+/// The history arrays of an IK run, `defs` declaring k, q, F, norm_F, step, lambda: every
+/// stride-th iterate of `h` and the last.
+template <class Hist>
+std::vector<HistoryArray> ik_arrays(const std::vector<HistoryArrayDef>& defs, const Hist& h, int stride) {
+  const std::size_t n = h.size();
+  std::vector<std::size_t> rows;
+  for (std::size_t k = 0; k < n; k += static_cast<std::size_t>(stride)) rows.push_back(k);
+  if (rows.back() != n - 1) rows.push_back(n - 1);
+  std::vector<HistoryArray> a;
+  for (const HistoryArrayDef& d : defs) a.push_back({d.name, d.unit, rows.size(), d.columns, {}});
+  for (auto& x : a) x.data.reserve(rows.size() * x.cols);
+  for (std::size_t r : rows) {
+    a[0].data.push_back(static_cast<double>(r));
+    for (std::size_t j = 0; j < a[1].cols; ++j) a[1].data.push_back(h.q[r][j]);
+    for (std::size_t j = 0; j < a[2].cols; ++j) a[2].data.push_back(h.F[r][j]);
+    a[3].data.push_back(h.error[r]);
+    a[4].data.push_back(h.step[r]);
+    a[5].data.push_back(h.lambda[r]);
+  }
   return a;
 }
 }  // namespace
@@ -113,32 +156,7 @@ RunOutcome run_chain_trajectory(const Scenario& sc, const TrajectoryRun& run, in
   }
   RunOutcome out;
   out.result = simulate(chain, task, start_guess(chain, run.q0), o, h);
-  if (h && h->size > 0) {
-    const Eigen::Index n = h->size;
-    auto& a = out.history.arrays;
-    std::string q_unit, v_unit, a_unit, f_unit;
-    for (const ChainJoint& j : chain.joints) {
-      const bool p = j.type == JointType::prismatic;
-      const char* sep = q_unit.empty() ? "" : ", ";
-      q_unit += sep + std::string(p ? "m" : "rad");
-      v_unit += sep + std::string(p ? "m/s" : "rad/s");
-      a_unit += sep + std::string(p ? "m/s^2" : "rad/s^2");
-      f_unit += sep + std::string(p ? "N" : "Nm");
-    }
-    bool uniform = true;
-    for (const ChainJoint& j : chain.joints) uniform = uniform && j.type == chain.joints.front().type;
-    if (uniform) {  // one unit for every component
-      const bool p = chain.joints.front().type == JointType::prismatic;
-      q_unit = p ? "m" : "rad", v_unit = p ? "m/s" : "rad/s", a_unit = p ? "m/s^2" : "rad/s^2", f_unit = p ? "N" : "Nm";
-    }
-    a.push_back({"t", "s", static_cast<std::size_t>(n), 1, std::vector<double>(h->t.data(), h->t.data() + n)});
-    a.push_back(array_of("q", q_unit, h->q, n));
-    a.push_back(array_of("qd", v_unit, h->qd, n));
-    a.push_back(array_of("qdd", a_unit, h->qdd, n));
-    a.push_back(array_of("tau", f_unit, h->tau, n));
-    a.push_back(array_of("x", "m", h->x, n));
-    a.push_back({"alpha", "rad", static_cast<std::size_t>(n), 1, std::vector<double>(h->alpha.data(), h->alpha.data() + n)});
-  }
+  if (h && h->size > 0) out.history.arrays = trajectory_arrays(trajectory_history_arrays(shape_of(chain)), *h);
   return out;
 }
 
@@ -146,17 +164,7 @@ RunOutcome run_chain_trajectory(const Scenario& sc, const TrajectoryRun& run, in
 RunOutcome trajectory_outcome(const TrajectoryMetrics& metrics, const TrajectoryHistory* h) {
   RunOutcome out;
   out.result = metrics;
-  if (h && h->size > 0) {
-    const Eigen::Index n = h->size;
-    auto& a = out.history.arrays;
-    a.push_back({"t", "s", static_cast<std::size_t>(n), 1, std::vector<double>(h->t.data(), h->t.data() + n)});
-    a.push_back(array_of("q", "rad", h->q, n));
-    a.push_back(array_of("qd", "rad/s", h->qd, n));
-    a.push_back(array_of("qdd", "rad/s^2", h->qdd, n));
-    a.push_back(array_of("tau", "Nm", h->tau, n));
-    a.push_back(array_of("x", "m", h->x, n));
-    a.push_back({"alpha", "rad", static_cast<std::size_t>(n), 1, std::vector<double>(h->alpha.data(), h->alpha.data() + n)});
-  }
+  if (h && h->size > 0) out.history.arrays = trajectory_arrays(trajectory_history_arrays(RobotShape{}), *h);
   return out;
 }
 
@@ -212,29 +220,12 @@ std::uint64_t restart_seed_of(const IkRun& run) {
 }
 
 template <class P, int M>
-RunOutcome solve_ik(const P& problem, const VecN& q0, const ik::Options& o, int stride, ik::Summary<3, M>& s,
-                    const char* q3_unit) {
+RunOutcome solve_ik(const P& problem, IkProblem problem_id, const VecN& q0, const ik::Options& o, int stride,
+                    ik::Summary<3, M>& s) {
   ik::solve(problem, Vec3(q0.head<3>()), o, s);
   RunOutcome out;
   out.result = IkResult{s.status, s.iterations, s.rejected, s.solution, s.error, s.min_rcond, s.q, s.restarts_used};
-  if (stride > 0 && s.history.size() > 0) {
-    const std::size_t n = s.history.size();
-    std::vector<std::size_t> rows;
-    for (std::size_t k = 0; k < n; k += stride) rows.push_back(k);
-    if (rows.back() != n - 1) rows.push_back(n - 1);
-    HistoryArray k{"k", "", rows.size(), 1, {}}, q{"q", std::string("rad, rad, ") + q3_unit, rows.size(), 3, {}},
-        F{"F", "problem units", rows.size(), M, {}}, e{"norm_F", "problem units", rows.size(), 1, {}},
-        st{"step", "problem units", rows.size(), 1, {}}, l{"lambda", "", rows.size(), 1, {}};
-    for (std::size_t r : rows) {
-      k.data.push_back(static_cast<double>(r));
-      for (int j = 0; j < 3; ++j) q.data.push_back(s.history.q[r][j]);
-      for (int j = 0; j < M; ++j) F.data.push_back(s.history.F[r][j]);
-      e.data.push_back(s.history.error[r]);
-      st.data.push_back(s.history.step[r]);
-      l.data.push_back(s.history.lambda[r]);
-    }
-    out.history.arrays = {std::move(k), std::move(q), std::move(F), std::move(e), std::move(st), std::move(l)};
-  }
+  if (stride > 0 && s.history.size() > 0) out.history.arrays = ik_arrays(ik_history_arrays(problem_id, RobotShape{}), s.history, stride);
   return out;
 }
 
@@ -259,27 +250,7 @@ RunOutcome run_chain_ik(const Scenario& sc, const IkRun& run, const ik::Options&
   ik::solve_chain(chain, task, run.q0, o, r, ws.chain_ik);
   RunOutcome out;
   out.result = IkResult{r.status, r.iterations, r.rejected, -1, r.error, r.min_rcond, r.q, r.restarts_used};
-  if (stride > 0 && r.history.size() > 0) {
-    const std::size_t n = r.history.size(), nq = static_cast<std::size_t>(chain.dof());
-    const std::size_t m = static_cast<std::size_t>(ik::residual_count(task.kind));
-    std::vector<std::size_t> rows;
-    for (std::size_t k = 0; k < n; k += stride) rows.push_back(k);
-    if (rows.back() != n - 1) rows.push_back(n - 1);
-    std::string q_unit;
-    for (const ChainJoint& j : chain.joints) q_unit += (q_unit.empty() ? "" : ", ") + std::string(j.type == JointType::prismatic ? "m" : "rad");
-    const char* f_unit = pose ? "m, rad" : "m";
-    HistoryArray k{"k", "", rows.size(), 1, {}}, q{"q", q_unit, rows.size(), nq, {}}, F{"F", f_unit, rows.size(), m, {}},
-        e{"norm_F", f_unit, rows.size(), 1, {}}, st{"step", q_unit, rows.size(), 1, {}}, l{"lambda", "", rows.size(), 1, {}};
-    for (std::size_t row : rows) {
-      k.data.push_back(static_cast<double>(row));
-      for (std::size_t j = 0; j < nq; ++j) q.data.push_back(r.history.q[row][j]);
-      for (std::size_t j = 0; j < m; ++j) F.data.push_back(r.history.F[row][j]);
-      e.data.push_back(r.history.error[row]);
-      st.data.push_back(r.history.step[row]);
-      l.data.push_back(r.history.lambda[row]);
-    }
-    out.history.arrays = {std::move(k), std::move(q), std::move(F), std::move(e), std::move(st), std::move(l)};
-  }
+  if (stride > 0 && r.history.size() > 0) out.history.arrays = ik_arrays(ik_history_arrays(run.problem, shape_of(chain)), r.history, stride);
   return out;
 }
 
@@ -295,21 +266,21 @@ RunOutcome run_ik(const Scenario& sc, const IkRun& run, int stride, RunWorkspace
       ik::ScaraPosition s;
       s.target = run.target;
       s.z_mode = run.z_mode == ZMode::physical ? ik::ScaraZ::physical : ik::ScaraZ::thesis;
-      return solve_ik(s, run.q0, o, stride, ws.s33, "mm");
+      return solve_ik(s, run.problem, run.q0, o, stride, ws.s33);
     }
     case IkProblem::planar3r_pose: {
       ik::PlanarPose s;
       s.arm = *sc.robot;
       s.target = run.target.head<2>();
       s.alpha = run.target_alpha;
-      return solve_ik(s, run.q0, o, stride, ws.s33, "rad");
+      return solve_ik(s, run.problem, run.q0, o, stride, ws.s33);
     }
     case IkProblem::planar3r_position: break;
   }
   ik::PlanarPosition s;
   s.arm = *sc.robot;
   s.target = run.target.head<2>();
-  return solve_ik(s, run.q0, o, stride, ws.s32, "rad");
+  return solve_ik(s, IkProblem::planar3r_position, run.q0, o, stride, ws.s32);
 }
 
 }  // namespace

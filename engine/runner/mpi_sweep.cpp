@@ -274,6 +274,8 @@ class MpiBackend final : public SweepBackend {
           if (mask[i]) done_[i] = true;
       }
     }
+    msg = history_memory_problem(study, histories_);
+    if (!msg.empty()) return 1;
     if (!fs::path(out).parent_path().empty()) fs::create_directories(fs::path(out).parent_path());
     if (!run.resume || (!exists && shards.empty())) check_free_space(out, schema, done_.size(), size_ + 1);
     return 0;

@@ -76,7 +76,7 @@ struct Evaluator {
     double v = 0.0;
     if (kind == BlockKind::trajectory) {
       if (good) {
-        for (const auto& [m, w] : terms) v += w * metric(*m);
+        for (const auto& [m, w] : terms) v += m ? w * metric(*m) : 0.0;  // failure_rate: 0 for a good run
       } else if (status == "unreachable_start") {
         v = ob->penalty * (2.0 + std::max(0.0, margin_of(r)));
       } else {  // singular / diverged: the earlier it stopped, the worse
@@ -150,7 +150,7 @@ std::shared_ptr<Evaluator> make_evaluator(const Study& study, std::size_t index,
     return nullptr;
   };
   for (const auto& [m, w] : ob.objective) {
-    if (m == "failure_rate") e->terms.emplace_back(nullptr, w);
+    if (m == kFailureRate) e->terms.emplace_back(nullptr, w);
     else if (const MetricDef* d = metric(m)) e->terms.emplace_back(d, w);
     else throw std::invalid_argument("optimization " + ob.name + ": no metric " + m);
   }

@@ -1,7 +1,11 @@
 // One "run a study" path (see run_study.hpp) and the local backend (this process's threads).
 #include "runner/run_study.hpp"
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
+#include <limits>
+#include <stdexcept>
 #include <optional>
 #include <ostream>
 
@@ -24,6 +28,59 @@ store::StoreMeta store_meta(const Study& study, const HistoryPolicy& histories) 
   meta.robot_path = study.robot_file;
   meta.robot_text = study.robot_text;
   return meta;
+}
+
+namespace {
+/// The smallest dt of a trajectory block's runs [s] (its dt axis, else its dt).
+double smallest_dt(const Block& b) {
+  double dt = std::numeric_limits<double>::infinity();
+  bool swept = false;
+  for (const Axis& a : b.axes())
+    if (a.name == "dt")
+      for (const Cell& c : a.values) swept = true, dt = std::min(dt, std::get<double>(c));
+  return swept ? dt : std::get<double>(b.value(0, "dt"));
+}
+
+std::string number(double v) {
+  char s[32];
+  std::snprintf(s, sizeof s, "%g", v);
+  return s;
+}
+
+std::string megabytes(double bytes) {
+  char s[32];
+  std::snprintf(s, sizeof s, "%.0f MB", bytes / 1e6);
+  return s;
+}
+}  // namespace
+
+std::string history_memory_problem(const Study& study, const HistoryPolicy& histories) {
+  if (histories.mode == HistoryPolicy::Mode::none) return "";
+  double duration = 0;
+  for (double d : study.task.durations) duration += d;
+  const std::size_t values = values_per_row(trajectory_history_arrays(study.robot_shape()));
+  for (const Block& b : study.blocks) {
+    if (b.kind() != BlockKind::trajectory || b.run_count() == 0) continue;
+    const double dt = smallest_dt(b);
+    if (!(dt > 0)) continue;  // refused by the parser
+    const double rows = history_rows(duration, dt, histories.stride);
+    const double bytes = history_bytes_in_memory(rows, values);
+    if (bytes <= kMaxHistoryBytesPerRun) continue;
+    int stride = std::max(1, histories.stride);
+    while (history_bytes_in_memory(history_rows(duration, dt, stride), values) > kMaxHistoryBytesPerRun) stride *= 2;
+    int lo = stride / 2 + 1;  // the smallest stride that fits, between the last two powers of 2
+    while (lo < stride) {
+      const int mid = lo + (stride - lo) / 2;
+      if (history_bytes_in_memory(history_rows(duration, dt, mid), values) > kMaxHistoryBytesPerRun) lo = mid + 1;
+      else stride = mid;
+    }
+    return "block '" + b.name() + "': with histories = " + histories.str() + " a run on the " +
+           number(duration) + " s path at dt = " + number(dt) + " s keeps " + std::to_string(static_cast<std::uint64_t>(rows)) + " history rows of " +
+           std::to_string(values) + " values, " + megabytes(bytes) + " in memory while it runs; expected at most " +
+           megabytes(kMaxHistoryBytesPerRun) + " per run: use histories = \"every=" + std::to_string(stride) +
+           "\" or coarser, or \"none\" ([study] histories or --histories)";
+  }
+  return "";
 }
 
 std::string refuse_existing(const std::string& out, bool exists, const std::string& what, const RunRequest& r) {
@@ -93,10 +150,13 @@ OpenedResults open_results(const Study& study, const StudySchema& schema, const 
   if (resume && fs::exists(out)) {
     r.writer = std::move(store::ResultsWriter::open_for_resume(out, study.sha256, so).writer);
     r.histories = resume_histories(out, r.writer->recorded_histories(), histories, adopt_recorded);
+    if (const std::string why = history_memory_problem(study, r.histories); !why.empty())
+      throw std::runtime_error(why);
     require_same_columns(out, r.writer->columns(), schema);
     r.previous = previous_runs(*r.writer);
     return r;
   }
+  if (const std::string why = history_memory_problem(study, histories); !why.empty()) throw std::runtime_error(why);
   if (!fs::path(out).parent_path().empty()) fs::create_directories(fs::path(out).parent_path());
   check_free_space(out, schema, study.run_count(), 1);
   r.writer = store::ResultsWriter::create(out, store_meta(study, histories), schema.columns,
@@ -135,6 +195,10 @@ class LocalBackend final : public SweepBackend {
     store::StoreOptions so;  // commits every second (see StoreOptions)
     so.overwrite = r.overwrite;
     if (r.resume && exists && holds_edited_study(out, study)) {  // a new file, replacing `out` when complete
+      if (const std::string why = history_memory_problem(study, r.options.histories); !why.empty()) {
+        err << "kinesweep run: " << why << "; nothing written\n";
+        return 1;
+      }
       EditedResumeOptions eo;
       eo.histories = r.options.histories;
       eo.compression = r.options.compression;

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "runner/sweep.hpp"
+#include "schema/history_arrays.hpp"
 
 namespace ks {
 
@@ -27,6 +28,11 @@ struct RunRequest {
 /// and problems to `err` (under MPI: rank 0 prints). Returns the exit code, the same on every
 /// rank: 0 done, 1 results file problem, 130 interrupted.
 int run_study(const Study& study, const RunRequest& request, std::ostream& out, std::ostream& err);
+
+/// "" when every trajectory run of `study` keeps a history of at most kMaxHistoryBytesPerRun in
+/// memory under `histories`; else why not, naming the block, the run's rows and bytes, and the
+/// coarsest policy that fits ("every=N"). Checked before a results file is created or resumed.
+std::string history_memory_problem(const Study& study, const HistoryPolicy& histories);
 
 /// The StoreMeta of a study's results file (or shard) whose runs are written with `histories`.
 store::StoreMeta store_meta(const Study& study, const HistoryPolicy& histories);

@@ -82,6 +82,13 @@ Ranking ranking(BlockKind kind) {
   if (kind == BlockKind::trajectory) return {"E", ""};
   return {"iterations", "error"};
 }
+std::vector<std::string> objective_names(const std::vector<MetricDef>& metrics) {
+  std::vector<std::string> out;
+  for (const MetricDef& m : metrics)
+    if (m.type != CellType::str) out.push_back(m.name);
+  out.emplace_back(kFailureRate);
+  return out;
+}
 RankKey rank_key(double objective, double tie, std::uint64_t run) {
   constexpr double last = std::numeric_limits<double>::infinity();
   return {std::isnan(objective) ? last : objective, std::isnan(tie) ? last : tie, run};

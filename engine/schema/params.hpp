@@ -112,6 +112,13 @@ struct Ranking {
 };
 Ranking ranking(BlockKind kind);
 
+/// What an [[optimize]] block of a kind may minimise (a weighted sum of these): every numeric metric
+/// in `metrics` (the block's, per-joint columns for its robot), and "failure_rate" (the fraction of
+/// an evaluation's runs whose status is not the good one). The default is ranking(kind).objective.
+std::vector<std::string> objective_names(const std::vector<MetricDef>& metrics);
+/// The objective term counting failed runs (not a metric of any kind).
+inline constexpr std::string_view kFailureRate = "failure_rate";
+
 /// The ordering key of a good run under ranking(): NaN values sort after every number.
 struct RankKey {
   double objective = 0.0, tie = 0.0;

@@ -9,12 +9,6 @@
 
 namespace ks::study_parse {
 
-std::vector<std::string> objective_names(BlockKind k) {
-  if (k == BlockKind::ik) return {"iterations", "failure_rate", "error"};
-  return {"E", "E_M", "tau_inf", "tau1_inf", "tau2_inf", "tau3_inf", "min_manipulability", "torque_sq_integral",
-          "power_sq_integral", "max_tracking_error", "final_alpha"};
-}
-
 std::optional<opt::StageOptions> Parser::parse_stage(const toml::node& n, bool global, OptimizeBlock& ob) {
   const std::string where = global ? "[optimize.global]" : "[optimize.local]";
   const auto* t = n.as_table();
@@ -256,7 +250,7 @@ void Parser::parse_optimizations(const toml::table& root, Study& s) {
     }
 
     // objective = "E" | { E = 1, tau_inf = 0.01 }
-    const auto allowed = objective_names(kind);
+    const auto allowed = objective_names(block->metrics());
     auto check_metric = [&](const std::string& m, const toml::node& at) {
       if (std::find(allowed.begin(), allowed.end(), m) != allowed.end()) return true;
       error(at, "unknown objective '" + m + "' for " + std::string(to_string(kind)) + " runs; expected one of " +
@@ -280,8 +274,8 @@ void Parser::parse_optimizations(const toml::table& root, Study& s) {
         error(*on, "objective is " + type_name(*on) + "; expected a metric name (\"E\") or { metric = weight, ... }");
       }
     } else {
-      // Default: E (case 3 of the seed minimises mean sqrt(tau^T M^-1 tau): E_M); IK: iterations.
-      ob.objective.emplace_back(kind == BlockKind::ik ? "iterations" : ob.preset == "3" ? "E_M" : "E", 1.0);
+      // Default: the kind's ranking objective (case 3 of the seed minimises mean sqrt(tau^T M^-1 tau): E_M).
+      ob.objective.emplace_back(ob.preset == "3" ? "E_M" : std::string(ranking(kind).objective), 1.0);
     }
     for (std::size_t j = 0; j < ob.objective.size(); ++j) {
       const auto& [m, w] = ob.objective[j];

@@ -83,9 +83,6 @@ struct BlockDraft {
   bool belongs_to_other(std::string_view n) const;
 };
 
-/// The metrics an [[optimize]] objective may name for runs of kind `k`.
-std::vector<std::string> objective_names(BlockKind k);
-
 class Parser : public ParserCore {
  public:
   /// `text` must outlive the parser.

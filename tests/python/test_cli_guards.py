@@ -15,7 +15,7 @@ import unittest
 
 import h5py
 
-from e2e_common import Histories, TempDirTest
+from e2e_common import Histories, TempDirTest, history
 
 KS = None
 STUDIES = None
@@ -126,6 +126,52 @@ class ResumeMemory(TempDirTest):
             grid = f["landscapes/b/iterations"][()]
             self.assertEqual(grid.shape, (2000, 1000))
             self.assertTrue((grid.ravel() == f["runs/iterations"][()]).all())
+
+
+class HistoryMemory(TempDirTest):
+    """A run whose full history would not fit in a bounded memory is refused before anything is
+    written, with the coarsest history policy that fits; that policy runs under 300 MB."""
+    LONG = ("[study]\nname = \"long\"\nhistories = \"full\"\n[task]\nvertices = [[1.5, 0.5], [1.5, 1.5], [1.5, 0.5]]\n"
+            "durations = [3000, 3000]\n[[block]]\nname = \"one\"\nkind = \"trajectory\"\nmethod = \"local_weighted\"\n"
+            "[block.axes]\nalpha1A = [10]\n")
+
+    @staticmethod
+    def smallest_fitting_stride(samples, values):
+        # rows kept: every stride-th sample and the last; about 4 copies of 8-byte values in memory
+        stride = 1
+        while ((samples + stride - 1) // stride + 1) * values * 8 * 4 > 64 * 2**20:
+            stride += 1
+        return stride
+
+    def test_a_6e6_sample_full_history_is_refused_and_the_suggested_policy_runs(self):
+        study = self.write("long.toml", self.LONG)
+        out = os.path.join(self.dir, "long.h5")
+        samples = 6000 * 1000 + 1  # 6000 s at dt = 1 ms
+        values = 1 + 3 * 4 + 2 + 1  # t, q qd qdd tau of 3 joints, x, alpha
+        stride = self.smallest_fitting_stride(samples, values)
+        for extra in ([], ["--dry-run"]):
+            r = run("run", study, "-o", out, "-q", *extra)
+            self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+            self.assertIn(f"block 'one': with histories = full", r.stderr)
+            self.assertIn(f"keeps {samples + 1} history rows of {values} values", r.stderr)
+            self.assertIn(f'use histories = "every={stride}" or coarser', r.stderr)
+            self.assertEqual(sorted(os.listdir(self.dir)), ["long.toml"])
+        r = run("run", study, "-o", out, "-q", "--histories", f"every={stride - 1}")
+        self.assertEqual(r.returncode, 1, r.stderr)
+        with tempfile.TemporaryFile("w+") as err:
+            p = subprocess.Popen([KS, "run", study, "-o", out, "-q", "--histories", f"every={stride}"],
+                                 stdout=subprocess.DEVNULL, stderr=err)
+            _, status, usage = os.wait4(p.pid, 0)
+            err.seek(0)
+            self.assertEqual(os.waitstatus_to_exitcode(status), 0, err.read())
+        if not SANITIZED:
+            self.assertLess(usage.ru_maxrss * 1024, 300 * 2**20)
+        with h5py.File(out, "r") as f:
+            self.assertEqual(f["runs/status"][0], b"ok")
+            t = history(f, 0)["t"]
+            # every stride-th sample from the first, and the last one
+            self.assertEqual(len(t), (samples + stride - 1) // stride + (1 if (samples - 1) % stride else 0))
+            self.assertEqual(t[-1, 0], 6000.0)
 
 
 class Tmpfs:
