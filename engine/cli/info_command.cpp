@@ -132,21 +132,25 @@ void print_optimizations(store::ResultsReader& reader, const RunsTable& t, std::
         const RunsColumn* c = t.find(k);
         return format_double(v) + (c && !c->unit.empty() ? " " + c->unit : "");
       };
+      // The kind's key metrics (E_M only when the objective names it), a peak torque followed by the
+      // joints' own (tau<i>_inf); else every metric of the run.
       std::vector<std::string> parts;
-      if (const double* e = metric("E")) parts.push_back("E = " + with_unit("E", *e));
-      if (o.objective.find("E_M") != std::string::npos)
-        if (const double* e = metric("E_M")) parts.push_back("E_M = " + with_unit("E_M", *e));
-      if (const double* tau = metric("tau_inf")) {
-        std::string s = "|tau|inf = " + with_unit("tau_inf", *tau);
-        std::vector<std::string> taus;
-        for (const char* k : {"tau1_inf", "tau2_inf", "tau3_inf"})
-          if (const double* p = metric(k)) taus.push_back(format_double(*p));
-        if (!taus.empty()) s += " (joints " + join(taus, ", ") + ")";
-        parts.push_back(s);
-      }
-      if (parts.empty())  // IK: the key metrics (as query's compact default), else every metric of the run
-        for (const char* k : {"iterations", "error", "solution"})
-          if (const double* p = metric(k)) parts.push_back(std::string(k) + " = " + format_double(*p));
+      BlockKind kind{};
+      if (parse(o.kind, kind))
+        for (std::string_view key : key_metrics(kind)) {
+          const std::string k(key);
+          const double* v = metric(k);
+          if (!v || (k == "E_M" && o.objective.find(k) == std::string::npos)) continue;
+          std::string s = k + " = " + with_unit(k, *v);
+          std::vector<std::string> joints;
+          for (int j = 1; k.ends_with("_inf"); ++j) {
+            const double* p = metric(k.substr(0, k.size() - 4) + std::to_string(j) + "_inf");
+            if (!p) break;
+            joints.push_back(format_double(*p));
+          }
+          if (!joints.empty()) s += " (joints " + join(joints, ", ") + ")";
+          parts.push_back(s);
+        }
       if (parts.empty())
         for (const auto& [k, v] : o.best_metrics) parts.push_back(k + " = " + format_double(v));
       os << "    best run    " << join(parts, ", ") << '\n';

@@ -48,14 +48,13 @@ std::string RunsTable::kind(std::int64_t row) const {
 }
 
 std::vector<const RunsColumn*> RunsTable::key_metrics(const std::string& kind) const {
-  static const std::map<std::string, std::vector<std::string>> chosen = {
-      {"trajectory", {"E", "E_M", "tau_inf"}}, {"ik", {"iterations", "error", "solution"}}};
+  BlockKind k{};
+  const bool known = parse(kind, k);
   std::vector<const RunsColumn*> out;
-  const auto it = chosen.find(kind);
   for (const auto& c : cols) {
     if (c.role != Role::metric || !c.applies_to(kind)) continue;
-    if (it != chosen.end() ? std::count(it->second.begin(), it->second.end(), c.name) > 0 : out.size() < 3)
-      out.push_back(&c);
+    const auto keys = known ? ks::key_metrics(k) : std::span<const std::string_view>{};
+    if (known ? std::count(keys.begin(), keys.end(), c.name) > 0 : out.size() < 3) out.push_back(&c);
   }
   return out;
 }

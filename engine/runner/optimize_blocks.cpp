@@ -77,7 +77,7 @@ struct Evaluator {
     if (kind == BlockKind::trajectory) {
       if (good) {
         for (const auto& [m, w] : terms) v += m ? w * metric(*m) : 0.0;  // failure_rate: 0 for a good run
-      } else if (status == "unreachable_start") {
+      } else if (status == to_string(RunStatus::unreachable_start)) {
         v = ob->penalty * (2.0 + std::max(0.0, margin_of(r)));
       } else {  // singular / diverged: the earlier it stopped, the worse
         const double t = metric(*stop_time);

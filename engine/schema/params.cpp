@@ -82,6 +82,10 @@ Ranking ranking(BlockKind kind) {
   if (kind == BlockKind::trajectory) return {"E", ""};
   return {"iterations", "error"};
 }
+std::span<const std::string_view> key_metrics(BlockKind kind) {
+  static const std::array<std::string_view, 3> trajectory{"E", "E_M", "tau_inf"}, ik{"iterations", "error", "solution"};
+  return kind == BlockKind::trajectory ? trajectory : ik;
+}
 std::vector<std::string> objective_names(const std::vector<MetricDef>& metrics) {
   std::vector<std::string> out;
   for (const MetricDef& m : metrics)

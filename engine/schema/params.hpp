@@ -112,6 +112,10 @@ struct Ranking {
 };
 Ranking ranking(BlockKind kind);
 
+/// The metrics a one-line summary of a run of the kind shows (query's compact table, info's best
+/// run), in order: trajectory E, E_M, tau_inf; ik iterations, error, solution.
+std::span<const std::string_view> key_metrics(BlockKind kind);
+
 /// What an [[optimize]] block of a kind may minimise (a weighted sum of these): every numeric metric
 /// in `metrics` (the block's, per-joint columns for its robot), and "failure_rate" (the fraction of
 /// an evaluation's runs whose status is not the good one). The default is ranking(kind).objective.
