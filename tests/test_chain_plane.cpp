@@ -33,9 +33,12 @@ std::string read(const std::string& file) {
 Chain seed_arm() { return planar_chain(planar_bars({1, 1, 1}, {5, 2, 1}, 0.1), 9.81); }
 
 /// max |a - b| / max(1, max |b|)
+/// (evaluated into heap matrices: GCC 12 misjudges the bounds of Eigen's vectorised reductions over
+/// bounded-size expressions, -Warray-bounds / -Wmaybe-uninitialized)
 template <class A, class B>
 double rel(const A& a, const B& b) {
-  return (a - b).cwiseAbs().maxCoeff() / std::max(1.0, b.cwiseAbs().maxCoeff());
+  const Eigen::MatrixXd x = a, y = b;
+  return (x - y).cwiseAbs().maxCoeff() / std::max(1.0, y.cwiseAbs().maxCoeff());
 }
 
 Eigen::Matrix3d aligning(const Vector3d& from, const Vector3d& to) {
