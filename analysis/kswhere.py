@@ -17,8 +17,6 @@ relative, `nan` matches NaN); with degrees=True an angle column (unit "rad") is 
 A bad expression raises WhereError, whose message names the expression (and, for an unknown column,
 the closest column name and the valid ones).
 """
-import difflib
-
 import numpy as np
 
 RAD2DEG = 180.0 / np.pi
@@ -32,11 +30,31 @@ class WhereError(ValueError):
     """A --where expression that cannot be parsed or names an unknown column."""
 
 
+def edit_distance(a, b):
+    """Levenshtein distance: insertions, deletions and substitutions of one character."""
+    prev = list(range(len(b) + 1))
+    for i in range(1, len(a) + 1):
+        cur = [i] + [0] * len(b)
+        for j in range(1, len(b) + 1):
+            cur[j] = min(prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] != b[j - 1]))
+        prev = cur
+    return prev[len(b)]
+
+
 def did_you_mean(word, candidates):
-    """The candidate closest to `word` (case-insensitive), or None when none is close."""
-    lower = {c.lower(): c for c in candidates}
-    best = difflib.get_close_matches(word.lower(), list(lower), n=1, cutoff=0.6)
-    return lower[best[0]] if best else None
+    """The engine's one "did you mean" rule (engine/common/did_you_mean.hpp): the candidate nearest to
+    `word` by case-insensitive edit distance when within max(2, len(word) // 2) edits (the first of
+    equals), else the one candidate the word begins (3 characters or more); None otherwise."""
+    w = word.lower()
+    best, pick = None, None
+    for c in candidates:
+        d = edit_distance(w, c.lower())
+        if best is None or d < best:
+            best, pick = d, c
+    if pick is not None and pick != word and best <= max(2, len(w) // 2):
+        return pick
+    starts = [c for c in candidates if len(w) >= 3 and len(c) > len(w) and c.lower().startswith(w)]
+    return starts[0] if len(starts) == 1 else None
 
 
 def unknown_column_message(name, columns, where):

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "common/did_you_mean.hpp"
 #include "methods/seed_cases.hpp"
 #include "study/sha256.hpp"
 #include "study/study.hpp"
@@ -316,6 +317,17 @@ TEST(EditDistance, Basics) {
   EXPECT_EQ(edit_distance("kitten", "sitting"), 3u);
   EXPECT_EQ(edit_distance("", "abc"), 3u);
   EXPECT_EQ(edit_distance("lambda", "lambda"), 0u);
+}
+
+TEST(DidYouMean, OneRuleForEveryMessage) {
+  const std::vector<std::string> c{"alpha1A", "lambda", "thesis_m11", "local_weighted", "local_unweighted"};
+  EXPECT_EQ(did_you_mean("lamda", c), "lambda");            // one edit
+  EXPECT_EQ(did_you_mean("ALPHA1a", c), "alpha1A");         // case-insensitive
+  EXPECT_EQ(did_you_mean("local_weightd", c), "local_weighted");
+  EXPECT_EQ(did_you_mean("thesis", c), "thesis_m11");       // the one candidate it begins
+  EXPECT_EQ(did_you_mean("local", c), "");                  // begins two: no guess
+  EXPECT_EQ(did_you_mean("zzzzzz", c), "");                 // nothing near
+  EXPECT_EQ(did_you_mean("lambda", c), "");                 // the word itself
 }
 
 // ---- Defaults and metadata ----

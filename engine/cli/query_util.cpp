@@ -9,6 +9,7 @@
 #include <ostream>
 #include <set>
 
+#include "common/did_you_mean.hpp"
 #include "schema/params.hpp"
 #include "space/space.hpp"
 
@@ -270,26 +271,7 @@ std::string check_count(std::string& value) {
 }
 
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates) {
-  auto lower = [](std::string s) {
-    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-  };
-  const std::string w = lower(word);
-  std::string best;
-  std::size_t best_d = std::max<std::size_t>(2, w.size() / 3) + 1;
-  for (const auto& cand : candidates) {
-    const std::string c = lower(cand);
-    std::vector<std::size_t> prev(c.size() + 1), cur(c.size() + 1);
-    for (std::size_t j = 0; j <= c.size(); ++j) prev[j] = j;
-    for (std::size_t i = 1; i <= w.size(); ++i) {
-      cur[0] = i;
-      for (std::size_t j = 1; j <= c.size(); ++j)
-        cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (w[i - 1] == c[j - 1] ? 0 : 1)});
-      std::swap(prev, cur);
-    }
-    if (prev[c.size()] < best_d) best_d = prev[c.size()], best = cand;
-  }
-  return best;
+  return ks::did_you_mean(word, candidates);
 }
 
 void print_out(const OutTable& t, Format f, std::ostream& os) {

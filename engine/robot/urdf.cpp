@@ -16,6 +16,7 @@
 #include <mutex>
 #include <sstream>
 
+#include "common/did_you_mean.hpp"
 #include "model/chain_dynamics.hpp"
 #include "robot/urdf_check.hpp"
 
@@ -63,20 +64,6 @@ int element_line(std::string_view text, std::string_view tag, std::string_view v
   return 0;
 }
 
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
 
 // ---- urdfdom, with its log captured ----
 
@@ -134,12 +121,9 @@ class Builder {
 
   urdf::LinkConstSharedPtr find_link(std::string_view name, const char* role) const {
     if (auto link = model_.getLink(std::string(name))) return link;
-    std::string nearest;
-    std::size_t best = std::string::npos;
-    for (const auto& [candidate, link] : model_.links_) {
-      const std::size_t d = edit_distance(name, candidate);
-      if (d < best) best = d, nearest = candidate;
-    }
+    std::vector<std::string> links;
+    for (const auto& [candidate, link] : model_.links_) links.push_back(candidate);
+    const std::string nearest = did_you_mean(name, links);
     std::string message = std::string("unknown ") + role + " link '" + std::string(name) + "'";
     if (!nearest.empty()) message += "; did you mean '" + nearest + "'?";
     fail(0, message);

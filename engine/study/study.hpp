@@ -172,7 +172,5 @@ Study parse_study(std::string_view text, std::string_view file = "<string>", con
 /// Read and parse a study file. Throws StudyError (also when the file cannot be read).
 Study load_study(const std::filesystem::path& file, const StudyOptions& options = {});
 
-/// Levenshtein distance (for "did you mean" suggestions).
-std::size_t edit_distance(std::string_view a, std::string_view b);
 
 }  // namespace ks

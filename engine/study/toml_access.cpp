@@ -2,24 +2,14 @@
 // formatting helpers shared by the parser's parts.
 #include "study/toml_access.hpp"
 
+#include "common/did_you_mean.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <sstream>
 
 namespace ks {
-
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    cur[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j)
-      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
-    std::swap(prev, cur);
-  }
-  return prev[b.size()];
-}
 
 namespace study_parse {
 
@@ -30,23 +20,8 @@ std::string lower(std::string_view s) {
 }
 
 std::string suggest(std::string_view word, const std::vector<std::string>& candidates) {
-  std::size_t best = std::string::npos;
-  std::string pick;
-  for (const auto& c : candidates) {
-    const std::size_t d = edit_distance(lower(word), lower(c));
-    if (d < best) {
-      best = d;
-      pick = c;
-    }
-  }
-  if (!pick.empty() && pick != word && best <= std::max<std::size_t>(2, word.size() / 2))
-    return "; did you mean '" + pick + "'?";
-  // else a word that begins the one candidate ("thesis" for "thesis_m11")
-  const std::string w = lower(word);
-  std::vector<std::string> starts;
-  for (const auto& c : candidates)
-    if (w.size() >= 3 && lower(c).starts_with(w) && c.size() > w.size()) starts.push_back(c);
-  return starts.size() == 1 ? "; did you mean '" + starts.front() + "'?" : "";
+  const std::string pick = did_you_mean(word, candidates);
+  return pick.empty() ? "" : "; did you mean '" + pick + "'?";
 }
 
 std::string suggest_either(std::string_view word, const std::vector<std::string>& mine,
