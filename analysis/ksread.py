@@ -33,7 +33,8 @@ import kshistory
 import kslive
 from kssolutions import cluster_solutions  # noqa: F401 (part of this module's interface)
 from kstypes import FormatVersionError  # noqa: F401 (the same)
-from kstypes import IK_STATUSES, STATUS_COLOURS, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s  # noqa: F401 (the same)
+from kstypes import (GOOD_STATUSES, IK_STATUSES, KIND_MEANING, OTHER_SOLUTION_COLOUR, STATUS_COLOURS,  # noqa: F401
+                     TRAJECTORY_STATUSES, Axis, Landscape, Table, _s)
 
 RAD2DEG = 180.0 / np.pi
 FORMAT_VERSIONS = (2, 3)  # the results formats this module reads (engine/store/FORMAT.md)
@@ -237,6 +238,17 @@ class Results:
         """column -> the run kinds it applies to (its kinds attribute split at commas; [] = every run)."""
         return {c: list(k) for c, k in self._kinds.items()}
 
+    @kslive.consistent
+    def kind_meaning(self, kind):
+        """What runs of `kind` mean, as the file records it (/kinds/<kind>): {"statuses": in code
+        order, "good_statuses", "ranking": [objective, tie...] (best = lowest among good runs, then
+        by run id), "key_metrics", "objectives", "history_arrays", ...}, each a list of str. Files
+        from before /kinds: the engine's declarations (kstypes.KIND_MEANING); {} for an unknown kind."""
+        g = self.f.get("kinds")
+        if g is not None and kind in g:
+            return {k: [_s(x) for x in v] for k, v in g[kind].attrs.items()}
+        return {k: list(v) for k, v in KIND_MEANING.get(kind, {}).items()}
+
     def run_kinds(self):
         """The run kinds the columns name ("trajectory", "ik"), first seen first."""
         out = []
@@ -415,7 +427,8 @@ class Results:
             metrics[m] = np.array(g[m][()], dtype=float)
             units[m] = _s(g[m].attrs.get("unit", ""))
             desc[m] = _s(g[m].attrs.get("description", ""))
-        return Landscape(block, axes, metrics, units, desc, self._block_kind(block))
+        kind = self._block_kind(block)
+        return Landscape(block, axes, metrics, units, desc, kind, self.kind_meaning(kind))
 
     def _block_kind(self, block):
         """The run kind of a block's (done) rows, "" when it has none."""

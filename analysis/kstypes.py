@@ -9,11 +9,25 @@ TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged", "under
                        "out_of_limits"]
 IK_STATUSES = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution",
                "out_of_limits"]
+# What each run kind means, for files written before the engine recorded it under /kinds (the engine's
+# declarations, schema/params.hpp; tests/python/test_kinds.py checks a new file's /kinds against them).
+KIND_MEANING = {
+    "trajectory": {"statuses": TRAJECTORY_STATUSES, "good_statuses": ["ok"], "ranking": ["E"],
+                   "key_metrics": ["E", "E_M", "tau_inf"],
+                   "history_arrays": ["t", "q", "qd", "qdd", "tau", "x", "alpha"]},
+    "ik": {"statuses": IK_STATUSES, "good_statuses": ["converged"], "ranking": ["iterations", "error"],
+           "key_metrics": ["iterations", "error", "solution"],
+           "history_arrays": ["k", "q", "F", "norm_F", "step", "lambda"]},
+}
+GOOD_STATUSES = [s for m in KIND_MEANING.values() for s in m["good_statuses"]]
+
 # The colour of each failed status in every plot and the report (good runs are drawn by their metric).
 STATUS_COLOURS = {"unreachable_start": "#b0b0b0", "singular": "#7b3294", "diverged": "#202020",
                   "undersampled": "#8c6d31", "off_path": "#c51b7d",
                   "stalled": "#e08214", "max_iter": "#d7191c", "cycle": "#f4a582", "unsupported": "#6a6a6a",
                   "no_solution": "#8f8f8f", "out_of_limits": "#fdae61"}
+# A converged run that reached none of the solutions a basin plot names.
+OTHER_SOLUTION_COLOUR = "#c7c7c7"
 
 
 class FormatVersionError(ValueError):
@@ -65,9 +79,11 @@ class Landscape:
     .units / .descriptions (name -> str), .kind (the block's run kind, from its /runs rows).
     metrics[m][i, j, ...] is at axes[0].values[i], ..."""
 
-    def __init__(self, block, axes, metrics, units, descriptions, kind=""):
+    def __init__(self, block, axes, metrics, units, descriptions, kind="", meaning=None):
         self.block, self.axes, self.metrics, self.units, self.descriptions = block, axes, metrics, units, descriptions
         self._kind = kind
+        # what the block's run kind means (ksread.Results.kind_meaning): statuses, ranking, ...
+        self.meaning = meaning if meaning is not None else {k: list(v) for k, v in KIND_MEANING.get(kind, {}).items()}
 
     def axis(self, name):
         for a in self.axes:
@@ -84,7 +100,17 @@ class Landscape:
 
     @property
     def statuses(self):
-        return IK_STATUSES if self.kind == "ik" else TRAJECTORY_STATUSES
+        """The kind's statuses in code order (status_code indexes them; code 0 is the good one)."""
+        return self.meaning.get("statuses", IK_STATUSES if self.kind == "ik" else TRAJECTORY_STATUSES)
+
+    @property
+    def objective(self):
+        """The metric the kind's runs are ranked by (E; ik: iterations), or None."""
+        return next(iter(self.meaning.get("ranking", [])), None)
+
+    def status_grids(self):
+        """The names of the grids of statuses (the good-status grid and status_code), not metrics."""
+        return (self.statuses[0], "status_code")
 
     @staticmethod
     def _coordinate(a):

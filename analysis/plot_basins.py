@@ -22,9 +22,8 @@ import ksread  # noqa: E402
 DEFAULT_SIZE = "1200x500"  # one row of panels; more rows get more height
 MAX_ROWS = 6  # rows of panels: one per value of a second remaining dim
 SOLUTION_COLOURS = ["#1f77b4", "#2ca02c", "#ff7f0e", "#17becf", "#bcbd22", "#8c564b"]
-FAIL_COLOURS = {"stalled": "#8c510a", "singular": "#7b3294", "max_iter": "#d7191c", "cycle": "#f781bf",
-                "diverged": "#111111", "unsupported": "#555555", "no_solution": "#999999", "out_of_limits": "#fdae61",
-                "converged, other solution": "#bbbbbb"}
+# The failed statuses in the colours of every plot and the report (kstypes.STATUS_COLOURS).
+FAIL_COLOURS = dict(ksread.STATUS_COLOURS, **{"converged, other solution": ksread.OTHER_SOLUTION_COLOUR})
 
 
 def parse_args(argv=None):

@@ -183,7 +183,7 @@ def reduce_grid(ls, args):
     status = arrange(ls.metrics["status_code"])
     good = 0  # ok / converged
     if metric == "convergence":
-        z = np.nanmean(arrange(ls.metrics["converged"]), axis=3)
+        z = np.nanmean(arrange(ls.metrics[ls.statuses[0]]), axis=3)
         cat = np.full(z.shape, -1)
         if multi:
             notes.append(f"mean over {', '.join(multi)}")

@@ -28,8 +28,7 @@ import ksread  # noqa: E402
 import kswhere  # noqa: E402
 
 VIEWS = ("scatter", "slice", "parcoords")
-GOOD = ("ok", "converged")
-DEFAULT_METRIC = {"trajectory": "E", "ik": "iterations"}
+GOOD = tuple(ksread.GOOD_STATUSES)  # the legend's wording; a block's own come from the file (kind_meaning)
 FAIL_MARKERS = ["x", "+", "v", "^", "s", "D", "1", "*", "P"]
 FACET_MAX = 12  # a numeric column with at most this many distinct values can be a facet
 OK_COLOUR = "#1f77b4"
@@ -382,7 +381,8 @@ def main(argv=None):
     inblock = (kinds == kind) if (args.facet == "block" and not args.block) else (runs["block"] == block)
 
     metrics = res.metrics(kind)
-    metric_name = args.metric or DEFAULT_METRIC.get(kind, metrics[0] if metrics else None)
+    meaning = res.kind_meaning(kind)
+    metric_name = args.metric or next(iter(meaning.get("ranking", [])), metrics[0] if metrics else None)
     if metric_name not in metrics:
         close = kswhere.did_you_mean(str(metric_name), metrics)
         fail(f"--metric {metric_name}: not a metric of {kind} runs" + (f"; did you mean '{close}'?" if close else "")
@@ -419,8 +419,8 @@ def main(argv=None):
 
     idx = np.flatnonzero(rows)
     status = runs["status"][idx]
-    good = np.isin(status, GOOD)
-    known = ksread.IK_STATUSES if kind == "ik" else ksread.TRAJECTORY_STATUSES
+    good = np.isin(status, meaning.get("good_statuses", []))
+    known = meaning.get("statuses", [])
     failed_seen = [s for s in dict.fromkeys(status[~good])]
     fail_order = [s for s in known if s in failed_seen] + [s for s in failed_seen if s not in known]
     metric = make_col(runs, metric_name, idx, scale="log" if args.log else "linear")

@@ -3,12 +3,13 @@ solution its run converged to (the converged final iterates named by kssolutions
 failed runs in their status colours; hover with the iterations and status. Run with /usr/bin/python3."""
 import numpy as np
 
+import ksread
 from kssolutions import cluster_solutions
 from report_grids import STATUS_COLOURS, Selection, arrange, axis_values, capped_note, esc, legend_square, \
     value_text
 
 SOLUTION_COLOURS = ["#1f77b4", "#2ca02c", "#ff7f0e", "#17becf", "#bcbd22", "#8c564b", "#e377c2", "#9edae5"]
-OTHER_COLOUR = "#c7c7c7"
+OTHER_COLOUR = ksread.OTHER_SOLUTION_COLOUR
 CLUSTER_TOLERANCE = 1e-3  # max-norm distance [rad or mm] under which two final iterates are one solution
 RAD2DEG = 180.0 / np.pi
 

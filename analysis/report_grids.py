@@ -180,9 +180,9 @@ def landscape_figure(ls, cap):
     Returns (figure dict, caption html, cells drawn)."""
     if not ls.axes:
         return None
-    metric = "iterations" if ls.kind == "ik" else "E"
+    metric = ls.objective
     if metric not in ls.metrics:
-        metric = [m for m in ls.metrics if m not in ("ok", "converged", "status_code")][0]
+        metric = [m for m in ls.metrics if m not in ls.status_grids()][0]
     status = ls.metrics["status_code"]
     good = status == 0
     val = np.where(good, ls.metrics[metric], np.nan)
@@ -192,7 +192,7 @@ def landscape_figure(ls, cap):
     s = sel.stride(cap)
     xi = np.arange(0, len(xa.values), s)
     yi = np.arange(0, len(ya.values), s) if ya is not None else np.array([0])
-    hover_metrics = [m for m in ls.metrics if m not in ("ok", "converged", "status_code")
+    hover_metrics = [m for m in ls.metrics if m not in ls.status_grids()
                      and np.isfinite(np.where(good, ls.metrics[m], np.nan)).any()]
     frames_val = [sel.slice(val, f) for _, f in sel.frames]
     transform, zmin, zmax, ticks = colour_scale(np.concatenate([v.ravel() for v in frames_val]))
@@ -227,7 +227,7 @@ def landscape_figure(ls, cap):
             names = np.array([statuses[int(c)] if np.isfinite(c) else "" for c in fail.ravel()],
                              dtype=object).reshape(fail.shape)
             # the failed runs' metrics that have values (an IK failure's iterations and final error)
-            fm = [m for m in ls.metrics if m not in ("ok", "converged", "status_code")
+            fm = [m for m in ls.metrics if m not in ls.status_grids()
                   and np.isfinite(np.where(fail_all, ls.metrics[m], np.nan)).any()]
             fcustom = np.stack([names] + [sel.slice(ls.metrics[m], f)[np.ix_(yi, xi)].astype(object) for m in fm],
                                axis=-1)

@@ -6,9 +6,6 @@ import numpy as np
 import ksread
 from report_page import esc, fmt, table
 
-# The metric a block's runs are ranked by, per run kind, and the status that counts as success.
-RANK = {"trajectory": ("ok", ["E"]), "ik": ("converged", ["iterations", "error"])}
-
 
 class RunsView:
     """Every row of /runs (done or not, angles in degrees) with each row's kind and block order."""
@@ -34,13 +31,13 @@ class RunsView:
         return k[0] if len(k) == 1 else ""
 
     def ranked(self, block):
-        """The block's done rows of good status (ok / converged), best first: trajectory by E, IK by
-        iterations then error; ties by run id. Returns (row indices, the ranking metric names)."""
-        kind = self.kind(block)
-        good, keys = RANK.get(kind, ("ok", ["E"]))
-        keys = [k for k in keys if k in self.t]
+        """The block's done rows of good status, best first by the kind's ranking (the file's /kinds:
+        trajectory by E, IK by iterations then error); ties by run id. Returns (row indices, the
+        ranking metric names)."""
+        meaning = self.res.kind_meaning(self.kind(block))
+        keys = [k for k in meaning.get("ranking", []) if k in self.t]
         rows = self.rows(block)
-        rows = rows[self.t["status"][rows] == good]
+        rows = rows[np.isin(self.t["status"][rows], meaning.get("good_statuses", []))]
         cols = [self.t["run_id"][rows]] + [np.nan_to_num(np.asarray(self.t[k][rows], dtype=float), nan=np.inf)
                                             for k in reversed(keys)]
         return rows[np.lexsort(cols)], keys
@@ -69,9 +66,8 @@ def metadata_section(res, view):
 def status_section(view):
     """Runs per block and status (done rows), plus the rows not done yet."""
     statuses = []
-    for s in ksread.TRAJECTORY_STATUSES + ksread.IK_STATUSES:
-        if s not in statuses:
-            statuses.append(s)
+    for kind in view.res.run_kinds():
+        statuses += [s for s in view.res.kind_meaning(kind).get("statuses", []) if s not in statuses]
     present = set(view.t["status"][view.done].tolist())
     extra = sorted(s for s in present if s not in statuses and s)
     shown = [s for s in statuses if s in present] + extra
@@ -82,7 +78,9 @@ def status_section(view):
         st = view.t["status"][done_rows]
         rows.append([b, view.kind(b), len(all_rows), len(done_rows)] + [int(np.sum(st == s)) for s in shown]
                     + [len(all_rows) - len(done_rows)])
-    good = "ok (trajectory) and converged (IK) are the successful statuses."
+    good = " and ".join(f"{'/'.join(view.res.kind_meaning(k).get('good_statuses', []))} ({k})"
+                        for k in view.res.run_kinds())
+    good = f"{good} are the successful statuses." if good else ""
     return table(columns, rows, "status-table", text_columns=("block", "kind")) + \
         f'<p class="caption">Runs per block and status, counted over the done rows. {good}</p>'
 
@@ -122,7 +120,7 @@ def best_section(view, n_best):
         if not len(rows_done):
             continue
         kind = view.kind(b)
-        good = RANK.get(kind, ("ok",))[0]
+        good = "/".join(view.res.kind_meaning(kind).get("good_statuses", []))
         top = ranked[:n_best]
         varying, fixed = varying_parameters(view, b, rows_done)
         metrics = shown_metrics(view, b, rows_done)

@@ -3,6 +3,7 @@ time; IK: ‖F‖ against iteration) and the optimisation traces (objective agai
 stage, best so far). Plain plotly dicts. Run with /usr/bin/python3."""
 import numpy as np
 
+import ksread
 from report_grids import ordinal
 from report_page import esc, fmt, table
 from report_tables import varying_parameters
@@ -68,7 +69,7 @@ def history_figure(view, row):
               "legend": {"orientation": "h", "y": 1.08, "x": 0}}
     varying, _ = varying_parameters(view, t["block"][row], view.rows(t["block"][row]))
     shown = ", ".join(f"{c} = {fmt(t[c][row], 5)}{(' ' + t.units[c]) if t.units[c] else ''}" for c in varying)
-    metric = "E" if "t" in h else "iterations"
+    metric = view.res.kind_meaning(view.kinds[row]).get("ranking", ["E"])[0]
     caption = (f"{what} of run {rid} (status {esc(t['status'][row])}; {esc(shown)}), the block's best "
                f"{esc(t['status'][row])} run with a history: {metric} = {fmt(t[metric][row], 6)}"
                f"{(' ' + t.units[metric]) if t.units.get(metric) else ''}." + capped)
@@ -85,7 +86,7 @@ def optimization_figure(res, name):
     stage = np.asarray(ev["stage"], dtype=object)
     status = np.asarray(ev["status"], dtype=object) if "status" in ev else np.full(n, "", dtype=object)
     x = np.asarray(ev["x"], dtype=float).reshape(n, -1)
-    good = np.isin(status, ["ok", "converged"]) | (status == "")
+    good = np.isin(status, ksread.GOOD_STATUSES) | (status == "")
     best_so_far = np.fmin.accumulate(np.where(good & np.isfinite(obj), obj, np.inf)) if n else obj
     step = max(1, int(np.ceil(n / MAX_EVALUATIONS)))
     keep = np.arange(0, n, step)

@@ -18,9 +18,46 @@ namespace ks {
 
 namespace fs = std::filesystem;
 
+std::vector<store::KindMeta> kind_meta(const Study& study) {
+  std::vector<store::KindMeta> out;
+  auto strings = [](auto&& range) {
+    std::vector<std::string> v;
+    for (const auto& x : range) v.emplace_back(x);
+    return v;
+  };
+  for (const BlockKind kind : block_kinds()) {
+    const Block* block = nullptr;
+    for (const Block& b : study.blocks)
+      if (!block && b.kind() == kind) block = &b;
+    for (const OptimizeBlock& o : study.optimizations)
+      if (!block && o.block().kind() == kind) block = &o.block();
+    if (!block) continue;
+    store::KindMeta k;
+    k.name = std::string(to_string(kind));
+    const auto st = statuses(kind);
+    const Ranking rank = ranking(kind);
+    std::vector<std::string> ranked{std::string(rank.objective)};
+    if (!rank.tie.empty()) ranked.emplace_back(rank.tie);
+    const auto arrays = kind == BlockKind::trajectory ? trajectory_history_arrays(study.robot_shape())
+                                                      : ik_history_arrays(IkProblem::scara, study.robot_shape());
+    std::vector<std::string> names, units;
+    for (const auto& a : arrays) names.push_back(a.name), units.push_back(a.unit);
+    k.lists = {{"statuses", strings(st)},
+               {"good_statuses", {std::string(st.front())}},
+               {"ranking", ranked},
+               {"key_metrics", strings(key_metrics(kind))},
+               {"objectives", objective_names(block->metrics())},
+               {"history_arrays", names}};
+    if (kind == BlockKind::trajectory) k.lists.emplace_back("history_units", units);
+    out.push_back(std::move(k));
+  }
+  return out;
+}
+
 store::StoreMeta store_meta(const Study& study, const HistoryPolicy& histories) {
   store::StoreMeta meta;
   meta.histories = histories.str();
+  meta.kinds = kind_meta(study);
   meta.study_name = study.name;
   meta.study_path = study.file;
   meta.study_text = study.text;

@@ -34,6 +34,11 @@ int run_study(const Study& study, const RunRequest& request, std::ostream& out, 
 /// coarsest policy that fits ("every=N"). Checked before a results file is created or resumed.
 std::string history_memory_problem(const Study& study, const HistoryPolicy& histories);
 
+/// The meaning of each run kind the study's blocks use, as its results file records it (/kinds):
+/// statuses (enum order), good_statuses, ranking (objective, then tie), key_metrics, objectives,
+/// history_arrays (and, trajectory, history_units).
+std::vector<store::KindMeta> kind_meta(const Study& study);
+
 /// The StoreMeta of a study's results file (or shard) whose runs are written with `histories`.
 store::StoreMeta store_meta(const Study& study, const HistoryPolicy& histories);
 

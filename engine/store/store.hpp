@@ -49,6 +49,13 @@ inline constexpr std::int64_t kFormatVersion = 3;
 inline constexpr std::int64_t kOldestReadableFormatVersion = 1;
 
 /// Root metadata of a results file.
+/// A run kind's meaning as the engine declares it (schema/params.hpp, schema/history_arrays.hpp),
+/// written as string-list attributes of the group /kinds/<name> (FORMAT.md).
+struct KindMeta {
+  std::string name;  ///< "trajectory" | "ik"
+  std::vector<std::pair<std::string, std::vector<std::string>>> lists;  ///< attribute -> values
+};
+
 struct StoreMeta {
   std::string study_name;
   std::string study_path;    ///< attribute "path" of /study
@@ -61,6 +68,8 @@ struct StoreMeta {
   /// The history policy the runs are written with (root attribute "histories": full, every=N or
   /// none; written when not empty; "" in files from before it was recorded).
   std::string histories;
+  /// The study's run kinds (/kinds; empty in files from before they were written).
+  std::vector<KindMeta> kinds;
   std::string format = kFormatName;
   std::int64_t format_version = kFormatVersion;
 };

@@ -153,6 +153,14 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
                         Role::bookkeeping, ""};
   make(done, H5T_STD_U8LE, H5T_NATIVE_UINT8, &zero, "u8");
 
+  if (!meta.kinds.empty()) {
+    Hid kinds(check(H5Gcreate2(file, "kinds", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /kinds"));
+    for (const KindMeta& k : meta.kinds) {
+      Hid g(check(H5Gcreate2(kinds, k.name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path,
+                  "create /kinds/" + k.name));
+      for (const auto& [attr, values] : k.lists) write_str_list_attr(g, attr.c_str(), values);
+    }
+  }
   Hid h(check(H5Gcreate2(file, "histories", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /histories"));
   Hid l(check(H5Gcreate2(file, "landscapes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /landscapes"));
 }

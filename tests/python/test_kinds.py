@@ -1,0 +1,117 @@
+"""The run kinds' meaning as a results file records it (/kinds/<kind>): the same as the Python
+readers' fallback for older files (kstypes.KIND_MEANING), objectives = every numeric metric column
+of the kind plus failure_rate (read from the /runs column attributes), history arrays named and
+united as the runs' histories are written.
+
+usage: /usr/bin/python3 test_kinds.py KINESWEEP_BINARY ANALYSIS_DIR
+"""
+import os
+import subprocess
+import sys
+import unittest
+
+import h5py
+
+from e2e_common import TempDirTest, history
+
+KS = None
+
+STUDY = """
+[study]
+name = "kinds"
+histories = "full"
+
+[robot]
+l = [1.0, 1.0, 0.5, 0.5]
+m = [5.0, 2.0, 0.5, 0.5]
+b = 0.1
+
+[[block]]
+name = "traj"
+kind = "trajectory"
+[block.axes]
+alpha1A = [0, 10]
+k = [0, 0.5]
+
+[[block]]
+name = "scara"
+kind = "ik"
+problem = "scara"
+method = "newton"
+[block.axes]
+q0_1 = [-30, 30]
+"""
+
+
+def strings(values):
+    return [v.decode() if isinstance(v, bytes) else str(v) for v in values]
+
+
+class Kinds(TempDirTest):
+    @classmethod
+    def setUpClass(cls):
+        super().setUpClass()
+
+    def setUp(self):
+        super().setUp()
+        study = self.write("kinds.toml", STUDY)
+        self.out = os.path.join(self.dir, "kinds.h5")
+        r = subprocess.run([KS, "run", study, "-o", self.out, "-q"], capture_output=True, text=True, timeout=300)
+        self.assertEqual(r.returncode, 0, r.stderr)
+
+    def test_the_file_records_each_kind_it_holds(self):
+        import kstypes
+        with h5py.File(self.out, "r") as f:
+            self.assertEqual(sorted(f["kinds"]), ["ik", "trajectory"])
+            for kind in ("trajectory", "ik"):
+                a = {k: strings(v) for k, v in f["kinds"][kind].attrs.items()}
+                fallback = kstypes.KIND_MEANING[kind]
+                for key in ("statuses", "good_statuses", "ranking", "key_metrics", "history_arrays"):
+                    self.assertEqual(a[key], fallback[key], f"{kind} {key}")
+                self.assertEqual(a["good_statuses"], a["statuses"][:1])
+                # objectives: every numeric metric column of the kind, in /runs order, and failure_rate
+                numeric = []
+                for c in strings(f["runs"].attrs["columns"]):
+                    at = f["runs"][c].attrs
+                    kinds = [k for k in strings([at["kinds"]])[0].split(",") if k]
+                    if strings([at["role"]])[0] == "metric" and (not kinds or kind in kinds) \
+                            and strings([at["type"]])[0] != "str":
+                        numeric.append(c)
+                self.assertEqual(a["objectives"], numeric + ["failure_rate"], kind)
+            self.assertIn("tau4_inf", strings(f["kinds"]["trajectory"].attrs["objectives"]))
+            self.assertNotIn("tau5_inf", strings(f["kinds"]["trajectory"].attrs["objectives"]))
+
+    def test_history_arrays_are_the_ones_written(self):
+        with h5py.File(self.out, "r") as f:
+            blocks = strings(f["runs"]["block"][()])
+            traj, ik = blocks.index("traj"), blocks.index("scara")
+            t = f["kinds"]["trajectory"].attrs
+            h = history(f, traj)
+            self.assertEqual(list(h), strings(t["history_arrays"]))
+            self.assertEqual(h["q"].shape[1], 4)  # the 4R arm's joints
+            from kshistory import Histories
+            units = [u for _n, _a, u in Histories(f).read(traj)]
+            self.assertEqual(units, strings(t["history_units"]))
+            self.assertEqual(list(history(f, ik)), strings(f["kinds"]["ik"].attrs["history_arrays"]))
+
+    def test_ksread_reads_the_meaning_and_falls_back_for_older_files(self):
+        import ksread
+        with ksread.open_results(self.out) as res:
+            m = res.kind_meaning("ik")
+            self.assertEqual(m["ranking"], ["iterations", "error"])
+            self.assertEqual(res.landscape("traj").objective, "E")
+            self.assertEqual(res.landscape("traj").status_grids(), ("ok", "status_code"))
+        old = os.path.join(self.dir, "old.h5")
+        with open(self.out, "rb") as a, open(old, "wb") as b:
+            b.write(a.read())
+        with h5py.File(old, "r+") as f:
+            del f["kinds"]
+        with ksread.open_results(old) as res:
+            self.assertEqual(res.kind_meaning("trajectory")["good_statuses"], ["ok"])
+            self.assertEqual(res.kind_meaning("nonsense"), {})
+
+
+if __name__ == "__main__":
+    KS = os.path.abspath(sys.argv[1])
+    sys.path.insert(0, os.path.abspath(sys.argv[2]))
+    unittest.main(argv=[sys.argv[0], "-v"])
