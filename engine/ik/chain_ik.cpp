@@ -2,6 +2,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "ik/chain_ik_impl.hpp"
 
@@ -46,6 +48,7 @@ void unsupported(const Options& options, const VecN& q0, ChainIkResult& r) {
 
 void solve_chain(const Chain& chain, const ChainIkTask& task, const VecN& q0, const Options& options,
                  ChainIkResult& result, ChainIkWorkspace& workspace) {
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("solve_chain: " + why);
   const int n = chain.dof();
   const int kind = static_cast<int>(task.kind);
   if (n < kMinChainJoints || n > kMaxJoints || q0.size() != n || kind < 0 || kind > 3 ||

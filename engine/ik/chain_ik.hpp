@@ -78,7 +78,7 @@ class ChainIkWorkspace {
 /// Status::unsupported, without iterating, when: chain.dof() is outside 2 .. kMaxJoints, q0 has
 /// another size, the task is planar_pose and the chain is not planar (Chain::planar()), the method
 /// is analytic (no closed form for a general chain), or halley_thesis on a non-square task
-/// (residual_count(kind) != dof).
+/// (residual_count(kind) != dof). Throws std::invalid_argument when options.IsValid() fails.
 void solve_chain(const Chain& chain, const ChainIkTask& task, const VecN& q0, const Options& options,
                  ChainIkResult& result, ChainIkWorkspace& workspace);
 

@@ -337,6 +337,7 @@ TrajectoryMetrics simulate(const Chain& chain, const ChainTask& task, const VecN
                            ChainHistory* history) {
   const SampledPath3& sampled = task.path;
   const int n = chain.dof(), m = task_dimension(task.space);
+  if (std::string why; !o.IsValid(&why)) throw std::invalid_argument("simulate: " + why);
   if (sampled.dt() != o.dt)
     throw std::invalid_argument("simulate: path sampled at dt = " + std::to_string(sampled.dt()) +
                                 " s, options ask for dt = " + std::to_string(o.dt) + " s");

@@ -67,8 +67,8 @@ struct ChainHistory {
 /// the closed form's figure for every seed method and has one unit whatever the orientation rows;
 /// max_tracking_error is the tip position's; final_alpha is the tip angle (NaN for spatial tasks).
 /// The history is filled when given. Never throws on bad numbers: trouble is a status.
-/// Throws std::invalid_argument when task.path.dt() != options.dt, q0 has the wrong size, the task
-/// and method do not fit the chain (see above), or planar_pose has the wrong number of vertex_alpha.
+/// Throws std::invalid_argument when options.IsValid() fails, task.path.dt() != options.dt, q0 has
+/// the wrong size, the task and method do not fit the chain (see above), or planar_pose has the wrong number of vertex_alpha.
 TrajectoryMetrics simulate(const Chain& chain, const ChainTask& task, const VecN& q0, const TrajectoryOptions& options,
                            ChainHistory* history = nullptr);
 

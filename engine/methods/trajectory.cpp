@@ -82,6 +82,7 @@ void prepare(Batch& b, int lanes, const PlanarArm3& arm, const SampledPath& samp
   const TrajectoryOptions& o0 = options[0];
   for (int i = 0; i < count; ++i) {
     const TrajectoryOptions& o = options[i];
+    if (std::string why; !o.IsValid(&why)) throw std::invalid_argument("simulate: " + why);
     if (sampled.dt() != o.dt)
       throw std::invalid_argument("simulate: path sampled at dt = " + std::to_string(sampled.dt()) +
                                   " s, options ask for dt = " + std::to_string(o.dt) + " s");

@@ -155,7 +155,8 @@ struct TrajectoryHistory {
 /// Simulate one run. Inputs: arm constants, the path sampled at options.dt (see SampledPath: sample it
 /// once and share it between the runs of a sweep), options. Output: metrics; the history is filled
 /// when given. Never throws on bad numbers: trouble is a status. Throws std::invalid_argument when
-/// path.dt() != options.dt or vertex_alpha has the wrong number of vertex orientations.
+/// options.IsValid() fails, path.dt() != options.dt or vertex_alpha has the wrong number of vertex
+/// orientations.
 TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& path, const TrajectoryOptions& options,
                            TrajectoryHistory* history = nullptr);
 /// The same, sampling the path for this one run.

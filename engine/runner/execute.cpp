@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <cstring>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "ik/chain_ik.hpp"
@@ -256,6 +258,7 @@ RunOutcome run_chain_ik(const Scenario& sc, const IkRun& run, const ik::Options&
 
 RunOutcome run_ik(const Scenario& sc, const IkRun& run, int stride, RunWorkspace::Impl& ws) {
   ik::Options o = run.options;
+  if (std::string why; !o.IsValid(&why)) throw std::invalid_argument("ik run: " + why);
   o.keep_history = stride > 0;
   if (o.restarts > 0) o.restart_seed = restart_seed_of(run);
   switch (run.problem) {
