@@ -467,3 +467,18 @@ TEST(ClusterSolutions, GreedyInInputOrderModTwoPi) {
 }
 
 }  // namespace
+
+TEST(ChainIk, OptionsAreCheckedFirst) {
+  const Chain c = planar_chain(planar_bars({1, 1, 1}, {5, 2, 1}, 0.1), 9.81);
+  ChainIkTask t;
+  t.kind = ChainTask::planar_position;
+  t.position = {1.5, 1.0, 0.0};
+  ChainIkResult r;
+  ChainIkWorkspace ws;
+  Options o;
+  o.tolerance = -1.0;
+  EXPECT_THROW(solve_chain(c, t, VecN::Constant(3, 0.3), o, r, ws), std::invalid_argument);
+  o = Options{};
+  solve_chain(c, t, VecN::Constant(3, 0.3), o, r, ws);
+  EXPECT_EQ(r.status, Status::converged);
+}

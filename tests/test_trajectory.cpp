@@ -1,6 +1,10 @@
 // Redundancy resolution runs: seed Table 4 rows, optimality of the local methods, statuses, history.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
 #include <Eigen/Eigenvalues>
 
 #include "methods/resolution.hpp"
@@ -237,6 +241,24 @@ TEST(Trajectory, NamesRoundTrip) {
   }
   TrajectoryMethod x;
   EXPECT_FALSE(parse("local_weigthed", x));
+}
+
+TEST(Trajectory, OptionsAreCheckedFirst) {
+  // Options::IsValid at the entry point: a field outside its rule is the caller's bug, named
+  for (auto bad : {+[](TrajectoryOptions& o) { o.torque_bound = -1.0; },
+                   +[](TrajectoryOptions& o) { o.tracking_bound = std::nan(""); },
+                   +[](TrajectoryOptions& o) { o.k = std::numeric_limits<double>::infinity(); }}) {
+    TrajectoryOptions o = find_seed_case("1a")->options();
+    bad(o);
+    std::string why;
+    ASSERT_FALSE(o.IsValid(&why));
+    try {
+      simulate(PlanarArm3::seed(), seed_square(), o);
+      ADD_FAILURE() << "no throw for " << why;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Trajectory, SampledPathMustMatchTheStep) {
