@@ -80,7 +80,9 @@ TEST(JournalGather, SmallAndLargeChunkWritesReadBackBeforeAndAfterCommits) {
         const std::size_t back = g() % 3 == 0 ? g() % (r + 1) : r;
         EXPECT_EQ(read_row(d[k], back, widths[k]), row(back, widths[k])) << "d" << k << " row " << back << " after " << r;
       }
-      if (r % 37 == 36) ASSERT_GE(H5Fflush(f, H5F_SCOPE_LOCAL), 0);  // a commit now and then
+      if (r % 37 == 36) {
+        ASSERT_GE(H5Fflush(f, H5F_SCOPE_LOCAL), 0);  // a commit now and then
+      }
     }
     for (hid_t x : d) H5Dclose(x);
     H5Pclose(dapl);

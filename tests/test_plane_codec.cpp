@@ -80,7 +80,9 @@ TEST(PlaneCodec, RunCoderInflatesToItsInput) {
         const auto back = inflate_raw(out.data(), m, n);
         ASSERT_EQ(back.size(), n) << "distance " << distance << " n " << n << " kind " << kind;
         EXPECT_TRUE(back == src) << "distance " << distance << " n " << n << " kind " << kind;
-        if (kind == 1 && n >= 5000 && distance <= 5) EXPECT_LT(m, n / 20) << "runs should code to a few bytes per 258";
+        if (kind == 1 && n >= 5000 && distance <= 5) {
+          EXPECT_LT(m, n / 20) << "runs should code to a few bytes per 258";
+        }
       }
     }
 }
@@ -117,7 +119,9 @@ TEST(PlaneCodec, LongChunksDecodeWithZlibAtEveryLevel) {
           if (i < a.data.size()) ASSERT_EQ(0, std::memcmp(&x, &a.data[i], 8)) << a.name << " value " << i;
           else ASSERT_TRUE(std::isnan(x)) << a.name << " padding " << i;
         }
-        if (a.name == "q" && chunk_rows == a.rows) EXPECT_LT(c.bytes.size(), 8 * n * 15 / 16) << "level " << level;
+        if (a.name == "q" && chunk_rows == a.rows) {
+          EXPECT_LT(c.bytes.size(), 8 * n * 15 / 16) << "level " << level;
+        }
         const RunHistory back = decode_history(e);
         ASSERT_EQ(back.arrays.size(), 1u);
         EXPECT_EQ(0, std::memcmp(back.arrays[0].data.data(), a.data.data(), 8 * a.data.size()));

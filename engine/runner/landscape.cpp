@@ -7,11 +7,6 @@ namespace ks {
 namespace {
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-double number(const Cell& c) {
-  if (const double* d = std::get_if<double>(&c)) return *d;
-  if (const std::int64_t* i = std::get_if<std::int64_t>(&c)) return static_cast<double>(*i);
-  return kNaN;
-}
 }  // namespace
 
 LandscapeGrid::LandscapeGrid(const Block& block) : block_(block) {
@@ -51,7 +46,7 @@ void LandscapeGrid::add(std::uint64_t local, const Record& row, const StudySchem
       case Source::is_ok: v = code == 0.0 ? 1.0 : 0.0; break;  // ok / converged are code 0
       case Source::status_code: v = code; break;
       case Source::column:
-        v = number(row.cells[schema.metric_column[b][metric_index_[m]]]);
+        v = cell_number(row.cells[schema.metric_column[b][metric_index_[m]]]);
         if (std::holds_alternative<std::int64_t>(row.cells[schema.metric_column[b][metric_index_[m]]]) && v == -1.0)
           v = kNaN;  // the missing integer (solution -1: none reached)
         break;
@@ -75,7 +70,7 @@ store::LandscapeSpec LandscapeGrid::spec() const {
         a.values.push_back(static_cast<double>(i));
         labels += (i ? "," : "") + *str;
       } else {
-        a.values.push_back(number(first.values[i]));
+        a.values.push_back(cell_number(first.values[i]));
       }
     }
     if (!labels.empty()) a.unit = "labels:" + labels;

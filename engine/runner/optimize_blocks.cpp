@@ -24,11 +24,6 @@ namespace {
 constexpr double kRad2Deg = 180.0 / std::numbers::pi;
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-double cell_num(const Cell& c) {
-  if (const double* d = std::get_if<double>(&c)) return *d;
-  if (const std::int64_t* i = std::get_if<std::int64_t>(&c)) return static_cast<double>(*i);
-  return kNaN;
-}
 
 /// Everything an evaluation needs, shared by the objective's copies (thread-safe: per-thread
 /// workspaces). Evaluates typed runs: the evaluation set's specs with the variables set to x.
@@ -98,7 +93,7 @@ struct Evaluator {
   std::pair<double, std::string> run_value(std::size_t run, std::span<const double> x, int stride, RunOutcome* keep) {
     const RunSpec r = run_at(run, x);
     RunOutcome o = execute(scenario, r, stride, workspaces.local());
-    const double v = value_of(r, o.good(), o.status(), [&](const MetricDef& m) { return cell_num(m.get(o)); });
+    const double v = value_of(r, o.good(), o.status(), [&](const MetricDef& m) { return cell_number(m.get(o)); });
     std::string status(o.status());
     if (keep) *keep = std::move(o);
     return {v, std::move(status)};
@@ -207,7 +202,7 @@ opt::Problem make_problem(const Study& study, std::size_t index) {
   for (std::size_t i = 0; i < ob.variables.size(); ++i) {
     const auto& v = ob.variables[i];
     opt::Variable var{v.name, v.unit, v.lower, v.upper, v.start};
-    if (std::isnan(var.start)) var.start = cell_num(e->vars[i]->get(base));  // the block's value (the preset's)
+    if (std::isnan(var.start)) var.start = cell_number(e->vars[i]->get(base));  // the block's value (the preset's)
     p.variables.push_back(std::move(var));
   }
   p.objective = [e](std::span<const double> x) { return e->evaluate(x); };
@@ -270,7 +265,7 @@ std::vector<opt::Start> best_cells(const Study& study, std::size_t index, const 
   for (std::uint64_t r : idx) {
     if (static_cast<int>(out.size()) >= ob.polish_best) break;
     opt::Start s;
-    for (const auto& v : ob.variables) s.x.push_back(cell_num(find_param(lb.table(), v.name)->get(e->set[r])));
+    for (const auto& v : ob.variables) s.x.push_back(cell_number(find_param(lb.table(), v.name)->get(e->set[r])));
     s.value = value[r];
     s.status = status[r];
     s.run = static_cast<std::int64_t>(first + r);
@@ -358,7 +353,7 @@ OptimizeResult run_optimization(const Study& study, std::size_t index, const Opt
   if (!s.best_x.empty()) {
     RunOutcome o;
     e->run_value(0, s.best_x, 1, &o);
-    for (const MetricDef& m : e->block->metrics()) r.best_metrics.emplace_back(m.name, cell_num(m.get(o)));
+    for (const MetricDef& m : e->block->metrics()) r.best_metrics.emplace_back(m.name, cell_number(m.get(o)));
     r.history = std::move(o.history);
   }
   // A seed row: the thesis' optimum and figures, and this objective at the thesis' printed point.

@@ -34,11 +34,6 @@ struct Batch {
   std::vector<Job> jobs;
 };
 
-double as_f64(const Cell& c) {
-  if (const double* d = std::get_if<double>(&c)) return *d;
-  if (const std::int64_t* i = std::get_if<std::int64_t>(&c)) return static_cast<double>(*i);
-  return std::numeric_limits<double>::quiet_NaN();
-}
 const std::string& as_str(const Cell& c) {
   static const std::string empty;
   const std::string* s = std::get_if<std::string>(&c);
@@ -92,7 +87,7 @@ class Accumulator {
     const bool good = status == statuses(block.kind()).front();
     const Columns& c = columns_[ref.block];
     if (good)
-      consider_best(br, rank_key(as_f64(row.cells[c.value]), c.tie == Columns::npos ? 0.0 : as_f64(row.cells[c.tie]), id),
+      consider_best(br, rank_key(cell_number(row.cells[c.value]), c.tie == Columns::npos ? 0.0 : cell_number(row.cells[c.tie]), id),
                     row, ref.block);
     if (traj) {
       const std::string& preset = as_str(row.cells[c.preset]);
@@ -101,8 +96,8 @@ class Accumulator {
         s.preset = preset;
         s.inertia = c.inertia == Columns::npos ? "chain" : as_str(row.cells[c.inertia]);
         s.status = status;
-        s.E = as_f64(row.cells[c.value]);
-        for (int j = 0; j < 3; ++j) s.tau[j] = as_f64(row.cells[c.tau[j]]);
+        s.E = cell_number(row.cells[c.value]);
+        for (int j = 0; j < 3; ++j) s.tau[j] = cell_number(row.cells[c.tau[j]]);
         seed_[id] = std::move(s);
       }
     }

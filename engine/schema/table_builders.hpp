@@ -8,11 +8,6 @@
 
 namespace ks::schema_detail {
 
-inline double number(const Cell& c) {
-  if (const double* d = std::get_if<double>(&c)) return *d;
-  if (const std::int64_t* i = std::get_if<std::int64_t>(&c)) return static_cast<double>(*i);
-  return std::numeric_limits<double>::quiet_NaN();
-}
 
 /// A real parameter whose value is the double `field(run)` (field: a generic lambda returning a
 /// reference into the run struct).
@@ -28,7 +23,7 @@ ParamDef real(std::string name, FileUnit fu, std::string unit, Domain domain, st
   p.description = std::move(description);
   p.effect = std::move(effect);
   p.get = [field](const RunSpec& r) { return Cell(double(field(std::get<Run>(r)))); };
-  p.set = [field](RunSpec& r, const Cell& c) { field(std::get<Run>(r)) = number(c); };
+  p.set = [field](RunSpec& r, const Cell& c) { field(std::get<Run>(r)) = cell_number(c); };
   return p;
 }
 

@@ -2,6 +2,7 @@
 // What flows from a run to the store: a row of named, typed cells and the run's history arrays.
 // The store is the only code that knows HDF5; runs only fill these plain structures.
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -12,6 +13,12 @@ namespace ks {
 enum class CellType { f64, i64, str };
 /// One value of a /runs column. Missing values: NaN (f64), -1 (i64), "" (str).
 using Cell = std::variant<double, std::int64_t, std::string>;
+/// A numeric cell as a double (an integer converted); NaN for a text cell.
+inline double cell_number(const Cell& c) {
+  if (const double* d = std::get_if<double>(&c)) return *d;
+  if (const std::int64_t* i = std::get_if<std::int64_t>(&c)) return static_cast<double>(*i);
+  return std::numeric_limits<double>::quiet_NaN();
+}
 
 /// What a /runs column holds (stored as its `role` attribute: "parameter", "metric", "bookkeeping").
 enum class Role { parameter, metric, bookkeeping };
