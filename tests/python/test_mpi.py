@@ -200,14 +200,23 @@ class ResumeAdoptsRecordedHistories(Base):
     the file (or its shards) records, as the same command without mpirun does. The files are begun
     with --histories every=3, not the study's every=5."""
 
-    def setUp(self):
-        super().setUp()
-        self.study = self.write("long.toml", LONG)
-        self.ref = os.path.join(self.dir, "ref.h5")
+    @classmethod
+    def setUpClass(cls):
+        super().setUpClass()
+        cls.shared = tempfile.TemporaryDirectory()
+        cls.study = os.path.join(cls.shared.name, "long.toml")
+        with open(cls.study, "w") as f:
+            f.write(LONG)
+        cls.ref = os.path.join(cls.shared.name, "ref.h5")
         t0 = time.time()
-        r = run("run", self.study, "-o", self.ref, "-q", "--histories", "every=3", "--threads", "1")
-        self.ref_seconds = time.time() - t0
-        self.assertEqual(r.returncode, 0, r.stderr)
+        r = run("run", cls.study, "-o", cls.ref, "-q", "--histories", "every=3", "--threads", "1")
+        cls.ref_seconds = time.time() - t0
+        assert r.returncode == 0, r.stderr
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.shared.cleanup()
+        super().tearDownClass()
 
     def resume_and_compare(self, out):
         r = mpirun("run", self.study, "-o", out, "-q", "--threads", "1", "--resume")
