@@ -95,8 +95,7 @@ class Resources(TempDirTest):
 
     def test_a_file_larger_than_the_free_space_is_not_started(self):
         # 2e6 rows need more than the free space of any small test disk: refused before creating.
-        study = self.write("big.toml", "[[block]]\nname = \"b\"\nkind = \"ik\"\n[block.axes]\n"
-                                       "q0_1 = { from = 0, to = 1, count = 2000 }\nq0_2 = { from = 0, to = 1, count = 1000 }\n")
+        study = self.write("big.toml", BIG_STUDY)
         with Tmpfs(self, "1m") as mnt:
             out = os.path.join(mnt, "big.h5")
             r = run("run", study, "-o", out, "-q")
@@ -172,6 +171,11 @@ class HistoryMemory(TempDirTest):
             # every stride-th sample from the first, and the last one
             self.assertEqual(len(t), (samples + stride - 1) // stride + (1 if (samples - 1) % stride else 0))
             self.assertEqual(t[-1, 0], 6000.0)
+
+
+# 2e6 IK runs: their /runs rows alone need more than the free space of a small test disk.
+BIG_STUDY = ("[[block]]\nname = \"b\"\nkind = \"ik\"\n[block.axes]\n"
+             "q0_1 = { from = 0, to = 1, count = 2000 }\nq0_2 = { from = 0, to = 1, count = 1000 }\n")
 
 
 class Tmpfs:

@@ -8,6 +8,7 @@ usage: /usr/bin/python3 test_kinds.py KINESWEEP_BINARY ANALYSIS_DIR
 import os
 import subprocess
 import sys
+import tempfile
 import unittest
 
 import h5py
@@ -50,14 +51,17 @@ def strings(values):
 class Kinds(TempDirTest):
     @classmethod
     def setUpClass(cls):
-        super().setUpClass()
+        cls.shared = tempfile.TemporaryDirectory()
+        study = os.path.join(cls.shared.name, "kinds.toml")
+        with open(study, "w") as f:
+            f.write(STUDY)
+        cls.out = os.path.join(cls.shared.name, "kinds.h5")
+        r = subprocess.run([KS, "run", study, "-o", cls.out, "-q"], capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr
 
-    def setUp(self):
-        super().setUp()
-        study = self.write("kinds.toml", STUDY)
-        self.out = os.path.join(self.dir, "kinds.h5")
-        r = subprocess.run([KS, "run", study, "-o", self.out, "-q"], capture_output=True, text=True, timeout=300)
-        self.assertEqual(r.returncode, 0, r.stderr)
+    @classmethod
+    def tearDownClass(cls):
+        cls.shared.cleanup()
 
     def test_the_file_records_each_kind_it_holds(self):
         import kstypes

@@ -259,9 +259,8 @@ class ResumeAdoptsRecordedHistories(Base):
 
 class FreeSpace(Base):
     def test_a_file_and_shards_larger_than_the_free_space_are_not_started(self):
-        from test_cli_guards import Tmpfs
-        study = self.write("big.toml", "[[block]]\nname = \"b\"\nkind = \"ik\"\n[block.axes]\n"
-                                       "q0_1 = { from = 0, to = 1, count = 2000 }\nq0_2 = { from = 0, to = 1, count = 1000 }\n")
+        from test_cli_guards import BIG_STUDY, Tmpfs
+        study = self.write("big.toml", BIG_STUDY)
         with Tmpfs(self, "1m") as mnt:
             out = os.path.join(mnt, "big.h5")
             r = mpirun("run", study, "-o", out, "-q")
