@@ -1,8 +1,6 @@
 #pragma once
 // Definitions of ik/solve.hpp. Include this (instead of solve.hpp) in the one .cpp that instantiates
 // solve() for a new problem description; the engine's problems are instantiated in ik/solve.cpp.
-#include <Eigen/Cholesky>
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -11,6 +9,7 @@
 #include <random>
 
 #include "ik/cycle_watch.hpp"
+#include "ik/small_dense.hpp"
 #include "ik/solve.hpp"
 
 namespace ks::ik {
@@ -47,7 +46,7 @@ inline double rcond1(const Mat<N, N>& A) {
     const double ni = C.cwiseAbs().rowwise().sum().maxCoeff();
     return det == 0.0 ? 0.0 : std::abs(det) / (n1 * ni);
   } else {
-    return Eigen::PartialPivLU<Mat<N, N>>(A).rcond();
+    return lu_rcond<N>(A);
   }
 }
 
@@ -57,15 +56,16 @@ inline double rcond1(const Mat<N, N>& A) {
 template <int M, int N>
 inline double newton_solve(const Mat<M, N>& A, const Vec<M>& b, Vec<N>& x) {
   if constexpr (M == N) {
-    x = Eigen::PartialPivLU<Mat<N, N>>(A).solve(b);
+    x = SmallLu<N>(A).solve(b);
     return rcond1<N>(A);
   } else if constexpr (M < N) {
     const Mat<M, M> G = A * A.transpose();
-    x = A.transpose() * Eigen::LLT<Mat<M, M>>(G).solve(b);
+    const Vec<M> y = SmallLlt<M>(G).solve(b);
+    x = A.transpose() * y;
     return std::sqrt(rcond1<M>(G));
   } else {
     const Mat<N, N> G = A.transpose() * A;
-    x = Eigen::LLT<Mat<N, N>>(G).solve(A.transpose() * b);
+    x = SmallLlt<N>(G).solve(A.transpose() * b);
     return std::sqrt(rcond1<N>(G));
   }
 }
@@ -213,8 +213,8 @@ void solve_attempt(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Su
         MatNN A = J.transpose() * J;
         A.diagonal().array() += o.lambda;
         if (!rcond_ok(detail::rcond1<N>(A))) return finish(Status::singular);
-        const Eigen::LLT<MatNN> llt(A);
-        if (llt.info() != Eigen::Success) return finish(Status::singular);
+        const SmallLlt<N> llt(A);
+        if (!llt.ok()) return finish(Status::singular);
         delta = -llt.solve(J.transpose() * F);
         lambda_used = o.lambda;
         break;
@@ -227,8 +227,8 @@ void solve_attempt(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Su
           MatNN Am = A;
           Am.diagonal().array() += mu;
           if (!rcond_ok(detail::rcond1<N>(Am))) return finish(Status::singular);
-          const Eigen::LLT<MatNN> llt(Am);
-          if (llt.info() != Eigen::Success) return finish(Status::singular);
+          const SmallLlt<N> llt(Am);
+          if (!llt.ok()) return finish(Status::singular);
           delta = -llt.solve(g);
           if (!(delta.norm() >= o.step_floor)) return finish(Status::stalled);
           double predicted = 0.0;  // 2 (L(0) - L(d)), L(d) = |F + J d|^2 / 2, for the step d taken
@@ -268,10 +268,10 @@ void solve_attempt(const P& pb, const Vec<P::unknowns>& q0, const Options& o, Su
           MatNN Ht;  // H^T, H = dJ/dq1: H(i, j) = d2F_i/dq_j dq_1
           for (int i = 0; i < M; ++i) Ht.col(i) = D[i].col(0);
           if (!rcond_ok(detail::rcond1<N>(J))) return finish(Status::singular);
-          const Eigen::PartialPivLU<MatNN> lu(J);
+          const SmallLu<N> lu(J);
           const MatNN B = MatNN::Identity() - 0.5 * lu.solve(Ht);  // I - L/2, L = J^-1 H^T
           if (!rcond_ok(detail::rcond1<N>(B))) return finish(Status::singular);
-          const Eigen::PartialPivLU<MatNN> luB(B);
+          const SmallLu<N> luB(B);
           delta = -luB.solve(lu.solve(F));
         }
         break;
