@@ -246,6 +246,7 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
     }
     // metrics of this sample
     SampleValues<double> v;
+    v.n = dof, v.q = q.data(), v.qd = qd.data(), v.tau = tau.data();
     v.tt = tt, v.ff = ff, v.p6 = p6;
     v.qf = e.Mf.inverse_quadratic_form(z.data()), v.det = 1.0;  // tau^T M^-1 tau
     if constexpr (P == m && R != Resolution::nonredundant)

@@ -245,7 +245,10 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
       break;
     }
     // metrics of this sample
+    double qa[N], qda[N], taua[N];  // in the chain's coordinates q = sigma u
+    for (int j = 0; j < N; ++j) qa[j] = k.sigma[j] * q[j], qda[j] = k.sigma[j] * qd[j], taua[j] = k.sigma[j] * tau[j];
     SampleValues<double> v;
+    v.n = N, v.q = qa, v.qd = qda, v.tau = taua;
     v.tt = tt, v.ff = 0.0, v.p6 = p6;
     double z[N];
     for (int j = 0; j < N; ++j) z[j] = tau[j];
@@ -261,11 +264,7 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
     v.alpha = alpha;
     const bool off = sums.add(i, t, v, abs_tau, N, keep);
     bool beyond = false;
-    if (shape.limits) {  // in the chain's coordinates q = sigma u
-      double qa[N], qda[N];
-      for (int j = 0; j < N; ++j) qa[j] = k.sigma[j] * q[j], qda[j] = k.sigma[j] * qd[j];
-      beyond = sums.limits(qa, qda, tau, N);
-    }
+    if (shape.limits) beyond = sums.limits(qa, qda, tau, N);
     sums.mark(off, beyond);
     if (history && (i % history->stride == 0 || i + 1 == n)) {
       const Eigen::Index col = history->size++;

@@ -24,6 +24,9 @@ TrajectoryMetrics finish_run(const RunSums& s, const RunShape& shape, const Traj
     out.max_tracking_error = std::sqrt(s.max_err2);
     out.mean_tracking_error = s.sum_err / d;
     if (shape.orientation) out.max_orientation_error = s.max_orient;
+    for_each_sample_metric([&](const auto& m, int k) {
+      out.sampled[k] = m.reduce == Reduce::mean ? s.sampled[k] / d : s.sampled[k];
+    });
     if (const LimitTable* L = shape.limits) {
       if (L->any_position) out.max_q_limit_ratio = s.ratio_q;
       if (L->any_velocity) out.max_qd_limit_ratio = s.ratio_qd;
@@ -37,6 +40,7 @@ TrajectoryMetrics finish_run(const RunSums& s, const RunShape& shape, const Traj
     out.max_tracking_error = out.mean_tracking_error = out.max_orientation_error = nan;
     out.max_q_limit_ratio = out.max_qd_limit_ratio = out.max_tau_limit_ratio = nan;
     out.final_alpha = nan;
+    out.sampled.fill(nan);
     out.tau_inf.setConstant(shape.joints, nan);
   }
   return out;

@@ -2,14 +2,16 @@
 // The per-sample accumulator of every trajectory loop (the closed-form 3R kernel over SIMD lanes, the
 // chain loop, the fixed-size planar-chain loop): each sample's values enter the run's sums here, the
 // tracking bound and the joint limits are checked here, and finish_run turns the sums into
-// TrajectoryMetrics. A metric is one field of RunSums, the line of SampleSums::add that updates it,
-// and the line of finish_run that reads it.
+// TrajectoryMetrics. A metric that reduces one per-sample value is an entry of the table in
+// methods/sample_metrics.hpp; the others are written out here: a field of RunSums, the line of
+// SampleSums::add that updates it and the line of finish_run that reads it.
 #include <cmath>
 #include <cstddef>
 #include <limits>
 #include <type_traits>
 
 #include "methods/run_sums.hpp"
+#include "methods/sample_metrics.hpp"
 #include "methods/trajectory.hpp"
 #include "model/chain.hpp"
 #include "model/lanes.hpp"
@@ -53,19 +55,7 @@ struct RunSums {
   double min_w2 = 0, max_err2 = 0, max_orient = 0, last_alpha = 0, last_t = 0;
   double ratio_q = 0, ratio_qd = 0, ratio_tau = 0;
   TrapezoidSums trapezoid;
-};
-
-/// What one sample gives the sums, per lane (T: double or a lane type of model/lanes.hpp).
-template <class T>
-struct SampleValues {
-  T tt;         ///< tau^T tau over the revolute joints [N^2 m^2]
-  T ff;         ///< f^T f over the prismatic joints [N^2] (0 when none)
-  T qf, det;    ///< tau^T M^-1 tau = qf / det
-  T p6;         ///< sum (tau_i qd_i)^2 [W^2]
-  T w2;         ///< squared manipulability
-  T err2;       ///< squared tip position error [m^2]
-  T orient;     ///< |orientation error| [rad] (0 for position tasks)
-  T alpha;      ///< tip angle [rad] (NaN for spatial tasks)
+  double sampled[kSampleMetricCount > 0 ? kSampleMetricCount : 1] = {};  ///< the table's reductions
 };
 
 /// The running sums of a loop over the lanes of T, joints up to N. `keep(updated, old)` (the loop's)
@@ -81,6 +71,7 @@ class SampleSums {
   SampleSums(const T& tracking_bound, const T& orientation_bound, const LimitTable* limits = nullptr)
       : bound2_(tracking_bound * tracking_bound), obound_(orientation_bound), limits_(limits) {
     for (T& x : inf) x = T(0.0);
+    for_each_sample_metric([&](const auto& m, int k) { sampled_[k] = T(reduce_start(m.reduce)); });
   }
 
   /// Adds sample i at time t with per-joint |tau_j| in abs_tau (n joints); returns the lanes that
@@ -112,6 +103,13 @@ class SampleSums {
     last_t = keep(T(t), last_t);
     last_alpha = keep(v.alpha, last_alpha);
     done = keep(done + 1.0, done);
+    for_each_sample_metric([&](const auto& m, int k) {
+      const T x = m.value(v);
+      sampled_[k] = keep(m.reduce == Reduce::mean ? sampled_[k] + x
+                         : m.reduce == Reduce::max ? vmax(sampled_[k], x)
+                                                   : vmin(sampled_[k], x),
+                         sampled_[k]);
+    });
     return (v.err2 > bound2_) | (v.orient > obound_);
   }
 
@@ -164,6 +162,7 @@ class SampleSums {
     TrapezoidSums& z = r.trapezoid;
     z.f5 = lane(f5, l), z.f6 = lane(f6, l), z.first5 = lane(first5, l), z.first6 = lane(first6, l);
     z.last5 = lane(last5, l), z.last6 = lane(last6, l);
+    for (int k = 0; k < kSampleMetricCount; ++k) r.sampled[k] = lane(sampled_[k], l);
     return r;
   }
 
@@ -176,6 +175,7 @@ class SampleSums {
   T min_w2 = std::numeric_limits<double>::infinity(), max_err2 = 0.0, max_orient = 0.0;
   T f5 = 0.0, f6 = 0.0, first5 = 0.0, first6 = 0.0, last5 = 0.0, last6 = 0.0;
   T done = 0.0, last_t = 0.0, last_alpha = 0.0;
+  T sampled_[kSampleMetricCount > 0 ? kSampleMetricCount : 1];
   double ratio_q = 0, ratio_qd = 0, ratio_tau = 0;  // T = double only
   T bound2_, obound_;
   const LimitTable* limits_;

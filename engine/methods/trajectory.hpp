@@ -2,6 +2,7 @@
 // Redundancy resolution along a path (seed 000, chapter 3): one run = one simulation of the arm
 // following the path from rest, with joint accelerations chosen by a method, integrated open loop.
 #include <Eigen/Core>
+#include <array>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -100,6 +101,9 @@ struct TrajectoryOptions {
   bool IsValid(std::string* why = nullptr) const;
 };
 
+/// Room in TrajectoryMetrics for the metrics of methods/sample_metrics.hpp's table.
+inline constexpr int kMaxSampleMetrics = 8;
+
 /// Figures of merit of one run (seed Eq. 60 and seed 002's measures).
 struct TrajectoryMetrics {
   RunStatus status = RunStatus::ok;
@@ -124,6 +128,15 @@ struct TrajectoryMetrics {
   double E_force = std::numeric_limits<double>::quiet_NaN();
   double final_alpha = 0.0;           ///< alpha at the last sample [rad]
   double stop_time = 0.0;             ///< time of the last sample computed [s]
+  /// the metrics of methods/sample_metrics.hpp's table, in its order (NaN: no sample, or not a metric)
+  std::array<double, kMaxSampleMetrics> sampled = nan_array();
+
+ private:
+  static constexpr std::array<double, kMaxSampleMetrics> nan_array() {
+    std::array<double, kMaxSampleMetrics> a{};
+    a.fill(std::numeric_limits<double>::quiet_NaN());
+    return a;
+  }
 };
 
 /// The fewest samples per path segment (segment duration / dt) a run needs to follow its path: with

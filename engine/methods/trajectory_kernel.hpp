@@ -273,8 +273,10 @@ void run(const Shared& s, const Runs& in, Sums* out) {
     const T ex = e.J(1, 0) - xa[0], ey = -e.J(0, 0) - xa[1];  // tip = (x1, y1) = (J10, -J00)
     const T p0 = tau0 * qd[0], p1 = tau1 * qd[1], p2 = tau2 * qd[2];
     const T alpha = q[0] + q[1] + q[2];
-    const SampleValues<T> v{tt, T(0.0), e.Mi.P.quadratic_form(tau), e.Mi.det, p0 * p0 + p1 * p1 + p2 * p2,
-                            e.w2, ex * ex + ey * ey, vertex ? vabs(alpha - x.alpha_d) : T(0.0), alpha};
+    const T taus[3] = {tau0, tau1, tau2};
+    const SampleValues<T> v{3, &q[0], &qd[0], taus, tt, T(0.0), e.Mi.P.quadratic_form(tau), e.Mi.det,
+                            p0 * p0 + p1 * p1 + p2 * p2, e.w2, ex * ex + ey * ey,
+                            vertex ? vabs(alpha - x.alpha_d) : T(0.0), alpha};
     const M off = sums.add(i, t, v, a, 3, keep) & active;
     sums.mark(off);
     if (in.any_history) {

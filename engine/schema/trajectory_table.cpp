@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "methods/sample_metrics.hpp"
 #include "methods/seed_cases.hpp"
 #include "schema/kind_tables.hpp"
 #include "schema/table_builders.hpp"
@@ -165,6 +166,10 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
                             return r.tau_inf.hasNaN() ? std::numeric_limits<double>::quiet_NaN() : a;
                           }));
   }
+  for_each_sample_metric([&](const auto& e, int k) {
+    m.push_back(metric<M>(std::string(e.name), CellType::f64, std::string(e.unit), std::string(e.description),
+                          e.gridded, [k](const M& r) { return r.sampled[k]; }));
+  });
   if (robot.chain) {
     m.push_back(metric<M>("max_q_limit_ratio", CellType::f64, "",
                           "max over samples and joints of |q - mid| / half range (1 = at a position limit; NaN: none)",
