@@ -37,7 +37,6 @@ struct Evaluator {
   std::vector<const ParamDef*> vars;         // the variables' table entries
   std::vector<std::pair<const MetricDef*, double>> terms;  // metric (nullptr: failure_rate), weight
   const MetricDef* stop_time = nullptr;      // trajectory: penalty of runs that stopped early
-  const MetricDef* iterations = nullptr;     // ik: counted as max_iter when not converged
   double duration = 0.0;
   bool reach_varies = false;
   tbb::enumerable_thread_specific<RunWorkspace> workspaces;
@@ -81,7 +80,7 @@ struct Evaluator {
     } else {
       for (const auto& [m, w] : terms) {
         if (!m) v += w * (good ? 0.0 : 1.0);
-        else if (m == iterations && !good) v += w * std::get<IkRun>(r).options.max_iter;
+        else if (m->if_failed && !good) v += w * m->if_failed(r);
         else v += w * metric(*m);
       }
     }
@@ -150,7 +149,6 @@ std::shared_ptr<Evaluator> make_evaluator(const Study& study, std::size_t index,
     else throw std::invalid_argument("optimization " + ob.name + ": no metric " + m);
   }
   e->stop_time = metric("stop_time");
-  e->iterations = metric("iterations");
   for (double d : study.task.durations) e->duration += d;
   if (e->duration <= 0) e->duration = 1.0;
   return e;
@@ -395,12 +393,17 @@ void print_optimization(std::ostream& os, const Study& study, std::size_t index,
   std::snprintf(line, sizeof line, "  kinesweep: %s = %.6g at %s [%s]\n", ob.objective_text.c_str(), r.best_objective,
                 fmt_x(r.variables, r.units, r.best_x).c_str(), r.best_status.c_str());
   os << line;
-  for (const auto& [k, v] : r.best_metrics)
-    if (k == "E" || k == "tau1_inf" || k == "tau2_inf" || k == "tau3_inf") {
-      std::snprintf(line, sizeof line, "    %s = %.2f", k.c_str(), v);
-      os << line;
-    }
-  if (!r.best_metrics.empty() && r.kind == "trajectory") os << '\n';
+  BlockKind kind = BlockKind::trajectory;
+  bool shown = false;
+  if (parse(r.kind, kind))
+    for (std::string_view key : key_metrics(kind))
+      for (const auto& [k, v] : r.best_metrics)
+        if (k == key) {
+          std::snprintf(line, sizeof line, "    %s = %.6g", k.c_str(), v);
+          os << line;
+          shown = true;
+        }
+  if (shown) os << '\n';
   if (const SeedCase* c = ob.preset.empty() ? nullptr : find_seed_case(ob.preset)) {
     std::vector<double> xt;
     for (const auto& [k, v] : r.reference)

@@ -110,9 +110,12 @@ std::vector<ParamDef> ik_params(const KindContext& ctx) {
 
 std::vector<MetricDef> ik_metrics(const KindContext& ctx) {
   using R = IkResult;
+  MetricDef iterations = metric<R>("iterations", CellType::i64, "",
+                                   "updates made (the seed's count; summed over restarts)", true,
+                                   [](const R& r) { return std::int64_t(r.iterations); });
+  iterations.if_failed = [](const RunSpec& r) { return double(std::get<IkRun>(r).options.max_iter); };
   std::vector<MetricDef> m{
-      metric<R>("iterations", CellType::i64, "", "updates made (the seed's count; summed over restarts)", true,
-                [](const R& r) { return std::int64_t(r.iterations); }),
+      iterations,
       metric<R>("error", CellType::f64, "problem units", "||F|| at the final iterate (mm for scara, m/rad for planar3r)",
                 true, [](const R& r) { return r.error; }),
       metric<R>("solution", CellType::i64, "", "index of the known exact solution reached (mod 2 pi), -1 if none",

@@ -87,6 +87,9 @@ struct MetricDef {
   std::string description;
   bool gridded = false;  ///< also kept in /landscapes
   std::function<Cell(const RunOutcome&)> get;
+  /// The value an [[optimize]] objective term takes for a run whose status is not the good one
+  /// (empty: the metric's own value): e.g. a failed IK run counts max_iter iterations.
+  std::function<double(const RunSpec&)> if_failed;
   ColumnSpec column(BlockKind kind) const;
 };
 
