@@ -1,8 +1,8 @@
 # Install rules (included from engine/CMakeLists.txt, after the engine's targets and the CLI).
 #   bin/kinesweep
 #   lib/libks_*.a, include/kinesweep/<part>/*.hpp, lib/cmake/kinesweep/ (find_package(kinesweep))
-#   share/kinesweep/analysis/ (the plot scripts with ksread beside them), share/kinesweep/studies/
-#   lib/python3/dist-packages/ (ksread and the modules it uses, for `import ksread`)
+#   share/kinesweep/studies/, share/doc/kinesweep/analysis.md
+#   lib/python3.X/dist-packages/kinesweep/ (the Python package: `python3 -m kinesweep.plot_cases FILE`)
 #   share/man/man1/kinesweep.1 (help2man, when installed), share/bash-completion/completions/kinesweep
 include(CMakePackageConfigHelpers)
 
@@ -30,13 +30,24 @@ write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/kinesweepConfigVers
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/kinesweepConfig.cmake ${CMAKE_CURRENT_BINARY_DIR}/kinesweepConfigVersion.cmake
         DESTINATION ${KS_CMAKE_DIR})
 
-# Analysis: the scripts run from share/kinesweep/analysis (they import ksread from beside them);
-# the reader modules are also importable from lib/python3/dist-packages.
-file(GLOB KS_ANALYSIS ${PROJECT_SOURCE_DIR}/analysis/*.py)
-file(GLOB KS_ANALYSIS_MODULES ${PROJECT_SOURCE_DIR}/analysis/ks*.py)
-install(PROGRAMS ${KS_ANALYSIS} DESTINATION ${CMAKE_INSTALL_DATADIR}/kinesweep/analysis)
-install(FILES ${PROJECT_SOURCE_DIR}/analysis/README.md DESTINATION ${CMAKE_INSTALL_DATADIR}/kinesweep/analysis)
-install(FILES ${KS_ANALYSIS_MODULES} DESTINATION ${CMAKE_INSTALL_LIBDIR}/python3/dist-packages)
+# Analysis: the Python package `kinesweep` (analysis/kinesweep), into the directory Debian's python3
+# searches for this prefix: lib/python3/dist-packages under /usr, lib/python3.X/dist-packages under
+# any other prefix (e.g. /usr/local). KINESWEEP_PYTHON_DIR overrides it.
+if(NOT DEFINED KINESWEEP_PYTHON_DIR)
+  set(KS_PY lib/python3/dist-packages)
+  if(NOT CMAKE_INSTALL_PREFIX STREQUAL "/usr")
+    find_program(KS_SYSTEM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+    if(KS_SYSTEM_PYTHON)
+      execute_process(COMMAND ${KS_SYSTEM_PYTHON} -c "import sys; print('%d.%d' % sys.version_info[:2])"
+                      OUTPUT_VARIABLE KS_PY_VERSION OUTPUT_STRIP_TRAILING_WHITESPACE)
+      set(KS_PY lib/python${KS_PY_VERSION}/dist-packages)
+    endif()
+  endif()
+  set(KINESWEEP_PYTHON_DIR ${KS_PY} CACHE STRING "where `cmake --install` puts the Python package (relative: under the prefix)")
+endif()
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/analysis/kinesweep DESTINATION ${KINESWEEP_PYTHON_DIR}
+        FILES_MATCHING PATTERN "*.py" PATTERN "__pycache__" EXCLUDE)
+install(FILES ${PROJECT_SOURCE_DIR}/analysis/README.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/kinesweep RENAME analysis.md)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/studies/ DESTINATION ${CMAKE_INSTALL_DATADIR}/kinesweep/studies)
 
 # Man page from --help of the program and of each subcommand.

@@ -301,7 +301,7 @@ class HistoryLayouts(unittest.TestCase):
 
     def test_report_history_ids(self):
         import ksread
-        import report_traces
+        from kinesweep import report_traces
         for name, path in self.files.items():
             with self.subTest(file=name), ksread.open_results(path) as r:
                 self.assertEqual(report_traces.history_ids(r), set(self.hist))

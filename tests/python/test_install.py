@@ -79,7 +79,9 @@ def engine_compilers():
 
 
 def python_dir():
-    return os.path.join(PREFIX, "lib", "python3", "dist-packages")
+    """Where the package went: lib/python3.X/dist-packages under a prefix other than /usr (Debian's
+    python3 searches it under /usr/local)."""
+    return os.path.join(PREFIX, "lib", "python%d.%d" % sys.version_info[:2], "dist-packages")
 
 
 class Install(unittest.TestCase):
@@ -87,9 +89,10 @@ class Install(unittest.TestCase):
         for rel in ["bin/kinesweep", "include/kinesweep/study/study.hpp", "include/kinesweep/runner/execute.hpp",
                     "lib/cmake/kinesweep/kinesweepConfig.cmake", "lib/cmake/kinesweep/kinesweepTargets.cmake",
                     "share/man/man1/kinesweep.1", "share/bash-completion/completions/kinesweep",
-                    "share/kinesweep/analysis/plot_landscape.py", "share/kinesweep/analysis/ksread.py",
                     "share/kinesweep/studies/thesis_table4.toml", "share/kinesweep/studies/robots/arm7.urdf",
-                    "lib/python3/dist-packages/ksread.py"]:
+                    "share/doc/kinesweep/analysis.md",
+                    os.path.join(python_dir(), "kinesweep", "__init__.py"),
+                    os.path.join(python_dir(), "kinesweep", "plot_landscape.py")]:
             self.assertTrue(os.path.exists(os.path.join(PREFIX, rel)), rel)
         self.assertTrue(glob.glob(os.path.join(PREFIX, "lib", "libks_*.a")))
         self.assertFalse(os.path.exists(os.path.join(PREFIX, "include", "kinesweep", "cli")))
@@ -119,12 +122,14 @@ class Install(unittest.TestCase):
         with h5py.File(h5, "r") as f:
             self.assertEqual(int(f["runs"]["done"][()].sum()), 21)
         env = dict(os.environ, PYTHONPATH=python_dir())
-        p = run(["/usr/bin/python3", "-c", "import ksread; r = ksread.open_results(%r); print(len(r.runs()))" % h5],
+        p = run(["/usr/bin/python3", "-c",
+                 "import kinesweep; r = kinesweep.open_results(%r); print(len(r.runs()), kinesweep.__file__)" % h5],
                 env=env, cwd=TMP.name)
-        self.assertEqual(p.stdout.strip(), "21")
+        n, where = p.stdout.split()
+        self.assertEqual(n, "21")
+        self.assertTrue(where.startswith(python_dir()), where)  # the installed package, not the source tree
         png = os.path.join(TMP.name, "cases.png")
-        run(["/usr/bin/python3", os.path.join(PREFIX, "share/kinesweep/analysis/plot_cases.py"), h5, "-o", png],
-            cwd=TMP.name)
+        run(["/usr/bin/python3", "-m", "kinesweep.plot_cases", h5, "-o", png], env=env, cwd=TMP.name)
         self.assertGreater(os.path.getsize(png), 1000)
 
     def test_man_page_renders(self):

@@ -3,8 +3,8 @@ the best runs of each block (parameters and metrics, units in the headers, angle
 Run with /usr/bin/python3."""
 import numpy as np
 
-import ksread
-from report_page import esc, fmt, table
+from kinesweep import read as ksread
+from kinesweep.report_page import esc, fmt, table
 
 
 class RunsView:

@@ -3,9 +3,9 @@ solution its run converged to (the converged final iterates named by kssolutions
 failed runs in their status colours; hover with the iterations and status. Run with /usr/bin/python3."""
 import numpy as np
 
-import ksread
-from kssolutions import cluster_solutions
-from report_grids import STATUS_COLOURS, Selection, arrange, axis_values, capped_note, esc, legend_square, \
+from kinesweep import read as ksread
+from kinesweep.solutions import cluster_solutions
+from kinesweep.report_grids import STATUS_COLOURS, Selection, arrange, axis_values, capped_note, esc, legend_square, \
     value_text
 
 SOLUTION_COLOURS = ["#1f77b4", "#2ca02c", "#ff7f0e", "#17becf", "#bcbd22", "#8c564b", "#e377c2", "#9edae5"]

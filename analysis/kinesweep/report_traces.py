@@ -3,10 +3,10 @@ time; IK: ‖F‖ against iteration) and the optimisation traces (objective agai
 stage, best so far). Plain plotly dicts. Run with /usr/bin/python3."""
 import numpy as np
 
-import ksread
-from report_grids import ordinal
-from report_page import esc, fmt, table
-from report_tables import varying_parameters
+from kinesweep import read as ksread
+from kinesweep.report_grids import ordinal
+from kinesweep.report_page import esc, fmt, table
+from kinesweep.report_tables import varying_parameters
 
 MAX_LINE_POINTS = 4000   # per history line: longer ones are drawn every n-th sample (said in the caption)
 MAX_EVALUATIONS = 20000  # optimisation evaluations drawn (every n-th beyond; the best so far is exact)

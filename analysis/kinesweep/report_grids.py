@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 
-from kstypes import STATUS_COLOURS  # noqa: F401 (used below)
-from report_page import esc, fmt
+from kinesweep.kinds import STATUS_COLOURS  # noqa: F401 (used below)
+from kinesweep.report_page import esc, fmt
 
 MAX_FRAMES = 24      # facets / dropdown entries per figure; further dims are held at the best cell
 MAX_FACETS = 4       # up to this many frames side by side, more in a dropdown

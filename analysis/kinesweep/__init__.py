@@ -1,0 +1,32 @@
+"""kinesweep's Python side: read results files (HDF5, engine/store/FORMAT.md), select runs, plot, report.
+
+    import kinesweep
+    r = kinesweep.open_results("results/thesis_table4.h5")   # kinesweep.read.Results
+    r.runs()["E"], r.to_pandas(), r.landscape("table4"), r.history(3)
+
+Submodules (each importable alone):
+    read        the reader (Results, open_results, read_runs, ...)
+    history     the /histories layouts of every format version
+    live        reading a file while a sweep writes it (the journal's public stamp)
+    kinds       run kinds' statuses, good statuses, ranking, colours (fallback for older files)
+    where       `kinesweep query --where` expressions on numpy columns
+    solutions   clustering joint vectors into named IK solutions
+    plotting    shared matplotlib helpers of the plot commands
+Commands (`/usr/bin/python3 -m kinesweep.NAME --help`; from a source tree, analysis/NAME.py is the same):
+    plot_landscape, plot_histories, plot_cases, plot_basins, plot_convergence, plot_runs,
+    compare_landscapes, report, make_examples
+`python3 -m kinesweep` lists them. The former module names (ksread, kswhere, kshistory, kslive,
+kstypes, kssolutions, ksplot) remain importable from analysis/ as aliases of these modules.
+"""
+COMMANDS = ("plot_landscape", "plot_histories", "plot_cases", "plot_basins", "plot_convergence", "plot_runs",
+            "compare_landscapes", "report", "make_examples")
+_READ_API = ("open_results", "read_runs", "read_history", "read_landscape", "read_optimization", "Results",
+             "FormatVersionError", "THESIS_TABLE4")
+
+
+def __getattr__(name):
+    """The reader's main names at the top level, imported on first use (h5py only when needed)."""
+    if name in _READ_API:
+        from kinesweep import read
+        return getattr(read, name)
+    raise AttributeError(f"module 'kinesweep' has no attribute {name!r}")

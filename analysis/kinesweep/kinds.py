@@ -1,0 +1,129 @@
+"""The plain data types ksread returns: Table (a /runs table or a history), Axis and Landscape (a
+block's gridded metrics), with their conversions to pandas and xarray (each an optional dependency,
+imported when asked for), and FormatVersionError (a file of a format_version the readers do not read).
+Run with Debian's interpreter: /usr/bin/python3.
+"""
+import numpy as np
+
+TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged", "undersampled", "off_path",
+                       "out_of_limits"]
+IK_STATUSES = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution",
+               "out_of_limits"]
+# What each run kind means, for files written before the engine recorded it under /kinds (the engine's
+# declarations, schema/params.hpp; tests/python/test_kinds.py checks a new file's /kinds against them).
+KIND_MEANING = {
+    "trajectory": {"statuses": TRAJECTORY_STATUSES, "good_statuses": ["ok"], "ranking": ["E"],
+                   "key_metrics": ["E", "E_M", "tau_inf"],
+                   "history_arrays": ["t", "q", "qd", "qdd", "tau", "x", "alpha"]},
+    "ik": {"statuses": IK_STATUSES, "good_statuses": ["converged"], "ranking": ["iterations", "error"],
+           "key_metrics": ["iterations", "error", "solution"],
+           "history_arrays": ["k", "q", "F", "norm_F", "step", "lambda"]},
+}
+GOOD_STATUSES = [s for m in KIND_MEANING.values() for s in m["good_statuses"]]
+
+# The colour of each failed status in every plot and the report (good runs are drawn by their metric).
+STATUS_COLOURS = {"unreachable_start": "#b0b0b0", "singular": "#7b3294", "diverged": "#202020",
+                  "undersampled": "#8c6d31", "off_path": "#c51b7d",
+                  "stalled": "#e08214", "max_iter": "#d7191c", "cycle": "#f4a582", "unsupported": "#6a6a6a",
+                  "no_solution": "#8f8f8f", "out_of_limits": "#fdae61"}
+# A converged run that reached none of the solutions a basin plot names.
+OTHER_SOLUTION_COLOUR = "#c7c7c7"
+
+
+class FormatVersionError(ValueError):
+    """A results file of a format_version the reader does not read."""
+
+
+def _s(v):
+    return v.decode() if isinstance(v, bytes) else str(v)
+
+
+class Table(dict):
+    """dict of column name -> 1-D numpy array, with .units and .descriptions dicts (runs(): also .roles,
+    column -> "parameter" | "metric" | "bookkeeping", and .kinds, column -> list of run kinds, [] = all)."""
+
+    def __init__(self, *a, **kw):
+        super().__init__(*a, **kw)
+        self.units = {}
+        self.descriptions = {}
+        self.roles = {}
+        self.kinds = {}
+
+    def __len__(self):  # number of rows, as for a DataFrame
+        return len(next(iter(self.values()))) if dict.__len__(self) else 0
+
+    def columns(self):
+        return list(self.keys())
+
+    def to_pandas(self):
+        import pandas as pd  # optional dependency
+        df = pd.DataFrame(dict(self))
+        df.attrs["units"] = dict(self.units)
+        return df
+
+
+class Axis:
+    def __init__(self, name, unit, values, labels=None):
+        self.name, self.unit, self.values, self.labels = name, unit, values, labels
+
+    @property
+    def categorical(self):
+        return self.labels is not None
+
+    def __repr__(self):
+        return f"Axis({self.name!r}, {self.unit!r}, {len(self.values)} values)"
+
+
+class Landscape:
+    """A block's gridded metrics: .axes (list of Axis), .metrics (name -> N-D array, NaN = no value),
+    .units / .descriptions (name -> str), .kind (the block's run kind, from its /runs rows).
+    metrics[m][i, j, ...] is at axes[0].values[i], ..."""
+
+    def __init__(self, block, axes, metrics, units, descriptions, kind="", meaning=None):
+        self.block, self.axes, self.metrics, self.units, self.descriptions = block, axes, metrics, units, descriptions
+        self._kind = kind
+        # what the block's run kind means (ksread.Results.kind_meaning): statuses, ranking, ...
+        self.meaning = meaning if meaning is not None else {k: list(v) for k, v in KIND_MEANING.get(kind, {}).items()}
+
+    def axis(self, name):
+        for a in self.axes:
+            if a.name == name:
+                return a
+        raise KeyError(f"landscape {self.block} has no axis {name!r}; axes: {', '.join(a.name for a in self.axes)}")
+
+    def axis_index(self, name):
+        return [a.name for a in self.axes].index(self.axis(name).name)
+
+    @property
+    def kind(self):
+        return self._kind
+
+    @property
+    def statuses(self):
+        """The kind's statuses in code order (status_code indexes them; code 0 is the good one)."""
+        return self.meaning.get("statuses", IK_STATUSES if self.kind == "ik" else TRAJECTORY_STATUSES)
+
+    @property
+    def objective(self):
+        """The metric the kind's runs are ranked by (E; ik: iterations), or None."""
+        return next(iter(self.meaning.get("ranking", [])), None)
+
+    def status_grids(self):
+        """The names of the grids of statuses (the good-status grid and status_code), not metrics."""
+        return (self.statuses[0], "status_code")
+
+    @staticmethod
+    def _coordinate(a):
+        """An axis' coordinate values: its values, or the label each value (0 .. n-1) indexes."""
+        return np.array([a.labels[int(v)] for v in a.values], dtype=object) if a.categorical else a.values
+
+    def to_xarray(self):
+        """The landscape as an xarray.Dataset: one data variable per metric over the dimensions named
+        after the axes, each axis a coordinate (its labels for a string axis such as `method`); units
+        and descriptions in the variables' attrs ("units", "long_name"), block and kind in the Dataset's."""
+        import xarray as xr  # optional dependency
+        dims = [a.name for a in self.axes]
+        coords = {a.name: (a.name, self._coordinate(a), {"units": a.unit}) for a in self.axes}
+        data = {m: (dims, v, {"units": self.units.get(m, ""), "long_name": self.descriptions.get(m, "")})
+                for m, v in self.metrics.items()}
+        return xr.Dataset(data, coords=coords, attrs={"block": self.block, "kind": self.kind})

@@ -1,0 +1,418 @@
+#!/usr/bin/python3
+"""Heatmap of a landscape metric over two swept axes of a kinesweep results file.
+
+Contour lines, the minimum marked and labelled, cells whose runs failed (unreachable start, singular,
+diverged; IK failures) masked in their own colours with a legend, optional log colour scale, and the
+thesis' optimum points overlaid (--thesis), an [[optimize]] block's evaluations, local paths and best
+point overlaid (--optimization NAME, when its variables are the plotted axes). Dims other than --x/--y
+are fixed (--fix AXIS=VALUE), reduced (--reduce min|mean over them; the title says which), or, when one
+categorical dim remains (method), drawn as small multiples: one panel per value, one colour scale.
+A log-spaced numeric axis (lambda from 1e-3 to 100) is drawn on a log scale; --log is the colour scale.
+
+    /usr/bin/python3 analysis/plot_landscape.py results/landscape_alpha_k.h5 --fix method=local_weighted --log --thesis
+    /usr/bin/python3 analysis/plot_landscape.py results/ik_basins.h5 --metric convergence --x q0_1 --y q0_2
+    /usr/bin/python3 analysis/plot_landscape.py results/optimize_polish.h5 --block alpha_k_1h --optimization 1h_polish --log
+"""
+import argparse
+import os
+import sys
+
+import numpy as np
+
+from kinesweep import plotting as ksplot  # noqa: E402
+from kinesweep import read as ksread  # noqa: E402
+
+METRIC_LABELS = {"E": "E (mean ‖τ‖)", "E_M": "E_M (mean ‖τ‖ in M⁻¹ norm)", "tau_inf": "‖τ‖∞",
+                 "tau1_inf": "‖τ1‖∞", "tau2_inf": "‖τ2‖∞", "tau3_inf": "‖τ3‖∞",
+                 "iterations": "iterations", "convergence": "convergence fraction", "error": "final ‖F‖",
+                 "min_manipulability": "min manipulability", "max_tracking_error": "max tracking error"}
+MAX_PANELS = 6  # small multiples: at most this many panels, one per value of a categorical dim
+STATUS_COLOURS = ksread.STATUS_COLOURS
+
+
+def parse_args(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ksplot.add_output_args(p)
+    p.add_argument("--block", help="landscape (block) name (default: the first in file order with two swept "
+                   "numeric axes)")
+    p.add_argument("--metric", help="E, E_M, tau_inf, tau1_inf..tau3_inf, min_manipulability, max_tracking_error "
+                   "(trajectory; default E), iterations, error, convergence (IK; default convergence = mean of "
+                   "'converged' over the other dims)")
+    p.add_argument("--x", help="axis on x (default: the first numeric swept axis)")
+    p.add_argument("--y", help="axis on y (default: the next numeric swept axis)")
+    p.add_argument("--fix", action="append", default=[], metavar="AXIS=VALUE",
+                   help="hold another axis at VALUE (degrees for angles, a label for names); repeatable")
+    p.add_argument("--reduce", choices=["min", "mean"],
+                   help="reduce the dims neither plotted nor fixed by their min or mean (the title says so). "
+                   "Without it they are faceted: one panel per value of one remaining categorical dim (up to "
+                   f"{MAX_PANELS}, one colour scale); else exit 2 naming them. convergence is always the mean")
+    p.add_argument("--log", action="store_true", help="logarithmic colour scale")
+    p.add_argument("--vmin", type=float, help="lower end of the colour scale")
+    p.add_argument("--vmax", type=float, help="upper end of the colour scale (larger values saturate)")
+    p.add_argument("--levels", type=int, default=8, help="number of contour lines (0: none; default %(default)s)")
+    p.add_argument("--thesis", action="store_true",
+                   help="overlay seed 000's optimum points (Table 4 rows 1d-1h / 2d-2h) on an (alpha1A, k) plane")
+    p.add_argument("--optimization", metavar="NAME",
+                   help="overlay /optimizations/NAME: its evaluations (dots coloured by stage), the local stage's "
+                   "paths (arrows start -> best) and the final best point; its variables must be the --x/--y axes")
+    return p.parse_args(argv)
+
+
+STAGE_COLOURS = {"sweep": "#ffffff", "global": "#ff9f1c", "local": "#2ec4f6"}
+
+
+def optimization_overlay(res, name, xa, ya):
+    """The optimisation's points in plot coordinates (x = xa's variable, y = ya's), or SystemExit when its
+    variables are not the plotted axes."""
+    names = res.optimizations()
+    if name not in names:
+        raise SystemExit(f"--optimization {name}: not in {res.path}; optimizations: {', '.join(names) or 'none'}")
+    o = res.optimization(name, degrees=True)
+    if xa.categorical or ya.categorical or sorted(o.variables) != sorted([xa.name, ya.name]):
+        raise SystemExit(f"--optimization {name}: its variables ({', '.join(o.variables)}) are not the plotted axes "
+                         f"({xa.name}, {ya.name}); pick them with --x/--y (and --fix/--block)")
+    ix, iy = o.variable_index(xa.name), o.variable_index(ya.name)
+    ev = o.evaluations
+    return {"name": name, "objective": o.objective, "variables": o.variables, "units": o.units,
+            "points": {"x": ev["x"][:, ix], "y": ev["x"][:, iy], "stage": list(ev["stage"]),
+                       "objective": ev["objective"], "status": list(ev["status"])},
+            "paths": [{"from": [f[ix], f[iy]], "to": [t[ix], t[iy]], "objective": v}
+                      for f, t, v in zip(o.local["from"], o.local["to"], o.local["objective"])],
+            "best": {"x": o.best["x"][ix], "y": o.best["x"][iy], "objective": o.best["objective"],
+                     "status": o.best["status"], "stage": o.best["stage"]}}
+
+
+def pick_index(axis, value):
+    if axis.categorical:
+        if value not in axis.labels:
+            raise SystemExit(f"--fix {axis.name}={value}: not a value of the axis; values: {', '.join(axis.labels)}")
+        return axis.labels.index(value)
+    try:
+        v = float(value)
+    except ValueError:
+        raise SystemExit(f"--fix {axis.name}={value}: expected a number")
+    i = int(np.argmin(np.abs(axis.values - v)))
+    span = np.ptp(axis.values) if len(axis.values) > 1 else 1.0
+    if abs(axis.values[i] - v) > 1e-6 * max(span, 1.0) + 1e-9:
+        vals = ", ".join(ksplot.fmt_num(x) for x in axis.values[:12])
+        raise SystemExit(f"--fix {axis.name}={value}: not on the grid; values: {vals}{' ...' if len(axis.values) > 12 else ''}")
+    return i
+
+
+def usage_exit(msg):
+    """A choice the user has to make: the message on stderr, exit status 2 (as argparse's usage errors)."""
+    print(f"plot_landscape: {msg}", file=sys.stderr)
+    raise SystemExit(2)
+
+
+def numeric_axes(ls):
+    return [a.name for a in ls.axes if not a.categorical and len(a.values) > 1]
+
+
+def choose_block(res, block):
+    """The named landscape, or the first in file order with two swept numeric axes to plot."""
+    names = res.landscapes()
+    if not names:
+        raise SystemExit(f"plot_landscape: {res.path} holds no landscapes")
+    if block:
+        if block not in names:
+            raise SystemExit(f"plot_landscape: no landscape {block!r}; landscapes: {', '.join(names)}")
+        return block
+    for b in names:
+        if len(numeric_axes(res.landscape(b))) >= 2:
+            return b
+    axes = "; ".join(f"{b}: {', '.join(a.name for a in res.landscape(b).axes) or 'no axis'}" for b in names)
+    raise SystemExit(f"plot_landscape: {res.path}: no landscape has two swept numeric axes to plot ({axes})")
+
+
+def reduce_grid(ls, args):
+    """The metric over (y, x) per panel: dict with x/y axes, z (panels x ny x nx), cat (same shape:
+    -1 value, -2 no run, else the status index of the cell's failed runs), facet (axis or None), notes."""
+    names = [a.name for a in ls.axes]
+    metric = args.metric or ("convergence" if ls.kind == "ik" else "E")
+    if metric != "convergence" and metric not in ls.metrics:
+        raise SystemExit(f"--metric {metric}: not in landscape {ls.block}; metrics: "
+                         f"{', '.join(list(ls.metrics) + (['convergence'] if ls.kind == 'ik' else []))}")
+    fixed = {}
+    for f in args.fix:
+        if "=" not in f:
+            raise SystemExit(f"--fix {f}: expected AXIS=VALUE")
+        k, v = f.split("=", 1)
+        if k not in names:
+            raise SystemExit(f"--fix {k}: no such axis; axes: {', '.join(names)}")
+        fixed[k] = v
+    free = [n for n in numeric_axes(ls) if n not in fixed]
+    x = args.x or (free[0] if free else None)
+    y = args.y or next((n for n in free if n != x), None)
+    for n, opt in ((x, "--x"), (y, "--y")):
+        if n is None:
+            raise SystemExit(f"{opt}: the landscape has no second swept axis to plot; axes: {', '.join(names)}")
+        if n not in names:
+            raise SystemExit(f"{opt} {n}: no such axis; axes: {', '.join(names)}")
+    if x == y or x in fixed or y in fixed:
+        raise SystemExit("--x and --y must be two different axes, neither of them fixed")
+    index = [slice(None)] * len(names)
+    notes = []
+    for k, v in fixed.items():
+        a = ls.axis(k)
+        index[names.index(k)] = pick_index(a, v)
+        notes.append(f"{k} = {v}" + (f" {a.unit}" if a.unit and not a.categorical else ""))
+    rest = [n for n in names if n not in (x, y) and n not in fixed]
+    multi = [n for n in rest if len(ls.axis(n).values) > 1]
+    facet = None
+    if metric != "convergence" and multi and args.reduce is None:
+        a = ls.axis(multi[0])
+        if len(multi) == 1 and a.categorical and len(a.labels) <= MAX_PANELS:
+            facet = multi[0]
+        else:
+            dims = ", ".join(f"{n} ({len(ls.axis(n).values)} values)" for n in multi)
+            usage_exit(f"landscape {ls.block}: the dims {dims} are neither plotted nor fixed; choose for each: "
+                       f"--fix AXIS=VALUE (e.g. --fix {multi[0]}={_first_value(ls.axis(multi[0]))}), or "
+                       f"--reduce min|mean over them" + ("" if len(multi) == 1 else
+                                                          ", or --fix all but one categorical dim (one panel per value)"))
+    rest = [n for n in rest if n != facet]
+
+    def arrange(g):  # -> panels x ny x nx x (cells reduced)
+        g = g[tuple(index)]
+        kept = [n for n in names if n not in fixed]
+        order = ([kept.index(facet)] if facet else []) + [kept.index(y), kept.index(x)] + [kept.index(n) for n in rest]
+        g = np.transpose(g, order)
+        return g.reshape((g.shape[0] if facet else 1,) + g.shape[(1 if facet else 0):(3 if facet else 2)] + (-1,))
+
+    status = arrange(ls.metrics["status_code"])
+    good = 0  # ok / converged
+    if metric == "convergence":
+        z = np.nanmean(arrange(ls.metrics[ls.statuses[0]]), axis=3)
+        cat = np.full(z.shape, -1)
+        if multi:
+            notes.append(f"mean over {', '.join(multi)}")
+        reduce = "mean" if multi else None
+    else:
+        vals = np.where(status == good, arrange(ls.metrics[metric]), np.nan)
+        import warnings
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            z = np.nanmean(vals, axis=3) if args.reduce == "mean" else np.nanmin(vals, axis=3)
+        cat = np.full(z.shape, -1)
+        none = np.all(np.isnan(vals), axis=3)
+        for p, i, j in zip(*np.nonzero(none)):
+            s = status[p, i, j][np.isfinite(status[p, i, j])].astype(int)
+            s = s[s != good]
+            cat[p, i, j] = np.bincount(s).argmax() if s.size else -2  # -2: no run at all
+        reduce = args.reduce if [n for n in rest if len(ls.axis(n).values) > 1] else None
+        if reduce:
+            notes.append(f"{reduce} over {', '.join(n for n in rest if len(ls.axis(n).values) > 1)}")
+    xa, ya = ls.axis(x), ls.axis(y)
+    # Axes in increasing order (random axes are stored in draw order).
+    for a, dim in ((xa, 2), (ya, 1)):
+        if not a.categorical and np.any(np.diff(a.values) < 0):
+            o = np.argsort(a.values, kind="stable")
+            z, cat = np.take(z, o, axis=dim), np.take(cat, o, axis=dim)
+            a = ksread.Axis(a.name, a.unit, a.values[o])
+            xa, ya = (a, ya) if dim == 2 else (xa, a)
+    fa = ls.axis(facet) if facet else None
+    return {"metric": metric, "x": xa, "y": ya, "z": z, "cat": cat, "notes": notes, "reduce": reduce,
+            "fixed": fixed, "facet": facet, "panel_labels": list(fa.labels) if fa else [None]}
+
+
+def _first_value(a):
+    return a.labels[0] if a.categorical else ksplot.fmt_num(a.values[0])
+
+
+def block_method(res, ls, fixed):
+    if "method" in fixed:
+        return fixed["method"]
+    runs = res.runs(columns=["block", "method"])
+    m = set(runs["method"][runs["block"] == ls.block])
+    return m.pop() if len(m) == 1 else None
+
+
+def is_integer_metric(res, metric):
+    """An integer column of /runs (iterations): its contours go on integers."""
+    return metric in res.columns() and res.f["runs"][metric].dtype.kind in "iu"
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    res = ksread.open_results(args.file)
+    ls = res.landscape(choose_block(res, args.block), degrees=True)
+    d = reduce_grid(ls, args)
+    xa, ya, Z, CAT, metric = d["x"], d["y"], d["z"], d["cat"], d["metric"]
+    unit = "" if metric == "convergence" else ls.units.get(metric, "")
+    label = METRIC_LABELS.get(metric, metric) + (f" [{unit}]" if unit else "")
+    xlog = not xa.categorical and ksplot.is_log_spaced(xa.values)
+    ylog = not ya.categorical and ksplot.is_log_spaced(ya.values)
+
+    plt, size = ksplot.figure(args)
+    from matplotlib.colors import ListedColormap, LogNorm, Normalize
+    from matplotlib import patheffects
+    from matplotlib.patches import Patch
+    n = Z.shape[0]
+    ncols = min(n, 3)
+    nrows = -(-n // ncols)
+    fig, axs = plt.subplots(nrows, ncols, figsize=size, constrained_layout=True, squeeze=False,
+                            sharex=True, sharey=True)
+    for k in range(n, nrows * ncols):
+        axs.flat[k].set_visible(False)
+    xv = np.arange(len(xa.values)) if xa.categorical else xa.values
+    yv = np.arange(len(ya.values)) if ya.categorical else ya.values
+    X, Y = np.meshgrid(ksplot.cell_edges(xv, xlog), ksplot.cell_edges(yv, ylog))
+    finite = Z[np.isfinite(Z)]  # one colour scale for every panel
+    vmin = args.vmin if args.vmin is not None else (finite.min() if finite.size else 0.0)
+    vmax = args.vmax if args.vmax is not None else (finite.max() if finite.size else 1.0)
+    if metric == "convergence":
+        vmin, vmax = (0.0 if args.vmin is None else vmin), (1.0 if args.vmax is None else vmax)
+    if args.log:
+        pos = finite[finite > 0]
+        vmin = max(vmin, pos.min() if pos.size else 1e-12)
+        norm = LogNorm(vmin=vmin, vmax=max(vmax, vmin * 1.0001))
+    else:
+        norm = Normalize(vmin=vmin, vmax=vmax if vmax > vmin else vmin + 1)
+    cmap = plt.get_cmap("viridis").copy()
+    cmap.set_bad((0, 0, 0, 0))
+    levels = []
+    if args.levels > 0 and finite.size and len(xv) > 2 and len(yv) > 2 and metric != "convergence":
+        levels = ksplot.round_levels(norm.vmin, norm.vmax, args.levels, log=args.log,
+                                     integer=is_integer_metric(res, metric))
+    statuses = ls.statuses
+    panels, thesis, opt = [], [], None
+    if args.optimization:
+        opt = optimization_overlay(res, args.optimization, xa, ya)
+    for p in range(n):
+        ax, z, cat = axs.flat[p], Z[p], CAT[p]
+        pfinite = z[np.isfinite(z)]
+        mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(z), cmap=cmap, norm=norm, shading="flat")
+        # Failed cells in their own colours.
+        handles = []
+        present = sorted(set(cat[cat >= 0].ravel().tolist()))
+        if present or (cat == -2).any():
+            colours = ["#ffffff"] * (len(statuses) + 1)
+            for s in present:
+                colours[s] = STATUS_COLOURS.get(statuses[s], "#999999")
+                handles.append(Patch(facecolor=colours[s], edgecolor="0.3",
+                                     label=f"{statuses[s]} ({int((cat == s).sum())} cells)"))
+            if (cat == -2).any():
+                handles.append(Patch(facecolor="#ffffff", edgecolor="0.3", label="no run"))
+            c = np.where(cat == -2, len(statuses), cat).astype(float)
+            ax.pcolormesh(X, Y, np.ma.masked_less(c, 0), cmap=ListedColormap(colours),
+                          vmin=-0.5, vmax=len(statuses) + 0.5, shading="flat")
+        if len(levels) and pfinite.size:
+            cs = ax.contour(xv, yv, np.ma.masked_invalid(z), levels=levels, colors="white", linewidths=0.7, alpha=0.8)
+            ax.clabel(cs, fmt=lambda v: f"{v:g}", fontsize=7, inline=True)
+        # Minimum (the mean for the convergence fraction).
+        best = None
+        if metric == "convergence" and pfinite.size:
+            ax.plot([], [], ls="none", label=f"mean convergence fraction {np.nanmean(z):.0%}")
+        elif pfinite.size:
+            i, j = np.unravel_index(np.nanargmin(z), z.shape)
+            best = {"value": z[i, j], "x": xa.values[j], "y": ya.values[i], "i": int(i), "j": int(j)}
+            xs = xa.labels[j] if xa.categorical else f"{ksplot.fmt_num(xa.values[j])}{'°' if xa.unit == 'deg' else ''}"
+            ys = ya.labels[i] if ya.categorical else f"{ksplot.fmt_num(ya.values[i])}{'°' if ya.unit == 'deg' else ''}"
+            ax.plot([xv[j]], [yv[i]], marker="*", ms=16, color="#ff3030", mec="white", mew=1.2, zorder=5, ls="none",
+                    label=f"min {ksplot.fmt_num(z[i, j])}{(' ' + unit) if unit else ''} at {xa.name} = {xs}, "
+                          f"{ya.name} = {ys}")
+        # Thesis optimum (of the panel's method).
+        if args.thesis and {xa.name, ya.name} == {"alpha1A", "k"}:
+            m = d["panel_labels"][p] if d["facet"] == "method" else block_method(res, ls, d["fixed"])
+            thesis += thesis_overlay(ax, m, metric, xa, patheffects)
+        if opt is not None:
+            optimization_draw(ax, opt, xa, ya, patheffects)
+        for a, setticks, setlab, log, which in ((xa, ax.set_xticks, ax.set_xlabel, xlog, "x"),
+                                                (ya, ax.set_yticks, ax.set_ylabel, ylog, "y")):
+            if which == "x" and p + ncols < n:
+                pass  # the panel below carries the x label
+            elif which == "y" and p % ncols:
+                pass
+            else:
+                setlab(ksplot.axis_label(a.name, a.unit))
+            if a.categorical:
+                setticks(np.arange(len(a.labels)), a.labels)
+            elif log:
+                ksplot.log_axis(ax, which)
+        lines = ax.get_legend_handles_labels()
+        ax.legend(handles=lines[0] + handles, labels=lines[1] + [h.get_label() for h in handles], loc="upper right",
+                  fontsize=8 if n == 1 else 7, framealpha=0.85)
+        if d["facet"]:
+            ax.set_title(f"{d['facet']} = {d['panel_labels'][p]}", fontsize=9)
+        panels.append({"label": d["panel_labels"][p], "z": z, "best": best,
+                       "masked_status": [[(statuses[c] if c >= 0 else None) for c in row] for row in cat]})
+    cb = fig.colorbar(mesh, ax=list(axs.flat[:n]), extend="max" if args.vmax is not None else "neither")
+    cb.set_label(label)
+    if args.log:
+        ksplot.log_colorbar_ticks(cb, norm.vmin, norm.vmax)
+    fig.canvas.draw()  # the colour bar's ticks, as drawn
+    cticks = [t for t in cb.ax.yaxis.get_majorticklocs() if norm.vmin <= t <= norm.vmax]
+    clabels = [t.get_text() for t in cb.ax.yaxis.get_majorticklabels() if t.get_text()]
+    what = "convergence fraction" if metric == "convergence" else METRIC_LABELS.get(metric, metric)
+    sub = "; ".join(d["notes"] + ([f"one panel per {d['facet']}"] if d["facet"] else []))
+    title = args.title or (f"{what} over {xa.name} × {ya.name} — block {ls.block}{(' (' + sub + ')') if sub else ''}"
+                           f"\n{os.path.basename(args.file)}{' (log colour scale)' if args.log else ''}")
+    (fig.suptitle if n > 1 else axs.flat[0].set_title)(title, fontsize=10)
+    first = panels[0]
+    return ksplot.finish(fig, args, f"landscape_{ls.block}_{metric}",
+        {"file": args.file, "block": ls.block, "metric": metric, "unit": unit,
+         "reduce": d["reduce"], "fixed": d["fixed"], "facet": d["facet"], "levels": levels,
+         "x": {"name": xa.name, "unit": xa.unit, "values": xa.values, "labels": xa.labels, "log": xlog},
+         "y": {"name": ya.name, "unit": ya.unit, "values": ya.values, "labels": ya.labels, "log": ylog},
+         "z": first["z"], "masked_status": first["masked_status"], "best": first["best"], "panels": panels,
+         "thesis": thesis, "optimization": opt, "xscale": axs.flat[0].get_xscale(),
+         "yscale": axs.flat[0].get_yscale(), "colorbar": {"ticks": cticks, "labels": clabels}})
+
+
+def thesis_overlay(ax, method, metric, xa, patheffects):
+    """Seed 000's optimum points of `method` on an (alpha1A, k) panel; returns what it drew."""
+    opt = ksread.THESIS_OPTIMA.get(method)
+    if opt is None:
+        print(f"plot_landscape: --thesis: no thesis optimum for method {method!r} (fix method=local_weighted "
+              "or local_unweighted)", file=sys.stderr)
+        return []
+    out = []
+    for case in [opt["global"]] + opt["partial"]:
+        _, kk, alpha, e, taus = ksread.THESIS_TABLE4[case]
+        tv = {"E": e, "tau_inf": max(taus), "tau1_inf": taus[0], "tau2_inf": taus[1], "tau3_inf": taus[2]}.get(metric)
+        tl = (f"{METRIC_LABELS.get(metric, metric)} = {tv} Nm" if tv is not None else f"E = {e} Nm")
+        px, py = (alpha, kk) if xa.name == "alpha1A" else (kk, alpha)
+        glob = case == opt["global"]
+        ax.plot([px], [py], ls="none", marker="P" if glob else "D", ms=11 if glob else 7,
+                mfc="#ff66ff" if glob else "none", mec="#ff66ff", mew=1.8, zorder=6,
+                label=(f"thesis optimum {case}: {tl}" if glob else None))
+        ax.annotate(f"thesis {case}", (px, py), xytext=(6, 6 if glob else -12), textcoords="offset points",
+                    color="#ff66ff", fontsize=8, fontweight="bold",
+                    path_effects=[patheffects.withStroke(linewidth=2.5, foreground="black")])
+        out.append({"case": case, "x": px, "y": py, "E": e, "value": tv})
+    ax.plot([], [], ls="none", marker="D", mfc="none", mec="#ff66ff", label="thesis partial optima")
+    return out
+
+
+def optimization_draw(ax, opt, xa, ya, patheffects):
+    """An optimisation's evaluations, local paths and best point, kept inside the landscape's extent
+    (the bounds may be wider than the grid)."""
+    xlim, ylim = ax.get_xlim(), ax.get_ylim()
+    pt = opt["points"]
+    stages = np.array(pt["stage"], dtype=object)
+    for st in dict.fromkeys(pt["stage"]):
+        m = stages == st
+        ax.scatter(np.asarray(pt["x"])[m], np.asarray(pt["y"])[m], s=9, c=STAGE_COLOURS.get(st, "#cccccc"),
+                   edgecolors="black", linewidths=0.3, zorder=7, alpha=0.85,
+                   label=f"{opt['name']}: {st} evaluations ({int(m.sum())})")
+    for path in opt["paths"]:
+        ax.annotate("", xy=path["to"], xytext=path["from"], zorder=8,
+                    arrowprops=dict(arrowstyle="-|>", color="#2ec4f6", lw=1.4, mutation_scale=10,
+                                    path_effects=[patheffects.withStroke(linewidth=2.6, foreground="black")]))
+    if opt["paths"]:
+        ax.plot([], [], color="#2ec4f6", lw=1.4, label=f"{opt['name']}: local paths (start → best)")
+    b = opt["best"]
+    bu = ["°" if u == "deg" else "" for u in (opt["units"][opt["variables"].index(xa.name)],
+                                             opt["units"][opt["variables"].index(ya.name)])]
+    ax.plot([b["x"]], [b["y"]], marker="o", ms=10, mfc="none", mec="#ff3030", mew=2.2, zorder=9, ls="none",
+            label=f"{opt['name']} best: {opt['objective']} = {ksplot.fmt_num(b['objective'])} at "
+                  f"{xa.name} = {ksplot.fmt_num(b['x'])}{bu[0]}, {ya.name} = {ksplot.fmt_num(b['y'])}{bu[1]}")
+    ax.annotate(f"{opt['name']} best {ksplot.fmt_num(b['objective'])}", (b["x"], b["y"]), xytext=(8, -14),
+                textcoords="offset points", color="#ff3030", fontsize=8, fontweight="bold", zorder=9,
+                path_effects=[patheffects.withStroke(linewidth=2.5, foreground="white")])
+    ax.set_xlim(xlim)
+    ax.set_ylim(ylim)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,483 @@
+"""Read kinesweep results files (HDF5, layout in engine/store/FORMAT.md) with h5py and numpy.
+
+    from kinesweep import read as ksread
+    r = ksread.open_results("results/thesis_table4.h5")
+    runs = r.runs()                      # dict of numpy arrays (done rows only), .units / .descriptions
+    runs["E"], runs.units["E"]           # array, "Nm"
+    r.parameters(), r.metrics("ik")      # column names by role (and run kind), from the file's attributes
+    r.row_kinds()                        # each (done) row's run kind: "trajectory", "ik"
+    df = r.to_pandas()                   # the same as a pandas.DataFrame (units in df.attrs)
+    h = r.history(3)                     # dict of 2-D arrays (rows x components) with .units
+    r.has_history(3)                     # whether run 3 has a history
+    r.history_arrays(3)                  # its array names in the run's order: ["t", "q", "qd", ...]
+    r.history_ids(), r.history_count()   # the run ids that have a history (ascending), how many
+    ls = r.landscape("local")            # axes (name, unit, values, labels) and gridded metrics
+    ds = r.to_xarray("local")            # the same as an xarray.Dataset: named dimensions, coordinates, units
+    o = r.optimization("1h", degrees=True)   # an [[optimize]] block: evaluations, stages, local paths, best
+    o.evaluations["x"], o.units          # n x d points, one unit per variable ("deg" for angles here)
+
+Angles are stored in radians (unit "rad"); pass degrees=True to runs()/history()/landscape()/optimization() to get
+them in degrees (their unit then reads "deg"). Run with Debian's interpreter: /usr/bin/python3.
+
+Column roles (parameter, metric, bookkeeping) and the run kinds a column applies to are the /runs
+datasets' `role` and `kinds` attributes (FORMAT.md, format_version 2 and 3); files of format_version 1
+lack them and are refused with FormatVersionError (kinesweep info / query still read them), as are
+versions newer than 3. Versions 2 and 3 differ in the /histories layout only, which kshistory reads.
+"""
+import os
+
+import h5py
+import numpy as np
+
+from kinesweep import history as kshistory
+from kinesweep import live as kslive
+from kinesweep.solutions import cluster_solutions  # noqa: F401 (part of this module's interface)
+from kinesweep.kinds import FormatVersionError  # noqa: F401 (the same)
+from kinesweep.kinds import (GOOD_STATUSES, IK_STATUSES, KIND_MEANING, OTHER_SOLUTION_COLOUR, STATUS_COLOURS,  # noqa: F401
+                     TRAJECTORY_STATUSES, Axis, Landscape, Table, _s)
+
+RAD2DEG = 180.0 / np.pi
+FORMAT_VERSIONS = (2, 3)  # the results formats this module reads (engine/store/FORMAT.md)
+ROLES = ("parameter", "metric", "bookkeeping")
+
+# Seed 000, Table 4 (copied from engine/methods/seed_cases.cpp, checked against it by the tests):
+# case -> (method, k, alpha1A [deg], thesis E [Nm], thesis (|tau1|inf, |tau2|inf, |tau3|inf) [Nm]).
+THESIS_TABLE4 = {
+    "1a": ("local_weighted", 0.0, 0.0, 51.03, (82.63, 32.31, 8.77)),
+    "1b": ("local_weighted", 0.0, 0.0, 51.03, (82.63, 32.31, 8.77)),
+    "1c": ("local_weighted", 0.0, 15.0, 55.77, (79.09, 33.26, 8.41)),
+    "1d": ("local_weighted", 0.57, 15.0, 51.70, (627.76, 111.32, 12.21)),
+    "1e": ("local_weighted", 0.0, 30.0, 62.27, (93.33, 42.30, 7.21)),
+    "1f": ("local_weighted", 0.16, 30.0, 54.32, (215.59, 50.28, 9.52)),
+    "1g": ("local_weighted", 0.0, -23.5, 38.63, (101.39, 45.40, 8.78)),
+    "1h": ("local_weighted", 0.13, -24.1, 37.79, (109.44, 48.33, 8.79)),
+    "2a": ("local_unweighted", 0.0, 0.0, 48.63, (50.33, 30.00, 8.71)),
+    "2b": ("local_unweighted", 0.0, 0.0, 48.63, (50.33, 30.00, 8.71)),
+    "2c": ("local_unweighted", 0.0, 15.0, 54.09, (57.32, 29.14, 8.61)),
+    "2d": ("local_unweighted", 0.75, 15.0, 54.07, (5301.60, 2135.90, 263.50)),
+    "2e": ("local_unweighted", 0.0, 30.0, 61.04, (387.90, 153.58, 22.35)),
+    "2f": ("local_unweighted", 0.18, 30.0, 54.83, (1076.50, 401.30, 49.40)),
+    "2g": ("local_unweighted", 0.0, -20.1, 39.41, (59.77, 51.65, 8.95)),
+    "2h": ("local_unweighted", 0.06, -23.5, 37.41, (90.23, 60.75, 10.30)),
+    "3": ("vertex_alpha", 0.0, -18.9, 53.58, (139.75, 35.49, 8.56)),
+    "4": ("vertex_alpha", 0.0, -18.3, 48.39, (116.40, 30.83, 8.58)),
+    "5a": ("vertex_alpha", 0.0, 0.0, 66.65, (178.82, 28.20, 8.26)),
+    "5b": ("vertex_alpha", 0.0, 15.0, 60.81, (121.11, 28.22, 8.26)),
+    "5c": ("vertex_alpha", 0.0, 30.0, 60.05, (107.88, 28.23, 8.26)),
+}
+# The thesis' optimised points on the (alpha1A, k) landscape of each local method:
+# the global optimum (1h / 2h) and the partial optima (k or alpha1A optimised alone).
+THESIS_OPTIMA = {
+    "local_weighted": {"global": "1h", "partial": ["1d", "1f", "1g"]},
+    "local_unweighted": {"global": "2h", "partial": ["2d", "2f", "2g"]},
+}
+
+class Optimization:
+    """One /optimizations/<name> group (FORMAT.md). Variables are columns of every n x d array:
+    .variables, .units (per variable: "rad", or "deg" with degrees=True), .lower, .upper (d);
+    .evaluations: Table of x (n x d), objective, constraint, stage, status, start (n);
+    .stages: Table of name, algorithm, result, best_status, wall_time, best_objective, evaluations (s),
+    best_x (s x d); .local: Table of from, to (m x d), objective (m);
+    .best: dict x (d), objective, status, stage, metrics (dict), history (Table, as Results.history());
+    .references: dict (thesis_E, thesis_<variable> in the variable's unit, objective_at_thesis_x, ...);
+    .kind, .preset, .objective, .settings, .wall_time [s], .seed, .n_evaluations."""
+
+    def __init__(self, name, g, degrees=False):
+        a = g.attrs
+        self.name = name
+        self.kind, self.preset, self.objective = _s(a.get("kind", "")), _s(a.get("preset", "")), _s(a.get("objective", ""))
+        self.settings = _s(a.get("settings", ""))
+        self.variables = [_s(v) for v in a.get("variables", [])]
+        stored = [_s(u) for u in a.get("units", [""] * len(self.variables))]
+        d = len(self.variables)
+        # Per-variable scale to the returned units.
+        scale = np.array([RAD2DEG if degrees and u == "rad" else 1.0 for u in stored], dtype=float).reshape(d)
+        self.units = ["deg" if degrees and u == "rad" else u for u in stored]
+        self.stored_units = stored
+
+        def pts(v):
+            v = np.array(v, dtype=float).reshape(-1, d) if d else np.zeros((len(v), 0))
+            return v * scale
+
+        self.lower = np.array(a.get("lower", []), dtype=float) * scale
+        self.upper = np.array(a.get("upper", []), dtype=float) * scale
+        self.wall_time = float(a.get("wall_time", np.nan))
+        self.seed = int(a.get("seed", 0))
+        self.n_evaluations = int(a.get("n_evaluations", len(g["evaluations"]["objective"])))
+
+        def table(grp, point_cols=()):
+            t = Table()
+            for k in grp:
+                v = grp[k][()]
+                if v.dtype.kind in "OSU":
+                    v = np.array([_s(x) for x in v], dtype=object)
+                unit = _s(grp[k].attrs.get("unit", ""))
+                if k in point_cols:
+                    v, unit = pts(v), ", ".join(self.units)
+                t[k] = v
+                t.units[k] = unit
+                t.descriptions[k] = _s(grp[k].attrs.get("description", ""))
+            return t
+
+        self.evaluations = table(g["evaluations"], ("x",))
+        self.stages = table(g["stages"], ("best_x",))
+        self.local = table(g["local"], ("from", "to"))
+        b = g["best"]
+        metrics = {m: float(b.attrs[m]) for m in (_s(x) for x in b.attrs.get("metrics", [])) if m in b.attrs}
+        hist = Table()
+        if "history" in b:
+            h = b["history"]
+            order = [_s(x) for x in h.attrs["arrays"]] if "arrays" in h.attrs else list(h)
+            for k in order:
+                v = np.array(h[k][()], dtype=float)
+                v = v[:, None] if v.ndim == 1 else v
+                unit = _s(h[k].attrs.get("unit", ""))
+                if degrees and unit == "rad":
+                    v, unit = v * RAD2DEG, "deg"
+                hist[k] = v
+                hist.units[k] = unit
+        self.best = {"x": np.array(a.get("best_x", []), dtype=float) * scale,
+                     "objective": float(a.get("best_objective", np.nan)),
+                     "status": _s(a.get("best_status", "")), "stage": _s(a.get("best_stage", "")),
+                     "metrics": metrics, "history": hist}
+        self.references = {}
+        for r in (_s(x) for x in a.get("references", [])):
+            v = float(a.get("reference_" + r, np.nan))
+            var = r[len("thesis_"):] if r.startswith("thesis_") else None
+            if var in self.variables:
+                v *= scale[self.variables.index(var)]
+            self.references[r] = v
+
+    def variable_index(self, name):
+        if name not in self.variables:
+            raise KeyError(f"optimization {self.name} has no variable {name!r}; variables: {', '.join(self.variables)}")
+        return self.variables.index(name)
+
+    def __repr__(self):
+        return (f"Optimization({self.name!r}, {self.objective!r} over {', '.join(self.variables)}, "
+                f"{self.n_evaluations} evaluations, best {self.best['objective']:.6g})")
+
+
+class Results:
+    """An open results file (read-only). Safe on a file a sweep is writing: every call reads one
+    committed state, the newest when it starts (kslive: retried from a fresh open when a commit lands
+    under it), so run counts never go backwards."""
+
+    def __init__(self, path):
+        if not os.path.exists(path):
+            raise FileNotFoundError(path)
+        self.path = path
+        self.f, self._stamp = kslive.open_snapshot(path, self._open_file)
+
+    def _reopen(self):
+        """A fresh handle on the file's newest committed state (kslive.consistent calls it)."""
+        self.f.close()
+        self.f, self._stamp = kslive.open_snapshot(self.path, lambda: h5py.File(self.path, "r"))
+
+    def _open_file(self):
+        """Open the file and read what every call needs (format, roles and kinds of the columns)."""
+        path = self.path
+        f = h5py.File(path, "r")
+        try:
+            a = f.attrs
+            if _s(a.get("format", "")) != "kinesweep-results":
+                raise ValueError(f"{path}: not a kinesweep results file")
+            self.meta = {k: (_s(v) if isinstance(v, (bytes, str)) else v.item() if hasattr(v, "item") else v)
+                         for k, v in a.items()}
+            version = int(self.meta.get("format_version", -1))
+            if version not in FORMAT_VERSIONS:
+                engine = self.meta.get("engine_version", "?")
+                what = (f"{path}: results file format v{version} (written by kinesweep {engine}); ksread reads "
+                        f"{' and '.join(f'v{v}' for v in FORMAT_VERSIONS)} only")
+                if version < min(FORMAT_VERSIONS):
+                    what += (" (v1 files have no role/kinds attributes on their /runs columns). `kinesweep query` "
+                             "and `kinesweep info` still read this file; to use it here, rerun its study: "
+                             "kinesweep run STUDY.toml --overwrite")
+                raise FormatVersionError(what)
+            self.study_text = _s(f["study"]["text"][()])
+            self._roles, self._kinds = {}, {}
+            for c in (_s(x) for x in f["runs"].attrs["columns"]):
+                attrs = f["runs"][c].attrs
+                role = _s(attrs.get("role", ""))
+                if role not in ROLES or "kinds" not in attrs:
+                    raise ValueError(f"{path}: /runs/{c} has no valid role/kinds attributes (role {role!r})")
+                self._roles[c] = role
+                self._kinds[c] = [k for k in _s(attrs["kinds"]).split(",") if k]
+        except Exception:
+            f.close()
+            raise
+        return f
+
+    def close(self):
+        self.f.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    @property
+    @kslive.consistent
+    def n_runs(self):
+        return int(self.f["runs"].attrs.get("n_runs", len(self.f["runs"]["done"])))
+
+    @kslive.consistent
+    def columns(self):
+        return [_s(c) for c in self.f["runs"].attrs["columns"]]
+
+    @kslive.consistent
+    def units(self):
+        return {c: _s(self.f["runs"][c].attrs.get("unit", "")) for c in self.columns()}
+
+    def roles(self):
+        """column -> "parameter" | "metric" | "bookkeeping" (the /runs datasets' role attribute)."""
+        return dict(self._roles)
+
+    def kinds(self):
+        """column -> the run kinds it applies to (its kinds attribute split at commas; [] = every run)."""
+        return {c: list(k) for c, k in self._kinds.items()}
+
+    @kslive.consistent
+    def kind_meaning(self, kind):
+        """What runs of `kind` mean, as the file records it (/kinds/<kind>): {"statuses": in code
+        order, "good_statuses", "ranking": [objective, tie...] (best = lowest among good runs, then
+        by run id), "key_metrics", "objectives", "history_arrays", ...}, each a list of str. Files
+        from before /kinds: the engine's declarations (kstypes.KIND_MEANING); {} for an unknown kind."""
+        g = self.f.get("kinds")
+        if g is not None and kind in g:
+            return {k: [_s(x) for x in v] for k, v in g[kind].attrs.items()}
+        return {k: list(v) for k, v in KIND_MEANING.get(kind, {}).items()}
+
+    def run_kinds(self):
+        """The run kinds the columns name ("trajectory", "ik"), first seen first."""
+        out = []
+        for ks in self._kinds.values():
+            out += [k for k in ks if k not in out]
+        return out
+
+    def _by_role(self, role, kind):
+        return [c for c in self.columns() if self._roles[c] == role and (kind is None or not self._kinds[c]
+                                                                        or kind in self._kinds[c])]
+
+    def parameters(self, kind=None):
+        """Parameter columns in file order (of one run kind, when given)."""
+        return self._by_role("parameter", kind)
+
+    def metrics(self, kind=None):
+        """Metric columns in file order (of one run kind, when given)."""
+        return self._by_role("metric", kind)
+
+    def bookkeeping(self):
+        """The bookkeeping columns (run_id, block, status, wall_time)."""
+        return self._by_role("bookkeeping", None)
+
+    @kslive.consistent
+    def row_kinds(self, done_only=True):
+        """Each row's run kind, an object array aligned with runs(done_only=...): the kind of the
+        single-kind parameter (else metric) columns that hold a value in the row; "" when none does
+        (a row not done yet). A file of one kind: that kind for every row."""
+        g = self.f["runs"]
+        done = g["done"][()].astype(bool)
+        kinds = self.run_kinds()
+        out = np.full(len(done), kinds[0] if len(kinds) == 1 else "", dtype=object)
+        if len(kinds) > 1:
+            for role in ("parameter", "metric"):
+                for c in self._by_role(role, None):
+                    if len(self._kinds[c]) != 1:
+                        continue
+                    v = g[c][()]
+                    if v.dtype.kind == "f":
+                        held = ~np.isnan(v)
+                    elif v.dtype.kind in "iu":
+                        held = v != -1
+                    else:
+                        held = np.array([len(x) > 0 for x in v], dtype=bool)
+                    out[(out == "") & held] = self._kinds[c][0]
+        return out[done] if done_only else out
+
+    def row_kind(self, run_id):
+        """The run kind of one row (see row_kinds)."""
+        return self.row_kinds(done_only=False)[int(run_id)]
+
+    @kslive.consistent
+    def runs(self, columns=None, done_only=True, degrees=False, pandas=False):
+        """The /runs table: Table (dict of arrays; strings as str objects) or a pandas DataFrame."""
+        g = self.f["runs"]
+        done = g["done"][()].astype(bool)  # before the columns (a writer may be committing)
+        names = self.columns() if columns is None else list(columns)
+        t = Table()
+        for c in names:
+            if c not in g:
+                raise KeyError(f"no column {c!r}; columns: {', '.join(self.columns())}")
+            d = g[c]
+            v = d[()]
+            if v.dtype.kind in "OSU":
+                v = np.array([_s(x) for x in v], dtype=object)
+            unit = _s(d.attrs.get("unit", ""))
+            if degrees and unit == "rad":
+                v, unit = v * RAD2DEG, "deg"
+            t[c] = v[done] if done_only else v
+            t.units[c] = unit
+            t.descriptions[c] = _s(d.attrs.get("description", ""))
+            t.roles[c] = self._roles[c]
+            t.kinds[c] = list(self._kinds[c])
+        if not done_only:
+            t["done"] = done
+            t.units["done"] = ""
+            t.roles["done"], t.kinds["done"] = "bookkeeping", []
+        return t.to_pandas() if pandas else t
+
+    def to_pandas(self, columns=None, done_only=True, degrees=False):
+        """The /runs table as a pandas.DataFrame (units in df.attrs["units"]): runs(..., pandas=True)."""
+        return self.runs(columns, done_only=done_only, degrees=degrees, pandas=True)
+
+    def to_xarray(self, block=None, degrees=False):
+        """A block's landscape (default: the first) as an xarray.Dataset (Landscape.to_xarray)."""
+        return self.landscape(block, degrees=degrees).to_xarray()
+
+    def _histories(self):
+        """The kshistory reader of the current handle (a fresh one after each reopen)."""
+        if getattr(self, "_hist", None) is None or self._hist.f is not self.f:
+            self._hist = kshistory.Histories(self.f)
+        return self._hist
+
+    @kslive.consistent
+    def has_history(self, run_id):
+        """Whether run run_id has a history (one of 0 rows included)."""
+        return self._histories().has(run_id)
+
+    @kslive.consistent
+    def history_arrays(self, run_id):
+        """The names of the run's history arrays in the order the run produced them ([] without one)."""
+        return self._histories().names(run_id)
+
+    @kslive.consistent
+    def history_ids(self):
+        """The run ids that have a history, ascending (int64 array)."""
+        return self._histories().ids()
+
+    @kslive.consistent
+    def history_count(self):
+        """The number of runs that have a history."""
+        return self._histories().count()
+
+    @kslive.consistent
+    def history(self, run_id, degrees=False):
+        """One run's history: Table of name -> 2-D array (rows x components), .units per array
+        (IK q: "rad, rad, mm" -- one unit per component). KeyError when the run has none."""
+        if not self.has_history(run_id):
+            raise KeyError(f"run {run_id} has no history in {self.path}")
+        h = Table()
+        for a, v, unit in self._histories().read(run_id):
+            if degrees:
+                parts = [p.strip() for p in unit.split(",")]
+                if len(parts) == v.shape[1] and "rad" in parts:
+                    v = v.copy()
+                    for j, p in enumerate(parts):
+                        if p == "rad":
+                            v[:, j] *= RAD2DEG
+                            parts[j] = "deg"
+                    unit = ", ".join(parts)
+                elif unit == "rad":
+                    v, unit = v * RAD2DEG, "deg"
+            h[a] = v
+            h.units[a] = unit
+        return h
+
+    @kslive.consistent
+    def blocks(self):
+        """The block names in file order: order of first appearance in the /runs `block` column."""
+        if "block" not in self.f["runs"]:
+            return []
+        names = [_s(x) for x in self.f["runs"]["block"][()]]
+        return [b for b in dict.fromkeys(names) if b]
+
+    @kslive.consistent
+    def landscapes(self):
+        """The /landscapes groups in block order (blocks()), any other after them."""
+        if "landscapes" not in self.f:
+            return []
+        have = list(self.f["landscapes"])
+        order = [b for b in self.blocks() if b in have]
+        return order + [b for b in have if b not in order]
+
+    @kslive.consistent
+    def landscape(self, block=None, degrees=False):
+        names = self.landscapes()
+        if not names:
+            raise KeyError(f"{self.path} holds no landscapes")
+        if block is None:
+            block = names[0]
+        if block not in names:
+            raise KeyError(f"no landscape {block!r}; landscapes: {', '.join(names)}")
+        g = self.f["landscapes"][block]
+        axes = []
+        for a in (_s(x) for x in g.attrs["axes"]):
+            unit = _s(g[a].attrs.get("unit", ""))
+            vals = np.array(g[a][()], dtype=float)
+            labels = None
+            if unit.startswith("labels:"):
+                labels, unit = unit[len("labels:"):].split(","), ""
+            elif degrees and unit == "rad":
+                vals, unit = vals * RAD2DEG, "deg"
+            axes.append(Axis(a, unit, vals, labels))
+        metrics, units, desc = {}, {}, {}
+        for m in (_s(x) for x in g.attrs["metrics"]):
+            metrics[m] = np.array(g[m][()], dtype=float)
+            units[m] = _s(g[m].attrs.get("unit", ""))
+            desc[m] = _s(g[m].attrs.get("description", ""))
+        kind = self._block_kind(block)
+        return Landscape(block, axes, metrics, units, desc, kind, self.kind_meaning(kind))
+
+    def _block_kind(self, block):
+        """The run kind of a block's (done) rows, "" when it has none."""
+        if "block" not in self._roles:
+            return self.run_kinds()[0] if len(self.run_kinds()) == 1 else ""
+        blocks = np.array([_s(x) for x in self.f["runs"]["block"][()]], dtype=object)
+        done = self.f["runs"]["done"][()].astype(bool)
+        kinds = self.row_kinds(done_only=False)[(blocks == block) & done]
+        kinds = [k for k in kinds if k]
+        return kinds[0] if kinds else ""
+
+
+    @kslive.consistent
+    def optimizations(self):
+        """Names of the /optimizations groups (empty when the file has none)."""
+        return list(self.f["optimizations"]) if "optimizations" in self.f else []
+
+    @kslive.consistent
+    def optimization(self, name=None, degrees=False):
+        """One /optimizations group as an Optimization (default: the first)."""
+        names = self.optimizations()
+        if not names:
+            raise KeyError(f"{self.path} holds no optimizations")
+        if name is None:
+            name = names[0]
+        if name not in names:
+            raise KeyError(f"no optimization {name!r}; optimizations: {', '.join(names)}")
+        return Optimization(name, self.f["optimizations"][name], degrees=degrees)
+
+
+def open_results(path):
+    return Results(path)
+
+
+def read_runs(path, **kw):
+    with Results(path) as r:
+        return r.runs(**kw)
+
+
+def read_history(path, run_id, **kw):
+    with Results(path) as r:
+        return r.history(run_id, **kw)
+
+
+def read_landscape(path, block=None, **kw):
+    with Results(path) as r:
+        return r.landscape(block, **kw)
+
+
+def read_optimization(path, name=None, **kw):
+    with Results(path) as r:
+        return r.optimization(name, **kw)

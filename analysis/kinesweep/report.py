@@ -1,0 +1,149 @@
+#!/usr/bin/python3
+"""One self-contained HTML page giving a whole kinesweep results file at a glance.
+
+Sections (those that do not apply are left out; the contents list what is there): the study text
+and file metadata, status counts per block, the best runs of each block, interactive landscapes,
+IK basins, the histories of the best runs, and the optimisation traces. Plotly's JavaScript is
+embedded (Debian's python3-plotly), so the page works offline and can be mailed as one file.
+Reads files a sweep is still writing (done rows only). Big grids and long traces are subsampled so
+that the page stays small (the captions say where).
+
+    /usr/bin/python3 analysis/report.py results/examples_landscape.h5 -o report.html
+
+Open a single section with report.html#only=SECTION (study, status, best, landscapes, basins,
+histories, optimizations).
+"""
+import argparse
+import datetime
+import os
+import sys
+
+from kinesweep import read as ksread  # noqa: E402
+from kinesweep.report_basins import basins_figure  # noqa: E402
+from kinesweep.report_grids import landscape_figure  # noqa: E402
+from kinesweep.report_page import esc, figure, page  # noqa: E402
+from kinesweep.report_tables import RunsView, best_section, metadata_section, status_section  # noqa: E402
+from kinesweep.report_traces import best_with_history, history_figure, history_ids, optimization_figure  # noqa: E402
+
+CELL_BUDGET = 60000   # heatmap cells over all landscape and basin figures (about 110 bytes each)
+MAX_HISTORY_FIGURES = 12
+
+
+def parse_args(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("file", help="results file (.h5) written by `kinesweep run`")
+    p.add_argument("-o", "--output", help="output page (default: FILE's name with _report.html)")
+    p.add_argument("--best", type=int, default=5, help="rows per block in the best-runs table (default %(default)s)")
+    p.add_argument("--max-cells", type=int, default=CELL_BUDGET,
+                   help="heatmap cells drawn over all grid figures (default %(default)s; bigger grids are "
+                        "subsampled and the caption says so)")
+    p.add_argument("--title", help="page title (default: the study's name)")
+    return p.parse_args(argv)
+
+
+def plotly_js():
+    import plotly.offline
+    return plotly.offline.get_plotlyjs()
+
+
+def grid_sections(res, cap_total):
+    """The landscapes and basins sections' html ("" when none)."""
+    names = res.landscapes()
+    lss = [res.landscape(b, degrees=True) for b in names]
+    ik = [ls for ls in lss if ls.kind == "ik"]
+    n_fig = len(lss) + len(ik)
+    cap = max(min(500, cap_total), cap_total // max(1, n_fig))
+    land = "".join(_landscape_html(i, ls, cap) for i, ls in enumerate(lss))
+    basins = []
+    for i, ls in enumerate(ik):
+        out = basins_figure(res, ls, cap)
+        if out is not None:
+            fig, caption, _ = out
+            basins.append(figure(f"basins-{i}", fig, caption, title=f"Block {ls.block}"))
+    return land, "".join(basins)
+
+
+def _landscape_html(i, ls, cap):
+    out = landscape_figure(ls, cap)
+    if out is None:  # a block without swept axes: one run, in the tables
+        return ""
+    fig, caption, _ = out
+    return figure(f"landscape-{i}", fig, caption, title=f"Block {ls.block} ({ls.kind})")
+
+
+def histories_section(view):
+    ids = history_ids(view.res)
+    if ids is not None and not ids:
+        return ""
+    parts, n = [], 0
+    for b in view.block_names:
+        if n >= MAX_HISTORY_FIGURES:
+            parts.append(f'<p class="caption capped">Histories of the first {MAX_HISTORY_FIGURES} blocks shown.</p>')
+            break
+        row = best_with_history(view, b, ids)
+        if row is None:
+            continue
+        out = history_figure(view, row)
+        if out is None:
+            continue
+        parts.append(figure(f"history-{n}", out[0], out[1], title=f"Block {b} ({view.kind(b)})"))
+        n += 1
+    return "".join(parts)
+
+
+def optimizations_section(res):
+    parts = []
+    for i, name in enumerate(res.optimizations()):
+        fig, caption, stages = optimization_figure(res, name)
+        parts.append(figure(f"optimization-{i}", fig, caption, title=f"Optimisation {name}")
+                     + (f"<p class=\"caption\">Stages of {esc(name)}:</p>{stages}" if stages else ""))
+    return "".join(parts)
+
+
+def build(path, best=5, max_cells=CELL_BUDGET, title=None):
+    """The page's html for one results file."""
+    with ksread.open_results(path) as res:
+        view = RunsView(res)
+        sections = [("study", "Study and file", metadata_section(res, view)),
+                    ("status", "Status counts per block", status_section(view))]
+        b = best_section(view, best)
+        if b:
+            sections.append(("best", "Best runs per block", b))
+        land, basins = grid_sections(res, max_cells)
+        if land:
+            sections.append(("landscapes", "Landscapes", land))
+        if basins:
+            sections.append(("basins", "IK basins of attraction", basins))
+        hist = histories_section(view)
+        if hist:
+            sections.append(("histories", "Histories of the best runs", hist))
+        opt = optimizations_section(res)
+        if opt:
+            sections.append(("optimizations", "Optimisation traces", opt))
+        name = res.meta.get("study_name", "") or os.path.basename(path)
+        done, n = int(view.done.sum()), len(view.done)
+        now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+        sub = (f"{esc(os.path.basename(path))}: {done} of {n} runs done, written by kinesweep "
+               f"{esc(res.meta.get('engine_version', '?'))} on {esc(res.meta.get('created', '?'))}; "
+               f"report made {now}. Angles in degrees.")
+        return page(title or f"kinesweep report: {name}", sub, sections, plotly_js())
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    out = args.output or os.path.splitext(args.file)[0] + "_report.html"
+    try:
+        text = build(args.file, best=args.best, max_cells=args.max_cells, title=args.title)
+    except (FileNotFoundError, ksread.FormatVersionError, ValueError) as e:
+        raise SystemExit(f"report: {e}")
+    d = os.path.dirname(out)
+    if d:
+        os.makedirs(d, exist_ok=True)
+    with open(out, "w", encoding="utf-8") as f:
+        f.write(text)
+    print(out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
