@@ -28,7 +28,7 @@ def parse_args(argv=None):
     p.add_argument("--print-data", action="store_true", help="also print the minima as JSON on stdout")
     p.add_argument("--block", help="landscape (block) name (default: each file's first in file order with "
                    "the --x and --y axes)")
-    p.add_argument("--metric", default="E", help="landscape metric (default %(default)s)")
+    p.add_argument("--metric", help="landscape metric (default: the metric the first file's runs are ranked by, E)")
     p.add_argument("--x", default="alpha1A", help="axis on x (default %(default)s)")
     p.add_argument("--y", default="k", help="axis on y (default %(default)s)")
     p.add_argument("--fix", action="append", default=[], metavar="AXIS=VALUE",
@@ -39,6 +39,7 @@ def parse_args(argv=None):
 
 def panel(land, args, fixed):
     """The metric over (x, y) of one landscape, the other dims fixed: (x values, y values, 2-D array)."""
+    args.metric = args.metric or land.objective
     if args.metric not in land.metrics:
         raise SystemExit(f"{land.block}: no metric {args.metric!r}; metrics: {', '.join(land.metrics)}")
     data = land.metrics[args.metric]

@@ -20,6 +20,13 @@ KIND_MEANING = {
            "history_arrays": ["k", "q", "F", "norm_F", "step", "lambda"]},
 }
 GOOD_STATUSES = [s for m in KIND_MEANING.values() for s in m["good_statuses"]]
+# Display labels of metrics in plot axes and captions (a metric not listed shows its name; its unit
+# comes from the file).
+METRIC_LABELS = {"E": "E (mean ‖τ‖)", "E_M": "E_M (mean ‖τ‖ in M⁻¹ norm)", "tau_inf": "‖τ‖∞",
+                 "tau1_inf": "‖τ1‖∞", "tau2_inf": "‖τ2‖∞", "tau3_inf": "‖τ3‖∞",
+                 "iterations": "iterations", "convergence": "convergence fraction", "error": "final ‖F‖",
+                 "min_manipulability": "min manipulability", "max_tracking_error": "max tracking error",
+                 "peak_joint_power": "peak joint power"}
 
 # The colour of each failed status in every plot and the report (good runs are drawn by their metric).
 STATUS_COLOURS = {"unreachable_start": "#b0b0b0", "singular": "#7b3294", "diverged": "#202020",

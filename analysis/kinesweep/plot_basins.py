@@ -173,6 +173,8 @@ def main(argv=None):
     # The final iterates: as many joints as the robot has (q_final_1 .. q_final_n), with their units.
     qcols = sorted((c for c in res.columns() if c.startswith("q_final_")), key=lambda c: int(c.rsplit("_", 1)[1]))
     runs = res.runs(columns=["run_id", "block", "solution", "status", "problem"] + qcols, done_only=False)
+    good = res.kind_meaning(ls.kind)["good_statuses"]  # ik: converged
+    is_good = np.isin(runs["status"], good)
     sel = (runs["block"] == ls.block) & runs["done"]
     qunits = joint_units(res, runs, qcols, sel)
     clustered = False
@@ -182,7 +184,7 @@ def main(argv=None):
         # iterates (ksread.cluster_solutions, tolerance CLUSTER_TOLERANCE), in run order, and grid them:
         # a grid block's runs are its cells in row-major order of the landscape's axes.
         rows = np.flatnonzero(runs["block"] == ls.block)
-        conv = runs["done"][rows] & (runs["status"][rows] == "converged")
+        conv = runs["done"][rows] & is_good[rows]
         q = np.column_stack([runs[c][rows] for c in qcols])
         q[~conv] = np.nan
         revolute = [u == "rad" for u in qunits]
@@ -210,7 +212,7 @@ def main(argv=None):
     sol_ids = sorted(int(s) for s in np.unique(sol[np.isfinite(sol)]))
     sol_label = {}
     for s in sol_ids:
-        m = sel & (runs["solution"] == s) & (runs["status"] == "converged")
+        m = sel & (runs["solution"] == s) & is_good
         text = joint_text(runs, qcols, qunits, m) if m.any() and qcols else ""
         sol_label[s] = f"solution {s}" + (": " + text if text else "")
         if continuum:
@@ -248,7 +250,7 @@ def main(argv=None):
                 for j in range(st.shape[1]):
                     code = int(st[i, j]) if np.isfinite(st[i, j]) else -1
                     name = statuses[code] if code >= 0 else "no run"
-                    if name == "converged" and np.isfinite(so[i, j]):
+                    if name in good and np.isfinite(so[i, j]):
                         s = int(so[i, j])
                         base = np.array(mcolors.to_rgb(SOLUTION_COLOURS[s % len(SOLUTION_COLOURS)]))
                         n = it[i, j]
@@ -257,7 +259,7 @@ def main(argv=None):
                         cls[i, j] = s
                         used[("sol", s)] = used.get(("sol", s), 0) + 1
                     else:
-                        key = "converged, other solution" if name == "converged" else name
+                        key = name + ", other solution" if name in good else name
                         rgb[i, j] = mcolors.to_rgb(FAIL_COLOURS.get(key, "#ffffff"))
                         cls[i, j] = key
                         used[("fail", key)] = used.get(("fail", key), 0) + 1

@@ -22,10 +22,7 @@ import numpy as np
 from kinesweep import plotting as ksplot  # noqa: E402
 from kinesweep import read as ksread  # noqa: E402
 
-METRIC_LABELS = {"E": "E (mean ‖τ‖)", "E_M": "E_M (mean ‖τ‖ in M⁻¹ norm)", "tau_inf": "‖τ‖∞",
-                 "tau1_inf": "‖τ1‖∞", "tau2_inf": "‖τ2‖∞", "tau3_inf": "‖τ3‖∞",
-                 "iterations": "iterations", "convergence": "convergence fraction", "error": "final ‖F‖",
-                 "min_manipulability": "min manipulability", "max_tracking_error": "max tracking error"}
+METRIC_LABELS = ksread.METRIC_LABELS
 MAX_PANELS = 6  # small multiples: at most this many panels, one per value of a categorical dim
 STATUS_COLOURS = ksread.STATUS_COLOURS
 
@@ -129,7 +126,7 @@ def reduce_grid(ls, args):
     """The metric over (y, x) per panel: dict with x/y axes, z (panels x ny x nx), cat (same shape:
     -1 value, -2 no run, else the status index of the cell's failed runs), facet (axis or None), notes."""
     names = [a.name for a in ls.axes]
-    metric = args.metric or ("convergence" if ls.kind == "ik" else "E")
+    metric = args.metric or ("convergence" if ls.kind == "ik" else ls.objective)
     if metric != "convergence" and metric not in ls.metrics:
         raise SystemExit(f"--metric {metric}: not in landscape {ls.block}; metrics: "
                          f"{', '.join(list(ls.metrics) + (['convergence'] if ls.kind == 'ik' else []))}")

@@ -33,8 +33,8 @@ from kinesweep import history as kshistory
 from kinesweep import live as kslive
 from kinesweep.solutions import cluster_solutions  # noqa: F401 (part of this module's interface)
 from kinesweep.kinds import FormatVersionError  # noqa: F401 (the same)
-from kinesweep.kinds import (GOOD_STATUSES, IK_STATUSES, KIND_MEANING, OTHER_SOLUTION_COLOUR, STATUS_COLOURS,  # noqa: F401
-                     TRAJECTORY_STATUSES, Axis, Landscape, Table, _s)
+from kinesweep.kinds import (GOOD_STATUSES, IK_STATUSES, KIND_MEANING, METRIC_LABELS, OTHER_SOLUTION_COLOUR,  # noqa: F401
+                             STATUS_COLOURS, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s)
 
 RAD2DEG = 180.0 / np.pi
 FORMAT_VERSIONS = (2, 3)  # the results formats this module reads (engine/store/FORMAT.md)

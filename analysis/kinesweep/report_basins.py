@@ -24,7 +24,7 @@ def final_iterates(res, block):
     scara = "problem" in t and bool(np.any(t["problem"][rows] == "scara"))
     units = [("mm" if scara else "rad") if t.units[c].startswith("rad or") else t.units[c] for c in qcols]
     q = np.column_stack([t[c][rows] for c in qcols]) if qcols else np.zeros((len(rows), 0))
-    conv = t["done"][rows] & (t["status"][rows] == "converged")
+    conv = t["done"][rows] & np.isin(t["status"][rows], res.kind_meaning("ik")["good_statuses"])
     q = q.astype(float)
     q[~conv] = np.nan
     return rows, q, qcols, units

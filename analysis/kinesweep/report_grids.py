@@ -6,12 +6,11 @@ import math
 
 import numpy as np
 
-from kinesweep.kinds import STATUS_COLOURS  # noqa: F401 (used below)
+from kinesweep.kinds import METRIC_LABELS, STATUS_COLOURS  # noqa: F401 (used below)
 from kinesweep.report_page import esc, fmt
 
 MAX_FRAMES = 24      # facets / dropdown entries per figure; further dims are held at the best cell
 MAX_FACETS = 4       # up to this many frames side by side, more in a dropdown
-METRIC_LABELS = {"E": "E (mean ‖τ‖)", "iterations": "iterations to converge", "tau_inf": "‖τ‖∞"}
 
 
 def axis_title(a):
