@@ -13,8 +13,8 @@ import os
 import subprocess
 import sys
 
-HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # analysis/: the scripts
-ROOT = os.path.dirname(HERE)
+PACKAGE_PARENT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # analysis/ in a source tree
+ROOT = os.path.dirname(PACKAGE_PARENT)  # the source tree: studies/, results/examples/, build/
 
 # Sweep then polish for Table 4's row 1h on a 0.25 deg x 0.02 landscape near the reach boundary (where
 # the optimum is), with a small GA-like global stage too (the picture shows all three stages):
@@ -58,6 +58,9 @@ def main():
     p.add_argument("--work", default="/tmp/ks_examples", help="where the .h5 files go")
     p.add_argument("--out", default=os.path.join(ROOT, "results", "examples"))
     a = p.parse_args()
+    if not os.path.isdir(os.path.join(ROOT, "studies")):
+        raise SystemExit("make_examples regenerates a source tree's results/examples from its studies/: run it "
+                         "from a kinesweep source tree (analysis/make_examples.py), not from an installed package")
     os.makedirs(a.work, exist_ok=True)
     os.makedirs(a.out, exist_ok=True)
     h5 = {}
@@ -91,8 +94,10 @@ def main():
          ["--view", "slice", "--block", "lm_lambda", "--size", "1100x450"]),
         ("plot_runs.py", h5["examples_lhs"], "runs_parcoords.png", ["--view", "parcoords"]),
     ]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [PACKAGE_PARENT, os.environ.get("PYTHONPATH")])))
     for script, f, out, extra in jobs:
-        subprocess.run([py, os.path.join(HERE, script), f, "-o", os.path.join(a.out, out), *extra], check=True)
+        subprocess.run([py, "-m", "kinesweep." + script[:-3], f, "-o", os.path.join(a.out, out), *extra], check=True,
+                       env=env)
         shrink(os.path.join(a.out, out))
     return 0
 

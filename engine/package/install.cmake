@@ -31,22 +31,28 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/kinesweepConfig.cmake ${CMAKE_CURRENT_
         DESTINATION ${KS_CMAKE_DIR})
 
 # Analysis: the Python package `kinesweep` (analysis/kinesweep), into the directory Debian's python3
-# searches for this prefix: lib/python3/dist-packages under /usr, lib/python3.X/dist-packages under
-# any other prefix (e.g. /usr/local). KINESWEEP_PYTHON_DIR overrides it.
-if(NOT DEFINED KINESWEEP_PYTHON_DIR)
-  set(KS_PY lib/python3/dist-packages)
-  if(NOT CMAKE_INSTALL_PREFIX STREQUAL "/usr")
-    find_program(KS_SYSTEM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
-    if(KS_SYSTEM_PYTHON)
-      execute_process(COMMAND ${KS_SYSTEM_PYTHON} -c "import sys; print('%d.%d' % sys.version_info[:2])"
-                      OUTPUT_VARIABLE KS_PY_VERSION OUTPUT_STRIP_TRAILING_WHITESPACE)
-      set(KS_PY lib/python${KS_PY_VERSION}/dist-packages)
+# searches for the prefix given at install time (`cmake --install --prefix P` included):
+# lib/python3/dist-packages under /usr, lib/python3.X/dist-packages under any other prefix (e.g.
+# /usr/local; X from /usr/bin/python3, else the python3 on PATH). KINESWEEP_PYTHON_DIR (relative to
+# the prefix) overrides it.
+set(KINESWEEP_PYTHON_DIR "" CACHE STRING "where cmake --install puts the Python package, relative to the prefix (empty: Debian's directory for the prefix)")
+find_program(KS_SYSTEM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+if(NOT KS_SYSTEM_PYTHON)
+  find_program(KS_SYSTEM_PYTHON NAMES python3)
+endif()
+install(CODE "
+  set(ks_py_dir \"${KINESWEEP_PYTHON_DIR}\")
+  if(NOT ks_py_dir)
+    set(ks_py_dir lib/python3/dist-packages)
+    if(NOT CMAKE_INSTALL_PREFIX STREQUAL \"/usr\" AND EXISTS \"${KS_SYSTEM_PYTHON}\")
+      execute_process(COMMAND \"${KS_SYSTEM_PYTHON}\" -c \"import sys; print('%d.%d' % sys.version_info[:2])\"
+                      OUTPUT_VARIABLE ks_py_version OUTPUT_STRIP_TRAILING_WHITESPACE)
+      set(ks_py_dir lib/python\${ks_py_version}/dist-packages)
     endif()
   endif()
-  set(KINESWEEP_PYTHON_DIR ${KS_PY} CACHE STRING "where `cmake --install` puts the Python package (relative: under the prefix)")
-endif()
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/analysis/kinesweep DESTINATION ${KINESWEEP_PYTHON_DIR}
-        FILES_MATCHING PATTERN "*.py" PATTERN "__pycache__" EXCLUDE)
+  file(INSTALL \"${PROJECT_SOURCE_DIR}/analysis/kinesweep\" DESTINATION \"\${CMAKE_INSTALL_PREFIX}/\${ks_py_dir}\"
+       FILES_MATCHING PATTERN \"*.py\" PATTERN \"__pycache__\" EXCLUDE)
+")
 install(FILES ${PROJECT_SOURCE_DIR}/analysis/README.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/kinesweep RENAME analysis.md)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/studies/ DESTINATION ${CMAKE_INSTALL_DATADIR}/kinesweep/studies)
 
