@@ -202,6 +202,19 @@ TEST(RunIdentity, TheContextNamesWhatChanged) {
                 "the settings changed: [study] histories: every=10 -> none"),
             std::string::npos);
   EXPECT_NE(context_changes(base, run_context(s, s.histories, "0.0.1")).find("kinesweep version"), std::string::npos);
+  // a chain's velocity and effort limits decide out_of_limits: each is part of the context
+  const Study arm = parse_study(kStudy + "[robot]\nl = [1, 1, 1, 1]\nm = [4, 3, 2, 1]\nb = 0.1\n");
+  const auto arm_base = run_context(arm, arm.histories);
+  for (int which = 0; which < 2; ++which) {
+    Study e = arm;
+    auto c = std::make_shared<Chain>(*arm.chain);
+    (which ? c->joints[1].effort : c->joints[1].velocity) = 3.5;
+    e.chain = c;
+    EXPECT_NE(digest_of(e), digest_of(arm)) << which;
+    EXPECT_NE(context_changes(arm_base, run_context(e, e.histories))
+                  .find(which ? "[robot] joint 2 effort limit" : "[robot] joint 2 velocity limit"),
+              std::string::npos);
+  }
   // the defaults written out change nothing
   EXPECT_EQ(context_changes(base, run_context(parse_study(kStudy + "[robot]\ng = 9.81\n[task]\ndt = 1e-3\n"), s.histories)), "");
 }

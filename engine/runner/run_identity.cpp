@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <charconv>
+#include <cmath>
 #include <map>
 
 #include "study/sha256.hpp"
@@ -56,6 +57,10 @@ void robot_fields(const Study& s, std::vector<ContextField>& out) {
     add(p + "origin", frame(q.origin));
     add(p + "axis", vec3(q.axis));
     add(p + "limits", list(std::array<double, 2>{q.lower, q.upper}));
+    // velocity and effort limits decide out_of_limits and the limit ratios; listed when the joint has
+    // them (a robot without them keeps the context it had before they were listed)
+    if (std::isfinite(q.velocity)) add(p + "velocity limit", num(q.velocity));
+    if (std::isfinite(q.effort)) add(p + "effort limit", num(q.effort));
     add(p + "mass", num(q.mass));
     add(p + "com", vec3(q.com));
     add(p + "inertia", mat3(q.inertia));

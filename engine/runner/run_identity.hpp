@@ -8,8 +8,9 @@
 // - the study's run context (run_context): every input of execute() and of the stored history
 //   that is not a run parameter, as values (not as the study file wrote them):
 //     robot     the closed-form 3R's constants (l, m, lc, I, g, inertia form), and for a chain robot
-//               (an n-link [robot] arm or a URDF robot) every joint's type, origin, axis, limits,
-//               mass, centre of mass and inertia, the tip frame and gravity (a URDF file's comments,
+//               (an n-link [robot] arm or a URDF robot) every joint's type, origin, axis, position
+//               limits, velocity and effort limits (where finite), mass, centre of mass and inertia,
+//               the tip frame and gravity (a URDF file's comments,
 //               names and unused links are not part of it);
 //     task      vertices (and heights), durations, dt and integrator (the defaults of the runs'
 //               columns of the same names), orientation;
