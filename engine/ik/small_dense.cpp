@@ -17,11 +17,6 @@ Mat<N, N> SmallLu<N>::solve(const Mat<N, N>& B) const {
 }
 
 template <int N>
-double SmallLu<N>::rcond() const {
-  return lu_.rcond();
-}
-
-template <int N>
 SmallLlt<N>::SmallLlt(const Mat<N, N>& A) : llt_(A) {}
 
 template <int N>

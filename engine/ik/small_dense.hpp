@@ -7,7 +7,7 @@
 //
 //   SmallLu<N> lu(A);          // A = P^-1 L U, partial pivoting
 //   Vec<N> x = lu.solve(b);    // A x = b
-//   double r = lu.rcond();     // LAPACK-style estimate of 1 / (|A|_1 |A^-1|_1)
+//   double r = lu_rcond<N>(A); // LAPACK-style estimate of 1 / (|A|_1 |A^-1|_1)
 //   SmallLlt<N> llt(A);        // A = L L^T (A symmetric positive definite)
 //   if (llt.ok()) x = llt.solve(b);
 //
@@ -31,8 +31,6 @@ class SmallLu {
   Vec<N> solve(const Vec<N>& b) const;
   /// \return X with A X = B (B: N x N).
   Mat<N, N> solve(const Mat<N, N>& B) const;
-  /// \return the estimated reciprocal condition number of A in the 1-norm (0 when singular).
-  double rcond() const;
 
  private:
   Eigen::PartialPivLU<Mat<N, N>> lu_;
@@ -53,7 +51,7 @@ class SmallLlt {
   Eigen::LLT<Mat<N, N>> llt_;
 };
 
-/// Reciprocal condition estimate of A (N x N) by its LU: SmallLu<N>(A).rcond().
+/// Reciprocal condition estimate of A (N x N) in the 1-norm by its LU (Eigen's PartialPivLU::rcond, 0 when singular).
 template <int N>
 double lu_rcond(const Mat<N, N>& A);
 
