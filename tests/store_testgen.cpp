@@ -15,7 +15,7 @@ std::vector<ColumnSpec> test_columns() {
           {"E", CellType::f64, "Nm", "energy-like metric", Role::metric, "trajectory"},
           {"iters", CellType::i64, "", "iterations used", Role::metric, "ik"},
           {"status", CellType::str, "", "outcome word", Role::bookkeeping, ""},
-          {"method", CellType::str, "", "redundancy resolution", Role::parameter, "trajectory,ik"}};
+          {"method", CellType::str, "", "redundancy resolution", Role::parameter, "trajectory,ik", {"pinv", "dls"}}};
 }
 
 Record test_record(std::int64_t id) {

@@ -97,6 +97,7 @@ TEST(StoreColumns, EverySpecFieldIsWrittenAndReadBack) {
     EXPECT_EQ(got.description, want.description) << want.name;
     EXPECT_EQ(got.role, want.role) << want.name;
     EXPECT_EQ(got.kinds, want.kinds) << want.name;
+    EXPECT_EQ(got.labels, want.type == CellType::str ? want.labels : std::vector<std::string>{}) << want.name;
   }
   // resume reads the same specs
   auto res = ResultsWriter::open_for_resume(path, test_meta().study_sha256);
@@ -104,6 +105,7 @@ TEST(StoreColumns, EverySpecFieldIsWrittenAndReadBack) {
   for (std::size_t i = 0; i < cols.size(); ++i) {
     EXPECT_EQ(res.writer->columns()[i].role, cols[i].role) << cols[i].name;
     EXPECT_EQ(res.writer->columns()[i].kinds, cols[i].kinds) << cols[i].name;
+    EXPECT_EQ(res.writer->columns()[i].labels, cols[i].labels) << cols[i].name;
   }
 }
 
@@ -151,7 +153,7 @@ TEST(StoreColumns, ResumeRefusesAVersion1FileAndLeavesItUntouched) {
   const std::string msg = error_of([&] { ResultsWriter::open_for_resume(path, test_meta().study_sha256); });
   EXPECT_NE(msg.find(path), std::string::npos) << msg;
   EXPECT_NE(msg.find("results file format v1 (written by kinesweep " KINESWEEP_VERSION
-                     "); this kinesweep writes v3: rerun with --overwrite"),
+                     "); this kinesweep resumes v3 to v4: rerun with --overwrite"),
             std::string::npos)
       << msg;
   EXPECT_EQ(slurp(path), before);
@@ -165,14 +167,15 @@ TEST(StoreColumns, ResumeRefusesAVersion1FileAndLeavesItUntouched) {
 
 TEST(StoreColumns, NewerFormatIsRefusedByReaderAndResume) {
   TempDir td;
-  const std::string path = td.file("v4.h5");
+  const std::string path = td.file("newer.h5");
   write_test_file(path, 4);
-  rewrite_as(path, 4, false);
+  const std::string newer = std::to_string(kFormatVersion + 1);
+  rewrite_as(path, kFormatVersion + 1, false);
   const std::string before = slurp(path);
   const std::string read = error_of([&] { ResultsReader r(path); });
-  EXPECT_NE(read.find("unsupported format_version 4"), std::string::npos) << read;
+  EXPECT_NE(read.find("unsupported format_version " + newer), std::string::npos) << read;
   const std::string resume = error_of([&] { ResultsWriter::open_for_resume(path, test_meta().study_sha256); });
-  EXPECT_NE(resume.find("results file format v4"), std::string::npos) << resume;
+  EXPECT_NE(resume.find("results file format v" + newer), std::string::npos) << resume;
   EXPECT_EQ(slurp(path), before);
 }
 
@@ -197,7 +200,7 @@ TEST(StoreColumns, AFileThatIsNoHdf5FileIsNamedAsSuch) {
 }
 
 TEST(StoreColumns, AStringColumnWhoseReadFailsHalfWayThrowsAndKeepsNoString) {
-  // Row 1 of /runs/method refers to a global heap collection past the end of the file: HDF5 converts
+  // Row 1 of /runs/status (free text) refers to a global heap collection past the end of the file: HDF5 converts
   // row 0's string, then fails on row 1 and never copies row 0's pointer out. The reader frees the
   // strings HDF5 allocated on that path too (LeakSanitizer checks this in sanitizer builds).
   TempDir td;
@@ -207,7 +210,7 @@ TEST(StoreColumns, AStringColumnWhoseReadFailsHalfWayThrowsAndKeepsNoString) {
   {
     hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
     ASSERT_GE(f, 0);
-    hid_t d = H5Dopen2(f, "runs/method", H5P_DEFAULT);
+    hid_t d = H5Dopen2(f, "runs/status", H5P_DEFAULT);
     ASSERT_GE(d, 0);
     offset = H5Dget_offset(d);  // contiguous: rows at fixed addresses
     H5Dclose(d);
@@ -219,7 +222,7 @@ TEST(StoreColumns, AStringColumnWhoseReadFailsHalfWayThrowsAndKeepsNoString) {
   std::uint32_t len0 = 0;
   io.seekg(static_cast<std::streamoff>(offset));
   io.read(reinterpret_cast<char*>(&len0), sizeof len0);
-  ASSERT_EQ(len0, 4u);  // row 0 is "pinv": the layout is as assumed
+  ASSERT_EQ(len0, 2u);  // row 0 is "ok": the layout is as assumed
   const std::uint64_t past_the_end = std::uint64_t{1} << 40;
   io.seekp(static_cast<std::streamoff>(offset + 16 + 4));
   io.write(reinterpret_cast<const char*>(&past_the_end), sizeof past_the_end);
@@ -227,14 +230,14 @@ TEST(StoreColumns, AStringColumnWhoseReadFailsHalfWayThrowsAndKeepsNoString) {
   ASSERT_TRUE(io);
 
   ResultsReader r(path);
-  const std::string msg = error_of([&] { r.read_str("method"); });
+  const std::string msg = error_of([&] { r.read_str("status"); });
   EXPECT_NE(msg.find(path), std::string::npos) << msg;
-  EXPECT_NE(msg.find("read /runs/method"), std::string::npos) << msg;
-  EXPECT_NE(error_of([&] { r.read_record(1); }).find("read /runs/method"), std::string::npos);
+  EXPECT_NE(msg.find("read /runs/status"), std::string::npos) << msg;
+  EXPECT_NE(error_of([&] { r.read_record(1); }).find("read /runs/status"), std::string::npos);
   // the rows around it still read
-  EXPECT_EQ(std::get<std::string>(r.read_record(0).cells[4]), "pinv");
-  EXPECT_EQ(std::get<std::string>(r.read_record(2).cells[4]), "pinv");
-  EXPECT_EQ(r.read_str("status"), (std::vector<std::string>{"ok", "diverged", "singular"}));
+  EXPECT_EQ(std::get<std::string>(r.read_record(0).cells[3]), "ok");
+  EXPECT_EQ(std::get<std::string>(r.read_record(2).cells[3]), "singular");
+  EXPECT_EQ(r.read_str("method"), (std::vector<std::string>{"pinv", "dls", "pinv"}));
 }
 
 }  // namespace

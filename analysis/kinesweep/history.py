@@ -4,7 +4,7 @@ histories through Histories. Run with Debian's interpreter: /usr/bin/python3.
 
 format_version 1 and 2: one group per run with a history, /histories/<zero-padded run id>/<array>,
   group attribute `arrays` = the array names in the order the run produced them.
-format_version 3: one row space shared by every history dataset. /histories/start, /rows, /layout
+format_version 3 and 4: one row space shared by every history dataset. /histories/start, /rows, /layout
   (int64, indexed by run id): run i's arrays are rows [start[i], start[i] + rows[i]) of the datasets
   named in the group attribute layouts[layout[i]] (comma-separated); layout -1 = no history. A
   dataset's `array` attribute names its array (`q.2` holds an array q of another column count or unit).
@@ -20,8 +20,8 @@ import numpy as np
 from kinesweep.kinds import FormatVersionError, _s
 
 GROUP_VERSIONS = (1, 2)  # one group per run
-RAGGED_VERSIONS = (3,)   # one shared row space
-NEWEST_VERSION = 3
+RAGGED_VERSIONS = (3, 4)  # one shared row space
+NEWEST_VERSION = 4
 
 
 def group_name(run_id, n_runs):
@@ -37,7 +37,7 @@ def _as_2d(v):
 
 
 class Histories:
-    """The histories of one open h5py.File (format_version 1 to 3). Reads nothing until asked."""
+    """The histories of one open h5py.File (format_version 1 to 4). Reads nothing until asked."""
 
     def __init__(self, f):
         self.f = f
@@ -48,7 +48,7 @@ class Histories:
         self.ragged = self.version in RAGGED_VERSIONS
         self.g = f["histories"] if "histories" in f else None
         if self.ragged and self.g is not None and "layout" not in self.g:
-            self.g = None  # v3 without the index datasets: no run has a history
+            self.g = None  # v3 / v4 without the index datasets: no run has a history
         self._layouts = None   # ragged: list of dataset-name lists, from the `layouts` attribute
         self._datasets = {}    # ragged: dataset name -> (array name, unit)
 
@@ -69,7 +69,7 @@ class Histories:
     def _group_read(self, grp):
         return [(a, _as_2d(grp[a][()]), _s(grp[a].attrs.get("unit", ""))) for a in self._group_names(grp)]
 
-    # --- the ragged layout (v3) ---
+    # --- the ragged layout (v3, v4) ---
 
     def _index(self, name, run_id):
         """Entry run_id of /histories/start, rows or layout; -1 for a run id outside it."""

@@ -45,6 +45,28 @@ def _s(v):
     return v.decode() if isinstance(v, bytes) else str(v)
 
 
+def enum_labels(dset):
+    """The labels of a labelled /runs text column by code (an HDF5 enum, format 4), else None."""
+    import h5py  # here, not at the top: importing kinesweep.kinds does not import h5py
+    e = h5py.check_enum_dtype(dset.dtype)
+    if e is None:
+        return None
+    labels = [""] * len(e)
+    for name, code in e.items():
+        labels[int(code)] = name
+    return labels
+
+
+def text_values(dset, codes=None):
+    """A text column (all rows, or the given enum `codes`) as an object array of str: enum codes
+    through their labels (a code without one, the missing value, as ""), strings decoded."""
+    labels = enum_labels(dset)
+    if labels is None:
+        return np.array([_s(x) for x in (dset[()] if codes is None else codes)], dtype=object)
+    table = np.array(labels + [""] * (256 ** dset.dtype.itemsize - len(labels)), dtype=object)
+    return table[dset[()] if codes is None else codes]
+
+
 class Table(dict):
     """dict of column name -> 1-D numpy array, with .units and .descriptions dicts (runs(): also .roles,
     column -> "parameter" | "metric" | "bookkeeping", and .kinds, column -> list of run kinds, [] = all)."""

@@ -225,8 +225,12 @@ def block_method(res, ls, fixed):
 
 
 def is_integer_metric(res, metric):
-    """An integer column of /runs (iterations): its contours go on integers."""
-    return metric in res.columns() and res.f["runs"][metric].dtype.kind in "iu"
+    """An integer column of /runs (iterations): its contours go on integers. A labelled text column
+    (an enum over uint8) is not one."""
+    if metric not in res.columns():
+        return False
+    d = res.f["runs"][metric]
+    return d.dtype.kind in "iu" and ksread.enum_labels(d) is None
 
 
 def main(argv=None):

@@ -20,24 +20,28 @@ Angles are stored in radians (unit "rad"); pass degrees=True to runs()/history()
 them in degrees (their unit then reads "deg"). Run with Debian's interpreter: /usr/bin/python3.
 
 Column roles (parameter, metric, bookkeeping) and the run kinds a column applies to are the /runs
-datasets' `role` and `kinds` attributes (FORMAT.md, format_version 2 and 3); files of format_version 1
+datasets' `role` and `kinds` attributes (FORMAT.md, format_version 2 to 4); files of format_version 1
 lack them and are refused with FormatVersionError (kinesweep info / query still read them), as are
-versions newer than 3. Versions 2 and 3 differ in the /histories layout only, which kshistory reads.
+versions newer than 4. Versions 2 and 3 differ in the /histories layout only, which kshistory reads;
+in version 4 the text columns with few distinct values are HDF5 enums (read here as the same str
+values, and by to_pandas() as pandas categoricals).
 """
 import os
 
 import h5py
 import numpy as np
 
+from kinesweep import frame
 from kinesweep import history as kshistory
 from kinesweep import live as kslive
 from kinesweep.solutions import cluster_solutions  # noqa: F401 (part of this module's interface)
 from kinesweep.kinds import FormatVersionError  # noqa: F401 (the same)
 from kinesweep.kinds import (GOOD_STATUSES, IK_STATUSES, KIND_MEANING, METRIC_LABELS, OTHER_SOLUTION_COLOUR,  # noqa: F401
-                             STATUS_COLOURS, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s)
+                             STATUS_COLOURS, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s, enum_labels,
+                             text_values)
 
 RAD2DEG = 180.0 / np.pi
-FORMAT_VERSIONS = (2, 3)  # the results formats this module reads (engine/store/FORMAT.md)
+FORMAT_VERSIONS = (2, 3, 4)  # the results formats this module reads (engine/store/FORMAT.md)
 ROLES = ("parameter", "metric", "bookkeeping")
 
 # Seed 000, Table 4 (copied from engine/methods/seed_cases.cpp, checked against it by the tests):
@@ -188,7 +192,7 @@ class Results:
             if version not in FORMAT_VERSIONS:
                 engine = self.meta.get("engine_version", "?")
                 what = (f"{path}: results file format v{version} (written by kinesweep {engine}); ksread reads "
-                        f"{' and '.join(f'v{v}' for v in FORMAT_VERSIONS)} only")
+                        f"v{min(FORMAT_VERSIONS)} to v{max(FORMAT_VERSIONS)} only")
                 if version < min(FORMAT_VERSIONS):
                     what += (" (v1 files have no role/kinds attributes on their /runs columns). `kinesweep query` "
                              "and `kinesweep info` still read this file; to use it here, rerun its study: "
@@ -287,7 +291,10 @@ class Results:
                     if len(self._kinds[c]) != 1:
                         continue
                     v = g[c][()]
-                    if v.dtype.kind == "f":
+                    labels = enum_labels(g[c])
+                    if labels is not None:
+                        held = v < len(labels)
+                    elif v.dtype.kind == "f":
                         held = ~np.isnan(v)
                     elif v.dtype.kind in "iu":
                         held = v != -1
@@ -302,7 +309,10 @@ class Results:
 
     @kslive.consistent
     def runs(self, columns=None, done_only=True, degrees=False, pandas=False):
-        """The /runs table: Table (dict of arrays; strings as str objects) or a pandas DataFrame."""
+        """The /runs table: Table (dict of arrays; strings as str objects) or a pandas DataFrame
+        (to_pandas())."""
+        if pandas:
+            return self.to_pandas(columns, done_only=done_only, degrees=degrees)
         g = self.f["runs"]
         done = g["done"][()].astype(bool)  # before the columns (a writer may be committing)
         names = self.columns() if columns is None else list(columns)
@@ -312,8 +322,9 @@ class Results:
                 raise KeyError(f"no column {c!r}; columns: {', '.join(self.columns())}")
             d = g[c]
             v = d[()]
-            if v.dtype.kind in "OSU":
-                v = np.array([_s(x) for x in v], dtype=object)
+            labels = enum_labels(d)
+            if labels is not None or v.dtype.kind in "OSU":
+                v = text_values(d, v)
             unit = _s(d.attrs.get("unit", ""))
             if degrees and unit == "rad":
                 v, unit = v * RAD2DEG, "deg"
@@ -328,9 +339,22 @@ class Results:
             t.roles["done"], t.kinds["done"] = "bookkeeping", []
         return t.to_pandas() if pandas else t
 
+    @kslive.consistent
     def to_pandas(self, columns=None, done_only=True, degrees=False):
-        """The /runs table as a pandas.DataFrame (units in df.attrs["units"]): runs(..., pandas=True)."""
-        return self.runs(columns, done_only=done_only, degrees=degrees, pandas=True)
+        """The /runs table (or its `columns`) as a pandas.DataFrame: numbers read straight into the
+        frame, labelled text as categoricals (kinesweep.frame); df.attrs["units"], ["descriptions"],
+        ["roles"], ["kinds"]. With done_only=False a bool column `done` is added."""
+        g = self.f["runs"]
+        done = g["done"][()].astype(bool)  # before the columns (a writer may be committing)
+        names = self.columns() if columns is None else list(columns)
+        for c in names:
+            if c not in g:
+                raise KeyError(f"no column {c!r}; columns: {', '.join(self.columns())}")
+        df = frame.runs_frame(g, names, done if done_only else None, self._roles, self._kinds, degrees)
+        if not done_only:
+            df["done"] = done
+            df.attrs["units"]["done"] = ""
+        return df
 
     def to_xarray(self, block=None, degrees=False):
         """A block's landscape (default: the first) as an xarray.Dataset (Landscape.to_xarray)."""
@@ -390,7 +414,13 @@ class Results:
         """The block names in file order: order of first appearance in the /runs `block` column."""
         if "block" not in self.f["runs"]:
             return []
-        names = [_s(x) for x in self.f["runs"]["block"][()]]
+        d = self.f["runs"]["block"]
+        labels = enum_labels(d)
+        if labels is not None:  # in order of first appearance, as for strings
+            codes = d[()]
+            present, first = np.unique(codes, return_index=True)
+            return [labels[c] for c, _ in sorted(zip(present, first), key=lambda p: p[1]) if c < len(labels)]
+        names = [_s(x) for x in d[()]]
         return [b for b in dict.fromkeys(names) if b]
 
     @kslive.consistent
@@ -434,7 +464,7 @@ class Results:
         """The run kind of a block's (done) rows, "" when it has none."""
         if "block" not in self._roles:
             return self.run_kinds()[0] if len(self.run_kinds()) == 1 else ""
-        blocks = np.array([_s(x) for x in self.f["runs"]["block"][()]], dtype=object)
+        blocks = text_values(self.f["runs"]["block"])
         done = self.f["runs"]["done"][()].astype(bool)
         kinds = self.row_kinds(done_only=False)[(blocks == block) & done]
         kinds = [k for k in kinds if k]

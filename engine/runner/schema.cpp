@@ -1,5 +1,6 @@
 #include "runner/schema.hpp"
 
+#include <algorithm>
 #include <limits>
 
 namespace ks {
@@ -17,6 +18,10 @@ std::size_t add(std::vector<ColumnSpec>& cols, const ColumnSpec& c) {
   for (std::size_t i = 0; i < cols.size(); ++i)
     if (cols[i].name == c.name) {
       ColumnSpec& have = cols[i];
+      if (have.labels.empty() || c.labels.empty()) have.labels.clear();  // free text for one kind: for all
+      else  // a text column of several kinds holds the values of each
+        for (const std::string& l : c.labels)
+          if (std::find(have.labels.begin(), have.labels.end(), l) == have.labels.end()) have.labels.push_back(l);
       if (!c.kinds.empty() && !have.kinds.empty() && ("," + have.kinds + ",").find("," + c.kinds + ",") == std::string::npos) {
         if (have.description != c.description) {  // one description per kind: "trajectory: ...; ik: ..."
           if (have.kinds.find(',') == std::string::npos) have.description = have.kinds + ": " + have.description;
@@ -36,6 +41,7 @@ StudySchema make_schema(const Study& study) {
   auto& c = s.columns;
   s.run_id = add(c, run_id_column());
   s.block = add(c, block_column());
+  for (const Block& b : study.blocks) c[s.block].labels.push_back(b.name());
   for (const Block& b : study.blocks) {
     std::vector<std::size_t> pc;
     for (const ColumnSpec& p : b.columns()) pc.push_back(add(c, p));

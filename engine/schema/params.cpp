@@ -1,6 +1,7 @@
 // What the kinds share: names, effect rules, columns, defaults, outcomes (see schema/params.hpp).
 #include "schema/params.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -59,7 +60,9 @@ Cell ParamDef::from_file(double v) const {
   return file_unit == FileUnit::deg ? v * kDeg : v;
 }
 ColumnSpec ParamDef::column(BlockKind kind) const {
-  return {name, type, unit, description, Role::parameter, std::string(to_string(kind))};
+  ColumnSpec c{name, type, unit, description, Role::parameter, std::string(to_string(kind))};
+  if (type == CellType::str) c.labels = choices;
+  return c;
 }
 ColumnSpec MetricDef::column(BlockKind kind) const {
   return {name, type, unit, description, Role::metric, std::string(to_string(kind))};
@@ -146,7 +149,11 @@ ColumnSpec status_column() {
     const auto s = statuses(k);
     for (std::size_t i = 0; i < s.size(); ++i) d += (i ? ", " : " ") + std::string(s[i]);
   }
-  return {"status", CellType::str, "", d, Role::bookkeeping, ""};
+  ColumnSpec c{"status", CellType::str, "", d, Role::bookkeeping, ""};
+  for (BlockKind k : block_kinds())
+    for (std::string_view w : statuses(k))
+      if (std::find(c.labels.begin(), c.labels.end(), w) == c.labels.end()) c.labels.emplace_back(w);
+  return c;
 }
 ColumnSpec wall_time_column() {
   return {"wall_time", CellType::f64, "s",

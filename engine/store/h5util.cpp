@@ -6,6 +6,8 @@
 #include <cstring>
 #include <unordered_set>
 
+#include "store/label_columns.hpp"
+
 namespace ks::store {
 
 void print_hdf5_error_stack(bool print) {
@@ -211,6 +213,7 @@ std::vector<ColumnSpec> read_run_columns(hid_t file, const std::string& path, st
     c.name = name;
     H5T_class_t cls = H5Tget_class(t);
     c.type = cls == H5T_FLOAT ? CellType::f64 : cls == H5T_INTEGER ? CellType::i64 : CellType::str;
+    if (cls == H5T_ENUM) c.labels = enum_labels(t, path, name);
     c.unit = read_str_attr(d, "unit");
     c.description = read_str_attr(d, "description");
     if (roles_stored) {

@@ -191,7 +191,7 @@ std::vector<std::string> ResultsReader::landscapes() const {
   return out;
 }
 
-LandscapeSpec ResultsReader::read_landscape(const std::string& block) const {
+LandscapeSpec ResultsReader::read_landscape(const std::string& block, bool grids) const {
   QuietHdf5 quiet;
   LandscapeSpec spec;
   spec.block = block;
@@ -212,6 +212,11 @@ LandscapeSpec ResultsReader::read_landscape(const std::string& block) const {
     spec.axes.push_back({name, unit, std::move(v)});
   }
   for (auto& name : read_str_list_attr(g, "metrics")) {
+    if (!grids) {
+      Hid d(check(H5Dopen2(g, name.c_str(), H5P_DEFAULT), impl_->path, "open /" + gp + "/" + name));
+      spec.metrics.push_back({name, read_str_attr(d, "unit"), read_str_attr(d, "description"), {}});
+      continue;
+    }
     auto [v, unit] = read_all(name);
     Hid d(H5Dopen2(g, name.c_str(), H5P_DEFAULT));
     spec.metrics.push_back({name, unit, read_str_attr(d, "description"), std::move(v)});

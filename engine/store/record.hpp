@@ -50,6 +50,10 @@ struct ColumnSpec {
   Role role = Role::bookkeeping;
   std::string kinds;        ///< comma-separated run kinds the column applies to ("trajectory", "ik",
                             ///< "trajectory,ik"); "" for bookkeeping columns that apply to every run
+  /// A text column with few distinct values: every value it may hold besides "" (the missing
+  /// value), stored as an HDF5 enum of codes 0..labels.size()-1 (FORMAT.md, /runs). Empty: the column
+  /// holds any text, stored as variable-length strings. Ignored for numeric columns.
+  std::vector<std::string> labels = {};
 };
 
 /// One result row: one cell per ColumnSpec of the study's schema, in schema order.

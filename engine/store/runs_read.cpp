@@ -1,6 +1,7 @@
 #include "store/runs_read.hpp"
 
 #include "store/h5util.hpp"
+#include "store/label_columns.hpp"
 
 namespace ks::store::detail {
 
@@ -19,18 +20,33 @@ std::pair<Hid, Hid> row_spaces(hid_t d, const RowSelection& sel) {
 }
 }  // namespace
 
+void read_runs_typed(hid_t d, const std::string& path, const std::string& name, hid_t mtype, const RowSelection& sel,
+                     void* out) {
+  if (sel.size() == 0) return;
+  auto [fs, ms] = row_spaces(d, sel);
+  check(H5Dread(d, mtype, ms, fs, H5P_DEFAULT, out), path, "read /runs/" + name);
+}
+
 void read_runs_numbers(hid_t file, const std::string& path, const std::string& name, hid_t mtype,
                        const RowSelection& sel, void* out) {
   if (sel.size() == 0) return;
   Hid d(check(H5Dopen2(file, ("runs/" + name).c_str(), H5P_DEFAULT), path, "open /runs/" + name));
-  auto [fs, ms] = row_spaces(d, sel);
-  check(H5Dread(d, mtype, ms, fs, H5P_DEFAULT, out), path, "read /runs/" + name);
+  read_runs_typed(d, path, name, mtype, sel, out);
 }
 
 std::vector<std::string> read_runs_strings(hid_t file, const std::string& path, const std::string& name,
                                            const RowSelection& sel) {
   if (sel.size() == 0) return {};
   Hid d(check(H5Dopen2(file, ("runs/" + name).c_str(), H5P_DEFAULT), path, "open /runs/" + name));
+  Hid ft(H5Dget_type(d));
+  if (H5Tget_class(ft) == H5T_ENUM) {
+    const std::vector<std::string> labels = enum_labels(ft, path, name);
+    const std::vector<std::uint16_t> codes = read_label_codes(file, path, name, sel);
+    std::vector<std::string> out(codes.size());
+    for (std::size_t i = 0; i < codes.size(); ++i)
+      if (codes[i] < labels.size()) out[i] = labels[codes[i]];
+    return out;
+  }
   auto [fs, ms] = row_spaces(d, sel);
   return read_vlen_strings(d, ms, fs, sel.size(), path, "read /runs/" + name);
 }

@@ -23,7 +23,11 @@ struct RowSelection {
 /// values). Throws StoreError naming `path`.
 void read_runs_numbers(hid_t file, const std::string& path, const std::string& name, hid_t mtype,
                        const RowSelection& sel, void* out);
-/// Rows `sel` of the text column /runs/<name> ("" for a null string). Throws StoreError.
+/// Rows `sel` of the open /runs dataset `dset` (column `name`) read as `mtype` into `out`.
+void read_runs_typed(hid_t dset, const std::string& path, const std::string& name, hid_t mtype,
+                     const RowSelection& sel, void* out);
+/// Rows `sel` of the text column /runs/<name> ("" for a null string or the missing code of a
+/// labelled column). Throws StoreError.
 std::vector<std::string> read_runs_strings(hid_t file, const std::string& path, const std::string& name,
                                            const RowSelection& sel);
 

@@ -41,12 +41,15 @@ class StoreError : public std::runtime_error {
 void print_hdf5_error_stack(bool print);
 
 inline constexpr const char* kFormatName = "kinesweep-results";
-/// The format this kinesweep writes (3: histories as ragged arrays sharing one row space; 2: one
-/// group per run's history; both: /runs columns carry `role` and `kinds` attributes).
-inline constexpr std::int64_t kFormatVersion = 3;
+/// The format this kinesweep writes (4: text columns with few distinct values as HDF5 enums; 3:
+/// histories as ragged arrays sharing one row space; 2: one group per run's history; all three:
+/// /runs columns carry `role` and `kinds` attributes).
+inline constexpr std::int64_t kFormatVersion = 4;
 /// The oldest format ResultsReader still opens (1: no role/kinds; see ResultsReader's V1ColumnRoles).
-/// Resume (ResultsWriter::open_for_resume) accepts kFormatVersion only.
 inline constexpr std::int64_t kOldestReadableFormatVersion = 1;
+/// The oldest format ResultsWriter::open_for_resume continues (a format 3 file differs from 4 only in
+/// how /runs stores text: its columns, read back without labels, keep their strings).
+inline constexpr std::int64_t kOldestResumableFormatVersion = 3;
 
 /// Root metadata of a results file.
 /// A run kind's meaning as the engine declares it (schema/params.hpp, schema/history_arrays.hpp),
@@ -75,7 +78,8 @@ struct StoreMeta {
 };
 
 /// Throws StoreError unless a results file with these root attributes can be resumed by this
-/// kinesweep (format kinesweep-results, version kFormatVersion); the message names the version.
+/// kinesweep (format kinesweep-results, version kOldestResumableFormatVersion .. kFormatVersion); the
+/// message names the version.
 void require_resumable(const std::string& path, const StoreMeta& meta);
 
 struct StoreOptions {
@@ -219,7 +223,8 @@ class ResultsWriter {
   /// Reopen an existing file to fill its missing runs (recovering it first after a crash, when its
   /// journal matches the file as it is; otherwise refusing with the file untouched). Refuses
   /// with StoreError when the file's study_sha256 differs from `expected_sha256`, or when its
-  /// format_version is not kFormatVersion (checked read-only: a refused file is left untouched).
+  /// format_version is not kOldestResumableFormatVersion .. kFormatVersion (checked read-only: a
+  /// refused file is left untouched).
   static Resumed open_for_resume(const std::string& path, const std::string& expected_sha256,
                                  const StoreOptions& options = {});
 
@@ -329,7 +334,9 @@ class ResultsReader {
   /// when the run has none. Format 3 files; older ones are read and encoded at `level`.
   EncodedHistory read_history_chunks(std::int64_t run_id, int level = 1) const;
   std::vector<std::string> landscapes() const;
-  LandscapeSpec read_landscape(const std::string& block) const;
+  /// A block's landscape: its axes and metrics, with every metric's grid, or (`grids` false) with
+  /// their names, units and descriptions only (grid vectors empty).
+  LandscapeSpec read_landscape(const std::string& block, bool grids = true) const;
   /// Names of the groups under /optimizations (empty when none), and one of them (optimizations_read.cpp).
   std::vector<std::string> optimizations() const;
   OptimizationRecord read_optimization(const std::string& name) const;

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
@@ -18,6 +19,7 @@
 #include "store/h5util.hpp"
 #include "store/journal_format.hpp"
 #include "store/journal_vfd.hpp"
+#include "store/label_columns.hpp"
 #include "store/runs_read.hpp"
 #include "store/store.hpp"
 #include "store/writer_impl.hpp"
@@ -61,7 +63,16 @@ std::unique_ptr<ResultsWriter::Impl> open_writer_impl(const std::string& path, c
 
 namespace {
 
+/// Rows per chunk of the fixed-size /runs columns (FORMAT.md, /runs).
+constexpr hsize_t kRunsChunkRows = 16384;
+
 const char* type_word(CellType t) { return t == CellType::f64 ? "f64" : t == CellType::i64 ? "i64" : "str"; }
+
+std::string join_labels(const std::vector<std::string>& labels) {
+  std::string out;
+  for (std::size_t i = 0; i < labels.size() && i < 12; ++i) out += (i ? ", " : "") + labels[i];
+  return labels.size() > 12 ? out + ", ..." : out;
+}
 
 std::string now_iso8601() {
   std::time_t t = std::time(nullptr);
@@ -124,10 +135,18 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
   Hid space(H5Screate_simple(1, &n, nullptr));
   auto make = [&](const ColumnSpec& c, hid_t ftype, hid_t mtype, const void* fill, const char* type_attr) {
     Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
-    H5Pset_layout(dcpl, H5D_CONTIGUOUS);
-    H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY);  // rows live at fixed addresses from creation on
-    H5Pset_fill_time(dcpl, H5D_FILL_TIME_ALLOC);
-    if (fill) H5Pset_fill_value(dcpl, mtype, fill);
+    if (H5Tis_variable_str(ftype) > 0 || n == 0) {  // heap references: nothing to compress
+      H5Pset_layout(dcpl, H5D_CONTIGUOUS);
+      H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_EARLY);  // rows live at fixed addresses from creation on
+      H5Pset_fill_time(dcpl, H5D_FILL_TIME_ALLOC);
+    } else {  // chunks of kRunsChunkRows rows, shuffled and deflated (or raw: runs_chunks.hpp)
+      const hsize_t rows = std::min<hsize_t>(n, kRunsChunkRows);
+      H5Pset_chunk(dcpl, 1, &rows);
+      H5Pset_shuffle(dcpl);
+      H5Pset_deflate(dcpl, 1);
+      H5Pset_fill_time(dcpl, H5D_FILL_TIME_IFSET);
+    }
+    if (fill) H5Pset_fill_value(dcpl, H5Tget_class(ftype) == H5T_ENUM ? ftype : mtype, fill);
     Hid d(check(H5Dcreate2(runs, c.name.c_str(), ftype, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), path,
                 "create /runs/" + c.name));
     write_str_attr(d, "unit", c.unit);
@@ -139,6 +158,14 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::int64_t minus1 = -1;
   for (auto& c : columns) {
+    if (c.type == CellType::str && !c.labels.empty()) {  // few distinct values: an enum (missing: no member)
+      Hid ft(check(enum_file_type(c.labels), path, "enum type of /runs/" + c.name));
+      const std::uint16_t missing = enum_file_missing(c.labels.size());
+      make(c, ft, H5T_NATIVE_UINT16, &missing, "str");
+      Hid d(check(H5Dopen2(runs, c.name.c_str(), H5P_DEFAULT), path, "open /runs/" + c.name));
+      write_enum_attributes(d, c.labels, path);
+      continue;
+    }
     Hid ft(file_type_of(c.type));
     switch (c.type) {
       case CellType::f64: make(c, ft, H5T_NATIVE_DOUBLE, &nan, "f64"); break;
@@ -172,10 +199,40 @@ void ResultsWriter::Impl::open_objects() {
   histories = Hid(check(H5Gopen2(file, "histories", H5P_DEFAULT), path, "open /histories"));
   landscapes = Hid(check(H5Gopen2(file, "landscapes", H5P_DEFAULT), path, "open /landscapes"));
   done_dset = Hid(check(H5Dopen2(runs, "done", H5P_DEFAULT), path, "open /runs/done"));
+  if (n_runs < 0) n_runs = H5Sget_simple_extent_npoints(Hid(H5Dget_space(done_dset)));  // no n_runs attribute
   open_histories();
   col_dsets.clear();
-  for (auto& c : columns)
-    col_dsets.emplace_back(check(H5Dopen2(runs, c.name.c_str(), H5P_DEFAULT), path, "open /runs/" + c.name));
+  encoders.clear();
+  chunk_col.assign(columns.size(), -1);
+  std::vector<hid_t> chunked;
+  std::vector<std::size_t> sizes;
+  hsize_t chunk_rows = 0;
+  Hid dapl(H5Pcreate(H5P_DATASET_ACCESS));
+  H5Pset_chunk_cache(dapl, 0, 0, 1.0);  // chunks are gathered and written by runs_chunks, never cached
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    const ColumnSpec& c = columns[i];
+    col_dsets.emplace_back(check(H5Dopen2(runs, c.name.c_str(), dapl), path, "open /runs/" + c.name));
+    encoders.emplace_back(c.type == CellType::str && !c.labels.empty() ? LabelEncoder(c.labels) : LabelEncoder());
+    Hid dcpl(H5Dget_create_plist(col_dsets.back()));
+    hsize_t rows = 0;
+    if (H5Pget_layout(dcpl) != H5D_CHUNKED || H5Pget_chunk(dcpl, 1, &rows) != 1) continue;
+    if (chunk_rows != 0 && rows != chunk_rows) throw StoreError(path, "/runs columns with different chunk sizes");
+    chunk_rows = rows;
+    chunk_col[i] = static_cast<int>(chunked.size());
+    chunked.push_back(col_dsets.back());
+    sizes.push_back(H5Tget_size(Hid(H5Dget_type(col_dsets.back()))));
+  }
+  runs_chunks.clear();
+  if (!chunked.empty()) runs_chunks.open(std::move(chunked), std::move(sizes), chunk_rows, static_cast<hsize_t>(n_runs), path);
+}
+
+void ResultsWriter::Impl::count_chunk_done() {
+  chunk_done.clear();
+  if (!runs_chunks.active()) return;
+  const hsize_t cr = runs_chunks.chunk_rows();
+  chunk_done.assign(static_cast<std::size_t>((static_cast<hsize_t>(n_runs) + cr - 1) / cr), 0);
+  for (std::size_t id = 0; id < done.size(); ++id)
+    if (done[id]) ++chunk_done[id / cr];
 }
 
 std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, const StoreMeta& meta,
@@ -189,6 +246,8 @@ std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, co
     validate_name(path, c.name, "column");
     if (c.name == "done") throw StoreError(path, "column name 'done' is reserved for /runs/done");
     if (!seen.insert(c.name).second) throw StoreError(path, "duplicate column '" + c.name + "'");
+    if (c.type == CellType::str && !c.labels.empty() && !enum_storable(c.labels))
+      throw StoreError(path, "column '" + c.name + "': its labels must be 1 to 65534 distinct, non-empty names");
   }
   struct stat st{};
   if (::stat(path.c_str(), &st) == 0) {
@@ -258,6 +317,7 @@ std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, co
   impl->n_runs = n_runs;
   impl->done.assign(static_cast<std::size_t>(n_runs), false);
   impl->open_objects();
+  impl->count_chunk_done();
   return std::unique_ptr<ResultsWriter>(new ResultsWriter(std::move(impl)));
 }
 
@@ -287,6 +347,7 @@ std::vector<Record> ResultsWriter::read_rows(std::int64_t first, std::int64_t co
   first = std::min(first, impl_->n_runs);
   count = std::min(count, impl_->n_runs - first);
   impl_->write_rows();
+  impl_->runs_chunks.write_partial();
   return read_runs_rows(impl_->file, impl_->path, impl_->columns,
                         {static_cast<hsize_t>(first), static_cast<hsize_t>(count)});
 }
@@ -313,10 +374,15 @@ void ResultsWriter::write_run(std::int64_t run_id, const Record& record, const E
     if (!ok)
       throw StoreError(m.path, "run " + std::to_string(run_id) + ": cell '" + m.columns[i].name +
                                    "' does not hold a " + type_word(want));
+    std::uint16_t code = 0;
+    if (!m.columns[i].labels.empty() && !m.encoders[i].encode(std::get<std::string>(record.cells[i]), code))
+      throw StoreError(m.path, "run " + std::to_string(run_id) + ": column '" + m.columns[i].name + "' holds '" +
+                                   std::get<std::string>(record.cells[i]) + "', not one of its labels (" +
+                                   join_labels(m.columns[i].labels) + ")");
   }
   m.write_history(run_id, history);
   m.pending[run_id] = record;
-  m.done[static_cast<std::size_t>(run_id)] = true;
+  m.mark_done(run_id);
   // rows go to the datasets in batches as they come (uncommitted, invisible until the next commit),
   // so that the commit at the end of a sweep, which nothing overlaps, has little left to write
   if (m.pending.size() >= Impl::kRowBatch) m.write_rows();
@@ -356,7 +422,28 @@ void ResultsWriter::Impl::write_rows() {
   for (auto& [id, rec] : pending) ids.push_back(static_cast<hsize_t>(id));
   hsize_t k = ids.size();
   Hid mspace(H5Screate_simple(1, &k, nullptr));
+  std::vector<unsigned char> bytes;
   for (std::size_t c = 0; c < columns.size(); ++c) {
+    if (chunk_col[c] >= 0) {  // gathered per chunk (runs_chunks), in the file's bytes
+      const ColumnSpec& col = columns[c];
+      const std::size_t size = col.type == CellType::str ? encoders[c].code_bytes() : 8;
+      bytes.resize(ids.size() * size);
+      unsigned char* out = bytes.data();
+      for (auto& [id, rec] : pending) {
+        const Cell& cell = rec.cells[c];
+        if (col.type == CellType::f64) std::memcpy(out, &std::get<double>(cell), 8);
+        else if (col.type == CellType::i64) std::memcpy(out, &std::get<std::int64_t>(cell), 8);
+        else {
+          std::uint16_t code = 0;
+          encoders[c].encode(std::get<std::string>(cell), code);
+          if (size == 1) *out = static_cast<unsigned char>(code);
+          else std::memcpy(out, &code, 2);
+        }
+        out += size;
+      }
+      runs_chunks.set(static_cast<std::size_t>(chunk_col[c]), ids, bytes.data());
+      continue;
+    }
     Hid fs = select_rows(col_dsets[c], ids);
     if (fs.get() < 0) fail("select rows");
     herr_t rc = -1;
@@ -374,6 +461,24 @@ void ResultsWriter::Impl::write_rows() {
         break;
       }
       case CellType::str: {
+        if (!columns[c].labels.empty()) {  // codes, checked by write_run; written in the file's enum type
+          std::vector<std::uint16_t> codes;
+          codes.reserve(pending.size());
+          for (auto& [id, rec] : pending) {
+            std::uint16_t code = 0;
+            encoders[c].encode(std::get<std::string>(rec.cells[c]), code);
+            codes.push_back(code);
+          }
+          Hid ft(H5Dget_type(col_dsets[c]));
+          Hid mt(H5Tget_native_type(ft, H5T_DIR_ASCEND));
+          if (encoders[c].code_bytes() == 1) {
+            std::vector<std::uint8_t> narrow(codes.begin(), codes.end());
+            rc = H5Dwrite(col_dsets[c], mt, mspace, fs, H5P_DEFAULT, narrow.data());
+          } else {
+            rc = H5Dwrite(col_dsets[c], mt, mspace, fs, H5P_DEFAULT, codes.data());
+          }
+          break;
+        }
         std::vector<const char*> v;
         for (auto& [id, rec] : pending) v.push_back(std::get<std::string>(rec.cells[c]).c_str());
         Hid t(utf8_vlen_type());
@@ -385,8 +490,24 @@ void ResultsWriter::Impl::write_rows() {
     }
     if (rc < 0) fail("cannot write column " + columns[c].name);
   }
+  if (runs_chunks.active()) {  // the chunks these rows completed: encoded and written once
+    const hsize_t cr = runs_chunks.chunk_rows();
+    std::vector<hsize_t> complete;
+    for (hsize_t id : ids) {
+      const hsize_t k = id / cr;
+      const hsize_t rows = std::min(cr, static_cast<hsize_t>(n_runs) - k * cr);
+      if ((complete.empty() || complete.back() != k) && chunk_done[static_cast<std::size_t>(k)] == rows)
+        complete.push_back(k);
+    }
+    try {
+      runs_chunks.write_complete(complete);
+    } catch (const StoreError&) {
+      fail("cannot write the chunks of /runs");
+    }
+  }
   std::size_t row_bytes = 1;  // the done flag, written at the commit
-  for (const ColumnSpec& c : columns) row_bytes += c.type == CellType::str ? 16 : 8;  // a string: its heap reference
+  for (std::size_t c = 0; c < columns.size(); ++c)  // a string: its heap reference; a label: its code
+    row_bytes += columns[c].type != CellType::str ? 8 : columns[c].labels.empty() ? 16 : encoders[c].code_bytes();
   uncommitted_bytes += ids.size() * row_bytes;
   unflagged.insert(unflagged.end(), ids.begin(), ids.end());
   pending.clear();
@@ -394,6 +515,11 @@ void ResultsWriter::Impl::write_rows() {
 
 void ResultsWriter::Impl::do_flush() {
   write_rows();
+  try {
+    runs_chunks.write_partial();  // incomplete chunks raw, so the commit holds every row written
+  } catch (const StoreError&) {
+    fail("cannot write the chunks of /runs");
+  }
   if (!unflagged.empty()) {
     // 1. the rows (and, already, the histories) are committed before the done flags ...
     if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) fail("flush (commit of rows) failed");
@@ -428,6 +554,7 @@ void ResultsWriter::close() {
   if (m.broken) {
     m.closed = true;
     // the driver refuses to commit after an I/O error; the file keeps its last committed state
+    m.runs_chunks.clear();
     m.col_dsets.clear();
     m.landscape_streams.clear();
     m.hist.close_handles();
@@ -438,6 +565,7 @@ void ResultsWriter::close() {
   }
   m.trim_histories();
   m.do_flush();
+  m.runs_chunks.clear();
   m.col_dsets.clear();
   m.landscape_streams.clear();
   m.hist.close_handles();

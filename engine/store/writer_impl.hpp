@@ -12,6 +12,8 @@
 #include "store/h5util.hpp"
 #include "store/history_datasets.hpp"
 #include "store/journal_vfd.hpp"
+#include "store/label_columns.hpp"
+#include "store/runs_chunks.hpp"
 #include "store/store.hpp"
 
 namespace ks::store {
@@ -23,6 +25,12 @@ struct ResultsWriter::Impl {
   std::int64_t n_runs = 0;
   detail::Hid file, runs, histories, landscapes, done_dset;
   std::vector<detail::Hid> col_dsets;
+  std::vector<detail::LabelEncoder> encoders;  // per column (labelled text columns only)
+  /// The chunked columns (format 4: every fixed-size one) and, per chunk, how many of its rows are
+  /// done (committed or pending): a chunk is encoded once that reaches its row count.
+  detail::RunsChunks runs_chunks;
+  std::vector<int> chunk_col;             // per column: its index in runs_chunks, -1 when contiguous
+  std::vector<std::uint32_t> chunk_done;  // per chunk of runs_chunks.chunk_rows() rows
   std::vector<bool> done;                   // per run, one bit: committed or pending
   std::map<std::int64_t, Record> pending;   // rows not yet in the datasets
   std::vector<hsize_t> unflagged;           // rows in the datasets, not yet committed with done = 1
@@ -77,6 +85,12 @@ struct ResultsWriter::Impl {
     if (broken) throw StoreError(path, "writer failed earlier; the file holds the runs of the last successful flush");
   }
   void open_objects();
+  void count_chunk_done();  ///< chunk_done from done (after open_objects and done are set)
+  void mark_done(std::int64_t id) {
+    if (done[static_cast<std::size_t>(id)]) return;
+    done[static_cast<std::size_t>(id)] = true;
+    if (runs_chunks.active()) ++chunk_done[static_cast<std::size_t>(static_cast<hsize_t>(id) / runs_chunks.chunk_rows())];
+  }
   void write_history(std::int64_t id, const EncodedHistory& h);
   void open_histories();          ///< the history state of an existing file (resume)
   void write_history_index();     ///< pending index entries and the group's attributes (no commit)

@@ -29,15 +29,15 @@ FormatStamp read_format_stamp(hid_t file) {
           read_i64_attr(file, "format_version", -1)};
 }
 
-/// Throws StoreError unless `s` is a kinesweep results file of the format this kinesweep writes:
-/// resuming must not mix two formats in one file.
+/// Throws StoreError unless `s` is a kinesweep results file of a format this kinesweep resumes: one
+/// whose layout it writes as it is (a format 3 file keeps its text columns as strings).
 void require_resumable_format(const std::string& path, const FormatStamp& s) {
   if (s.format != kFormatName)
     throw StoreError(path, "not a kinesweep results file (attribute format != kinesweep-results)");
-  if (s.version == kFormatVersion) return;
-  const std::string v = "v" + std::to_string(kFormatVersion);
+  if (s.version >= kOldestResumableFormatVersion && s.version <= kFormatVersion) return;
+  const std::string v = "v" + std::to_string(kOldestResumableFormatVersion) + " to v" + std::to_string(kFormatVersion);
   std::string m = "results file format v" + std::to_string(s.version) + " (written by kinesweep " +
-                  (s.engine_version.empty() ? std::string("?") : s.engine_version) + "); this kinesweep writes " + v;
+                  (s.engine_version.empty() ? std::string("?") : s.engine_version) + "); this kinesweep resumes " + v;
   if (s.version < kFormatVersion) m += ": rerun with --overwrite";
   else m += ": resume it with the kinesweep that wrote it, or rerun with --overwrite";
   throw StoreError(path, m);
@@ -113,6 +113,7 @@ ResultsWriter::Resumed ResultsWriter::open_for_resume(const std::string& path, c
         if (piece[static_cast<std::size_t>(i)]) impl->done[static_cast<std::size_t>(first + i)] = true;
     }
   }
+  impl->count_chunk_done();
   Resumed r;
   r.writer = std::unique_ptr<ResultsWriter>(new ResultsWriter(std::move(impl)));
   return r;

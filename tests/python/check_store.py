@@ -5,8 +5,10 @@ usage: check_store.py STORE_WRITER_HELPER WORKDIR
 
 1. Writes a complete file with the C++ helper and checks, with h5py + numpy only, the attributes,
    the /runs table (all columns one length, values recomputed here from the same formulas as
-   tests/store_testgen.cpp), the histories (bit-identical, chunked + deflate; in the layout of the
-   file's format_version, 2 or 3) and a landscape.
+   tests/store_testgen.cpp; labelled text columns HDF5 enums with their CF attributes, fixed-size
+   columns chunked + shuffle/deflate, free text variable-length strings), the histories
+   (bit-identical, chunked + deflate; in the shared row space of format_version 3 and 4) and a
+   landscape.
 2. Starts the helper writing slowly and reads the file concurrently, many times, while it grows.
 """
 import math
@@ -22,9 +24,17 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
 from kslive import stamp  # noqa: E402  FORMAT.md, "Reading while a sweep runs"
+from kinesweep.kinds import enum_labels, text_values  # noqa: E402
+
+FORMAT_VERSION = 4
+CHUNK_ROWS = 16384  # rows per chunk of the fixed-size /runs columns (FORMAT.md, "/runs")
 
 STATUSES = ["ok", "diverged", "singular", "ok-\u00f1"]
-COLUMNS = [("alpha", "f", "rad"), ("E", "f", "Nm"), ("iters", "i", ""), ("status", "O", ""), ("method", "O", "")]
+# (name, numpy dtype kind, unit): status is free text (variable-length strings), method is labelled
+# (an enum over uint8).
+COLUMNS = [("alpha", "f", "rad"), ("E", "f", "Nm"), ("iters", "i", ""), ("status", "O", ""), ("method", "u", "")]
+# The labels of the labelled columns, by code (store_testgen.cpp's ColumnSpec choices).
+LABELS = {"method": ["pinv", "dls"]}
 # The ColumnSpecs of tests/store_testgen.cpp (test_columns) beyond name and unit: description, role, kinds.
 SPECS = {
     "alpha": ("first swept angle", "parameter", "trajectory"),
@@ -81,7 +91,9 @@ def check_table(f, n, require_all_done):
     """Reads /runs like pandas would; done mask first, so that every row seen done is complete."""
     runs = f["runs"]
     done = runs["done"][()]
-    table = {k: runs[k][()] for k in runs}  # == pandas.DataFrame({k: f['runs'][k][()] for k in f['runs']})
+    # text columns as str (enum codes through their labels), numbers as stored
+    table = {k: text_values(runs[k]) if runs[k].dtype.kind == "O" or enum_labels(runs[k]) is not None
+             else runs[k][()] for k in runs}
     lengths = {k: len(v) for k, v in table.items()}
     check(len(set(lengths.values())) == 1 and lengths["done"] == n, f"/runs lengths differ or != {n}: {lengths}")
     ok_rows = 0
@@ -97,7 +109,7 @@ def check_table(f, n, require_all_done):
 
 
 def check_history(f, i):
-    if int(f.attrs["format_version"]) == 3:
+    if int(f.attrs["format_version"]) >= 3:
         check_history_v3(f, i)
         return
     want = expected_history(i)
@@ -119,7 +131,7 @@ def check_history(f, i):
 
 
 def check_history_v3(f, i):
-    """format_version 3: run i is rows [start[i], start[i] + rows[i]) of the datasets named by
+    """format_version 3 and 4: run i is rows [start[i], start[i] + rows[i]) of the datasets named by
     layouts[layout[i]], starting on a chunk boundary, NaN from its end to the next chunk boundary."""
     want = expected_history(i)
     g = f["histories"]
@@ -158,7 +170,7 @@ def check_complete(path, n):
     with h5py.File(path, "r") as f:
         a = f.attrs
         check(as_str(a["format"]) == "kinesweep-results", "format attribute")
-        check(int(a["format_version"]) in (2, 3), "format_version attribute")
+        check(int(a["format_version"]) == FORMAT_VERSION, f"format_version attribute {a['format_version']!r}")
         check(len(as_str(a["engine_version"])) > 0, "engine_version attribute")
         check(re.fullmatch(r"[0-9a-f]{64}", as_str(a["study_sha256"])) is not None, "study_sha256 is 64 hex digits")
         check(re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", as_str(a["created"])) is not None, "created ISO 8601")
@@ -173,6 +185,7 @@ def check_complete(path, n):
             check("unit" in d.attrs and "description" in d.attrs, f"/runs/{name} unit/description attributes")
             check(as_str(d.attrs["unit"]) == unit, f"/runs/{name} unit {d.attrs['unit']!r}")
             check(d.dtype.kind == kind, f"/runs/{name} dtype {d.dtype}")
+        check_column_layout(runs, n)
         check_column_specs(runs)
         check(check_table(f, n, True) == n, "all done")
         for i in range(n):
@@ -189,6 +202,50 @@ def check_complete(path, n):
             check(len(df) == n, "pandas DataFrame rows")
         except ImportError:
             pass
+
+
+def check_column_layout(runs, n):
+    """FORMAT.md, "/runs": a labelled text column is an enum over uint8 (label = code 0..L-1) with
+    flag_values, flag_meanings and _FillValue (255, no member) attributes and reads as its codes;
+    free text is variable-length UTF-8 strings, contiguous; numbers and labels are chunked (C rows,
+    N when N is smaller) through shuffle then deflate, with fill values the missing values."""
+    for name, kind, _ in COLUMNS + [("done", "u", "")]:
+        d = runs[name]
+        labels = LABELS.get(name)
+        if labels is not None:
+            check(d.dtype == np.dtype("uint8"), f"/runs/{name} base type {d.dtype}")
+            check(h5py.check_enum_dtype(d.dtype) == {lab: code for code, lab in enumerate(labels)},
+                  f"/runs/{name} enum members {h5py.check_enum_dtype(d.dtype)}")
+            check(enum_labels(d) == labels, f"/runs/{name} labels by code {enum_labels(d)}")
+            fv = d.attrs.get("flag_values")
+            check(fv is not None and np.asarray(fv).dtype == np.dtype("uint8")
+                  and np.asarray(fv).tolist() == list(range(len(labels))), f"/runs/{name} flag_values {fv!r}")
+            check(as_str(d.attrs.get("flag_meanings", "?")) == " ".join(x.replace(" ", "_") for x in labels),
+                  f"/runs/{name} flag_meanings {d.attrs.get('flag_meanings')!r}")
+            fill = d.attrs.get("_FillValue")
+            check(fill is not None and np.asarray(fill).dtype == np.dtype("uint8")
+                  and np.asarray(fill).ravel().tolist() == [255], f"/runs/{name} _FillValue {fill!r}")
+            check(int(d.fillvalue) == 255, f"/runs/{name} fill value {d.fillvalue!r}")
+            check(as_str(d.attrs.get("type", "?")) == "str", f"/runs/{name} type {d.attrs.get('type')!r}")
+            check(set(d[()].tolist()) <= set(range(len(labels))) | {255}, f"/runs/{name} codes {set(d[()].tolist())}")
+        else:
+            check(h5py.check_enum_dtype(d.dtype) is None, f"/runs/{name} is not an enum")
+            for a in ("flag_values", "flag_meanings", "_FillValue"):
+                check(a not in d.attrs, f"/runs/{name} has no {a} attribute")
+        if kind == "O":
+            info = h5py.check_string_dtype(d.dtype)
+            check(info is not None and info.length is None and info.encoding == "utf-8",
+                  f"/runs/{name} is a variable-length UTF-8 string: {info}")
+            check(d.chunks is None, f"/runs/{name} is contiguous: chunks {d.chunks}")
+        else:
+            check(d.chunks == (min(n, CHUNK_ROWS),), f"/runs/{name} chunks {d.chunks}")
+            check(d.shuffle and d.compression == "gzip", f"/runs/{name} filters: shuffle {d.shuffle}, {d.compression}")
+            if d.id.get_num_chunks():
+                masks = [d.id.get_chunk_info(k).filter_mask for k in range(d.id.get_num_chunks())]
+                check(all(m == 0 for m in masks), f"/runs/{name} chunk filter masks {masks}")
+    for name, want in (("alpha", math.nan), ("E", math.nan), ("iters", -1), ("done", 0)):
+        fv = runs[name].fillvalue
+        check((math.isnan(want) and math.isnan(fv)) or fv == want, f"/runs/{name} fill value {fv!r}")
 
 
 def check_column_specs(runs):

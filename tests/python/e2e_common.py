@@ -11,7 +11,8 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
-from kshistory import Histories, group_name  # noqa: E402  the /histories layouts (format_version 1 to 3)
+from kshistory import Histories, group_name  # noqa: E402  the /histories layouts (format_version 1 to 4)
+from kinesweep.kinds import enum_labels, text_values  # noqa: E402  /runs text columns (FORMAT.md, "/runs")
 
 # A trajectory landscape (561 runs) and an IK basin (441 runs): about a second on 2 cores.
 SWEEP = """
@@ -93,10 +94,28 @@ def same_histories(test, fa, fb):
             test.assertTrue(bitwise_equal(x, y), f"run {i} {name}")
 
 
+def is_text(d):
+    """A /runs dataset holds text: labelled (an HDF5 enum, format_version 4) or free (strings)."""
+    return enum_labels(d) is not None or d.dtype.kind in "OSU"
+
+
+def runs_column(d):
+    """A /runs dataset's values: text columns (labelled or free) as an object array of str, the
+    missing value as ""; numbers as stored."""
+    return text_values(d) if is_text(d) else d[()]
+
+
+def runs_columns(f, skip=()):
+    """Every /runs column of an open results file but those in `skip`, as runs_column reads them."""
+    g = f["runs"]
+    return {k: runs_column(g[k]) for k in g if k not in skip}
+
+
 def runs_table(path):
-    """Every /runs column but wall_time (the one column that varies between identical sweeps)."""
+    """Every /runs column but wall_time (the one column that varies between identical sweeps), text
+    as str."""
     with h5py.File(path, "r") as f:
-        return {k: f["runs"][k][()] for k in f["runs"] if k != "wall_time"}
+        return runs_columns(f, skip=("wall_time",))
 
 
 def same_tables(a, b):
@@ -104,13 +123,22 @@ def same_tables(a, b):
 
 
 def make_v1(src, dst):
-    """A format_version 1 copy of a results file: no role / kinds attributes on /runs, histories in
-    the group layout (one group per run), version 1."""
+    """A format_version 1 copy of a results file: text columns as variable-length strings (labelled
+    columns of format_version 4 rewritten), no role / kinds attributes on /runs, histories in the
+    group layout (one group per run), version 1."""
     shutil.copyfile(src, dst)
     with h5py.File(dst, "r+") as f:
-        for k in f["runs"]:
+        for k in list(f["runs"]):
+            d = f["runs"][k]
+            if enum_labels(d) is not None:
+                values, attrs = text_values(d), dict(d.attrs)
+                del f["runs"][k]
+                d = f["runs"].create_dataset(k, data=values, dtype=h5py.string_dtype())
+                for a, v in attrs.items():
+                    if a not in ("flag_values", "flag_meanings", "_FillValue"):
+                        d.attrs[a] = v
             for a in ("role", "kinds"):
-                del f["runs"][k].attrs[a]
+                del d.attrs[a]
         hist = list(Histories(f).items())
         n = len(f["runs"]["done"])
         del f["histories"]
@@ -155,7 +183,7 @@ class TempDirTest(unittest.TestCase):
 class StudyFileTest(unittest.TestCase):
     """A test case over one results file, run once for the class: subclasses set KS (the kinesweep
     binary), NAME and STUDY (the study text); cls.h5 is the file and cls.runs its /runs columns as
-    read by h5py (text columns as numpy arrays of str)."""
+    read by h5py (text columns as object arrays of str: runs_column)."""
     KS = NAME = STUDY = None
 
     @classmethod
@@ -163,9 +191,7 @@ class StudyFileTest(unittest.TestCase):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.h5 = run_study_text(cls.KS, cls.tmp.name, cls.NAME, cls.STUDY)
         with h5py.File(cls.h5, "r") as f:
-            g = f["runs"]
-            cls.runs = {k: (np.array(g[k].asstr()[()], dtype=object) if g[k].dtype.kind == "O" else g[k][()])
-                        for k in g}
+            cls.runs = runs_columns(f)
 
     @classmethod
     def tearDownClass(cls):

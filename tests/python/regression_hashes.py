@@ -59,7 +59,7 @@ def decode_text(values, source=None):
     enum = h5py.check_enum_dtype(dtype) if dtype.kind != "b" else None
     if enum is not None:
         names = {code: name for name, code in enum.items()}
-        return [names[int(v)] for v in flat]
+        return [names.get(int(v), "") for v in flat]  # a code without a member: the missing value
     if dtype.kind in "SUO":
         return [v.decode("utf-8") if isinstance(v, bytes) else str(v) for v in flat]
     return None

@@ -16,7 +16,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, history
+from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, history, runs_column
 
 KS = None
 ROOT = None
@@ -242,7 +242,7 @@ class AnalysisTest(unittest.TestCase):
     def test_histories(self):
         d = self.plot("plot_histories.py", self.files["table4"], "--preset", "1a,2d", "--what", "tau,q,qd")
         with h5py.File(self.files["table4"], "r") as f:
-            preset = [h5str(x) for x in f["runs"]["preset"][()]]
+            preset = runs_column(f["runs"]["preset"]).tolist()
             for case in ("1a", "2d"):
                 run = preset.index(case)
                 h = history(f, run)
@@ -256,7 +256,7 @@ class AnalysisTest(unittest.TestCase):
     def test_cases(self):
         d = self.plot("plot_cases.py", self.files["table4"])
         with h5py.File(self.files["table4"], "r") as f:
-            preset = [h5str(x) for x in f["runs"]["preset"][()]]
+            preset = runs_column(f["runs"]["preset"]).tolist()
             E = f["runs"]["E"][()]
         self.assertEqual(d["cases"], preset)
         np.testing.assert_array_equal(d["kinesweep"], E)
@@ -290,7 +290,7 @@ class AnalysisTest(unittest.TestCase):
     def test_convergence(self):
         d = self.plot("plot_convergence.py", self.files["convergence"])
         with h5py.File(self.files["convergence"], "r") as f:
-            method = [h5str(x) for x in f["runs"]["method"][()]]
+            method = runs_column(f["runs"]["method"]).tolist()
             lam = f["runs"]["lambda"][()]
             self.assertEqual(len(d["runs"]), len(method))  # one line per (method, lambda)
             for run, got in d["runs"].items():

@@ -1,5 +1,5 @@
-"""The /histories layouts of format_version 2 (one group per run) and 3 (one shared row space, FORMAT.md)
-read the same through every Python reader: ksread (has_history, history_arrays, history_ids,
+"""The /histories layouts of format_version 2 (one group per run) and 3 and 4 (one shared row space,
+FORMAT.md) read the same through every Python reader: ksread (has_history, history_arrays, history_ids,
 history_count, history, read_history), kshistory, regression_hashes' per-array hashes, check_store's
 history check, report_traces and the plot scripts (plot_histories, plot_convergence).
 
@@ -7,7 +7,8 @@ The test writes the files itself with h5py, from histories it generates (the ora
 IK runs, an IK array of another column count (dataset `F.2` holding array F), a run without a history,
 a run whose history has 0 rows, a history exactly one chunk long, a run not done, v3 runs stored in an
 order other than their ids (NaN padding rows between them), one v3 file with spare rows past
-`used_rows` and one without. Every reader's answer must equal the oracle, in every file.
+`used_rows` and one without, and a v4 file (the v3 layout, its labelled /runs text columns HDF5
+enums). Every reader's answer must equal the oracle, in every file.
 
 usage: /usr/bin/python3 test_history_layouts.py [REPO_ROOT]
 """
@@ -30,6 +31,16 @@ RAD2DEG = 180.0 / np.pi
 C = 4          # chunk_rows of the v3 files
 N = 10         # runs
 STR = h5py.string_dtype()
+MISSING_CODE = 255  # the missing value of a labelled column (FORMAT.md, "/runs"): no enum member
+# The labels (by code) of the /runs text columns a v4 file stores as enums, as the engine declares them:
+# every block, the methods of both kinds, the statuses of both kinds (some never held by a row).
+LABELS = {
+    "block": ["traj", "ik"],
+    "method": ["local_weighted", "local_unweighted", "vertex_alpha", "newton", "lm", "lm_adaptive", "halley_thesis",
+               "halley", "analytic"],
+    "status": ["ok", "unreachable_start", "singular", "diverged", "undersampled", "off_path", "out_of_limits",
+               "converged", "stalled", "max_iter", "cycle", "no_solution", "unsupported"],
+}
 
 # run id -> (kind, block, method, lambda, history layout or None, history rows, done)
 #   "traj": t (1, s), q (3, rad), qd (3, rad/s), tau (3, Nm)
@@ -109,8 +120,24 @@ def write_common(f, version):
     runs.attrs["n_runs"] = np.int64(N)
     for name, values, unit, typ, role, kind in cols + [("done", np.array([RUNS[i][6] for i in range(N)], dtype=np.uint8),
                                                         "", "u8", "bookkeeping", "")]:
-        d = runs.create_dataset(name, data=values, dtype=STR if typ == "str" else None)
+        if version >= 4 and name in LABELS:
+            d = create_labelled(runs, name, values, LABELS[name])
+        else:
+            d = runs.create_dataset(name, data=values, dtype=STR if typ == "str" else None)
         d.attrs.update({"unit": unit, "description": name, "type": typ, "role": role, "kinds": kind})
+
+
+def create_labelled(runs, name, values, labels):
+    """A labelled text column of format_version 4 (FORMAT.md, "/runs"): an enum over uint8, label =
+    code 0..L-1, "" stored as the missing code; chunked through shuffle + deflate; CF attributes."""
+    codes = np.array([labels.index(v) if v else MISSING_CODE for v in values], dtype=np.uint8)
+    dt = h5py.enum_dtype({label: code for code, label in enumerate(labels)}, basetype=np.uint8)
+    d = runs.create_dataset(name, data=codes, dtype=dt, chunks=(len(codes),), shuffle=True, compression="gzip",
+                            fillvalue=MISSING_CODE)
+    d.attrs["flag_values"] = np.arange(len(labels), dtype=np.uint8)
+    d.attrs["flag_meanings"] = " ".join(label.replace(" ", "_") for label in labels)
+    d.attrs["_FillValue"] = np.uint8(MISSING_CODE)
+    return d
 
 
 def write_v2(path, hist, version=2):
@@ -126,9 +153,9 @@ def write_v2(path, hist, version=2):
                 run.create_dataset(a, data=v, dtype="<f8", **kw).attrs["unit"] = unit
 
 
-def write_v3(path, hist, order, spare_chunks, compression):
-    """The ragged layout of FORMAT.md, format_version 3; runs stored in `order`, each from a chunk
-    boundary; `spare_chunks` chunks of rows past used_rows."""
+def write_v3(path, hist, order, spare_chunks, compression, version=3):
+    """The ragged layout of FORMAT.md, format_version 3 (or `version`: 4 has the same layout); runs
+    stored in `order`, each from a chunk boundary; `spare_chunks` chunks of rows past used_rows."""
     first_cols, datasets, layouts, placed = {}, {}, [], {}
     end = 0
     for i in order:
@@ -148,7 +175,7 @@ def write_v3(path, hist, order, spare_chunks, compression):
     for i, (s, n, j) in placed.items():
         start[i], rows[i], layout[i] = s, n, j
     with h5py.File(path, "w") as f:
-        write_common(f, 3)
+        write_common(f, version)
         g = f.create_group("histories")
         g.attrs["chunk_rows"] = np.int64(C)
         g.attrs["layouts"] = np.array(layouts, dtype=STR)
@@ -196,7 +223,9 @@ class HistoryLayouts(unittest.TestCase):
         cls.placed = write_v3(cls.v3, cls.hist, [8, 2, 5, 3, 0, 4, 7, 6], spare_chunks=1, compression=True)
         cls.v3b = os.path.join(d, "v3b.h5")  # the 0-row run stored last, no spare rows, no filter
         cls.placed_b = write_v3(cls.v3b, cls.hist, [7, 6, 5, 4, 2, 0, 8, 3], spare_chunks=0, compression=False)
-        cls.files = {"v2": cls.v2, "v3": cls.v3, "v3b": cls.v3b}
+        cls.v4 = os.path.join(d, "v4.h5")  # as v3, its block, method and status columns enums
+        write_v3(cls.v4, cls.hist, [8, 2, 5, 3, 0, 4, 7, 6], spare_chunks=1, compression=True, version=4)
+        cls.files = {"v2": cls.v2, "v3": cls.v3, "v3b": cls.v3b, "v4": cls.v4}
 
     @classmethod
     def tearDownClass(cls):
@@ -246,6 +275,22 @@ class HistoryLayouts(unittest.TestCase):
                 h = ksread.read_history(path, 5)
                 self.assertTrue(same_bits(h["qd"], self.hist[5][2][1]))
 
+    def test_ksread_runs_the_same_in_every_file(self):
+        """/runs reads the same whatever the format: the v4 file's enum codes as their labels."""
+        import ksread
+        with h5py.File(self.v4, "r") as f:
+            for name, labels in LABELS.items():
+                self.assertIsNotNone(h5py.check_enum_dtype(f["runs"][name].dtype), name)
+        want = {"block": [RUNS[i][1] for i in range(N)], "method": [RUNS[i][2] for i in range(N)],
+                "status": ["converged" if RUNS[i][0] == "ik" else "ok" for i in range(N)]}
+        for name, path in self.files.items():
+            with self.subTest(file=name), ksread.open_results(path) as r:
+                t = r.runs(done_only=False)
+                for c, values in want.items():
+                    self.assertEqual(t[c].tolist(), values, c)
+                self.assertEqual(r.blocks(), ["traj", "ik"])
+                self.assertEqual(r.row_kinds(done_only=False).tolist(), [RUNS[i][0] for i in range(N)])
+
     def test_kshistory_items_in_run_id_order(self):
         import kshistory
         for name, path in self.files.items():
@@ -279,7 +324,8 @@ class HistoryLayouts(unittest.TestCase):
         want = {i: {a: (v, u) for a, v, u in arrays} for i, arrays in self.hist.items()}
         check_store.expected_history = lambda i: want.get(i)
         try:
-            for name, path in (("v2", self.v2), ("v3", self.v3)):  # the filtered ones (check_store wants deflate)
+            # the filtered ones (check_store wants deflate)
+            for name, path in (("v2", self.v2), ("v3", self.v3), ("v4", self.v4)):
                 with self.subTest(file=name), h5py.File(path, "r") as f:
                     del check_store.failures[:]
                     for i in range(N):
@@ -352,24 +398,24 @@ class HistoryLayouts(unittest.TestCase):
 
     def test_other_versions(self):
         """v1 keeps the group layout (kshistory reads it; ksread refuses v1 for its /runs); a version
-        newer than 3 is refused by both, naming the version; a file without /histories has none."""
+        newer than 4 is refused by both, naming the version; a file without /histories has none."""
         import kshistory
         import ksread
         v1 = os.path.join(self.tmp.name, "v1.h5")
         write_v2(v1, self.hist, version=1)
         with h5py.File(v1, "r") as f:
             self.assertEqual([i for i, _ in kshistory.Histories(f).items()], sorted(self.hist))
-        v4 = os.path.join(self.tmp.name, "v4.h5")
-        write_v3(v4, self.hist, sorted(self.hist), spare_chunks=0, compression=False)
-        with h5py.File(v4, "r+") as f:
-            f.attrs["format_version"] = np.int64(4)
+        v5 = os.path.join(self.tmp.name, "v5.h5")
+        write_v3(v5, self.hist, sorted(self.hist), spare_chunks=0, compression=False, version=4)
+        with h5py.File(v5, "r+") as f:
+            f.attrs["format_version"] = np.int64(5)
         with self.assertRaises(ksread.FormatVersionError) as e:
-            ksread.open_results(v4)
-        self.assertIn("format v4", str(e.exception))
-        with h5py.File(v4, "r") as f, self.assertRaises(ksread.FormatVersionError) as e:
+            ksread.open_results(v5)
+        self.assertIn("format v5", str(e.exception))
+        with h5py.File(v5, "r") as f, self.assertRaises(ksread.FormatVersionError) as e:
             kshistory.Histories(f)
-        self.assertIn("format v4", str(e.exception))
-        for version in (2, 3):
+        self.assertIn("format v5", str(e.exception))
+        for version in (2, 3, 4):
             path = os.path.join(self.tmp.name, f"none_v{version}.h5")
             with h5py.File(path, "w") as f:
                 write_common(f, version)

@@ -13,7 +13,7 @@ import unittest
 
 import h5py
 
-from e2e_common import TempDirTest, history
+from e2e_common import TempDirTest, history, runs_column
 
 KS = None
 
@@ -87,7 +87,7 @@ class Kinds(TempDirTest):
 
     def test_history_arrays_are_the_ones_written(self):
         with h5py.File(self.out, "r") as f:
-            blocks = strings(f["runs"]["block"][()])
+            blocks = runs_column(f["runs"]["block"]).tolist()
             traj, ik = blocks.index("traj"), blocks.index("scara")
             t = f["kinds"]["trajectory"].attrs
             h = history(f, traj)

@@ -14,7 +14,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import TempDirTest, bitwise_equal
+from e2e_common import TempDirTest, bitwise_equal, runs_column
 
 KS = ANALYSIS = None
 
@@ -68,7 +68,7 @@ class LandscapeStream(TempDirTest):
         with h5py.File(out, "r") as f:
             done = f["runs/done"][()].astype(bool)
             E = f["runs/E"][()]
-            status = f["runs/status"].asstr()[()]
+            status = runs_column(f["runs/status"])
         n = len(done)
         self.assertTrue(0 < done.sum() < n, f"{done.sum()} of {n} runs done: the stop came too late or too early")
         grid = landscape(out)

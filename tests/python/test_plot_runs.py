@@ -18,7 +18,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import run_study_text
+from e2e_common import run_study_text, runs_column
 
 KS = None
 ROOT = None
@@ -90,8 +90,7 @@ def read_runs(path):
         g = f["runs"]
         cols, units = {}, {}
         for c in g:
-            v = g[c][()]
-            cols[c] = np.array([h5str(x) for x in v], dtype=object) if v.dtype.kind in "OS" else v
+            cols[c] = runs_column(g[c])
             units[c] = h5str(g[c].attrs.get("unit", ""))
     return cols, units
 

@@ -24,7 +24,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import Histories
+from e2e_common import Histories, runs_column
 from regression_hashes import FULL_HISTORIES
 
 KS = None
@@ -102,7 +102,7 @@ def h5str(v):
 
 def file_blocks(f):
     """Block names in order of first appearance in /runs/block."""
-    return list(dict.fromkeys(h5str(b) for b in f["runs"]["block"][()]))
+    return list(dict.fromkeys(runs_column(f["runs"]["block"]).tolist()))
 
 
 def landscape_axes(g):
@@ -257,8 +257,8 @@ class PlotStudiesTest(unittest.TestCase):
         else:
             self.assertNotEqual(rc, 0)
         # plot_cases: rows with a preset.
-        presets = [h5str(p) for p, done in zip(f["runs"]["preset"][()], f["runs"]["done"][()])
-                   if done and h5str(p)] if "preset" in f["runs"] else []
+        presets = [p for p, done in zip(runs_column(f["runs"]["preset"]), f["runs"]["done"][()])
+                   if done and p] if "preset" in f["runs"] else []
         rc, d, err = self.plot("plot_cases.py", h5, expect_ok=bool(presets))
         if presets:
             self.assertEqual(d["cases"], list(dict.fromkeys(presets)))
@@ -325,8 +325,8 @@ class PlotStudiesTest(unittest.TestCase):
     def test_joint_units(self):
         for name, block in (("planar3r_basins", "pose"), ("ik_basins", "basins")):
             with h5py.File(self.files[name], "r") as f:
-                problem = {h5str(p) for p, b in zip(f["runs"]["problem"][()], f["runs"]["block"][()])
-                           if h5str(b) == block}
+                problem = {p for p, b in zip(runs_column(f["runs"]["problem"]), runs_column(f["runs"]["block"]))
+                           if b == block}
                 unit3 = h5str(f["runs"]["q_final_3"].attrs["unit"])
             _, d, _ = self.plot("plot_basins.py", self.files[name], size=None)
             self.assertTrue(d["solutions"])
@@ -391,7 +391,7 @@ class PlotStudiesTest(unittest.TestCase):
         h5 = self.files["ik_scara"]
         _, d, _ = self.plot("plot_convergence.py", h5, "--runs", "0,1,2")
         with h5py.File(h5, "r") as f:
-            method = [h5str(x) for x in f["runs"]["method"][:3]]
+            method = runs_column(f["runs"]["method"])[:3].tolist()
             q01 = f["runs"]["q0_1"][:3] * 180 / math.pi
         runs = d["runs"]
         self.assertEqual(sorted(runs), ["0", "1", "2"])

@@ -18,7 +18,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, history, make_v1
+from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, history, make_v1, runs_columns
 
 KS = None
 ROOT = None
@@ -71,12 +71,7 @@ def ks(*args):
 
 def h5table(path):
     with h5py.File(path, "r") as f:
-        out = {}
-        for k in f["runs"]:
-            v = f["runs"][k][()]
-            if v.dtype.kind == "O":
-                v = np.array([x.decode() if isinstance(x, bytes) else x for x in v], dtype=object)
-            out[k] = v
+        out = runs_columns(f)
         units = {k: f["runs"][k].attrs.get("unit", "") for k in f["runs"]}
         units = {k: (u.decode() if isinstance(u, bytes) else u) for k, u in units.items()}
         return out, units
@@ -259,7 +254,7 @@ class QueryTest(unittest.TestCase):
     def test_column_attributes_describe_every_column(self):
         """role / kinds / unit / description of every /runs column (h5py) against what the engine writes."""
         with h5py.File(self.h5, "r") as f:
-            self.assertEqual(int(f.attrs["format_version"]), 3)
+            self.assertEqual(int(f.attrs["format_version"]), 4)
             runs = f["runs"]
             attrs = {k: {a: h5s(runs[k].attrs[a]) for a in ("role", "kinds", "unit", "description")} for k in runs}
         for c in ("run_id", "block", "status", "wall_time", "done"):
@@ -455,7 +450,7 @@ class Version1FileTest(unittest.TestCase):
         r = ks("run", self.study, "-o", self.v1, "--resume", "-q")
         self.assertEqual(r.returncode, 1, r.stderr)
         self.assertIn("results file format v1 (written by kinesweep ", r.stderr)
-        self.assertIn("); this kinesweep writes v3: rerun with --overwrite", r.stderr)
+        self.assertIn("); this kinesweep resumes v3 to v4: rerun with --overwrite", r.stderr)
         self.assertEqual((sha256(self.v1), os.stat(self.v1).st_mtime_ns), before)
         self.assertFalse(os.path.exists(self.v1 + ".journal"))
         self.assertEqual(sorted(os.listdir(self.tmp.name)), ["q.toml", "v1.h5", "v2.h5"])

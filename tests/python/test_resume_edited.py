@@ -18,7 +18,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import Histories, TempDirTest, bitwise_equal, runs_table, same_histories, same_tables
+from e2e_common import Histories, TempDirTest, bitwise_equal, runs_column, runs_table, same_histories, same_tables
 
 KS = ROBOTS = None
 
@@ -85,7 +85,7 @@ def keyed_wall_times(path):
     """{(block, parameter values...): wall_time} of a results file's runs."""
     with h5py.File(path, "r") as f:
         g = f["runs"]
-        cols = [np.array(g[k].asstr()[()], dtype=object) if g[k].dtype.kind == "O" else g[k][()] for k in PARAMS]
+        cols = [runs_column(g[k]) for k in PARAMS]
         wall = g["wall_time"][()]
     return {tuple(c[i] if isinstance(c[i], str) else c[i].tobytes() for c in cols): wall[i] for i in range(len(wall))}
 

@@ -13,7 +13,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import Histories, TempDirTest, history
+from e2e_common import Histories, TempDirTest, history, runs_column, runs_columns
 
 KS = None
 STUDIES = None
@@ -47,7 +47,7 @@ def urdf_limits(path):
 
 def read_runs(path):
     with h5py.File(path, "r") as f:
-        return {k: f["runs"][k][()] for k in f["runs"] if k not in ("wall_time",)}
+        return runs_columns(f, skip=("wall_time",))
 
 
 class Table4ThroughUrdf(TempDirTest):
@@ -114,8 +114,7 @@ class ChainStudies(TempDirTest):
             runs = f["runs"]
             self.assertIn("q0_7", runs)
             self.assertIn("tau7_inf", runs)
-            status = np.array([s.decode() if isinstance(s, bytes) else s for s in runs["status"][()]])
-            method = np.array([s.decode() if isinstance(s, bytes) else s for s in runs["method"][()]])
+            status, method = runs_column(runs["status"]), runs_column(runs["method"])
             # Some runs keep within every limit of the URDF (local_weighted with the limit spring at
             # small k), the others leave one and say by how much; the tip follows the 3-D path (RK4).
             self.assertEqual(set(status), {"ok", "out_of_limits"})
@@ -149,7 +148,7 @@ class ChainStudies(TempDirTest):
         self.assertEqual(r.returncode, 0, r.stderr)
         with h5py.File(out, "r") as f:
             runs = f["runs"]
-            status = [s.decode() if isinstance(s, bytes) else s for s in runs["status"][()]]
+            status = runs_column(runs["status"]).tolist()
             self.assertGreater(status.count("converged"), len(status) // 4)
             self.assertIn("q_final_7", runs)
         # the basins plot names the solutions by clustering (no closed form for a 7-DOF arm); a pose

@@ -14,21 +14,16 @@ import unittest
 import h5py
 import numpy as np
 
+from e2e_common import runs_column
+
 RESULTS = None
-
-
-def text(col):
-    return np.array([v.decode() if isinstance(v, bytes) else str(v) for v in col[()]])
 
 
 def trajectory_runs(path):
     """The /runs columns of the trajectory runs of a results file, as numpy arrays (None if none)."""
     with h5py.File(path, "r") as f:
         runs = f["runs"]
-        cols = {}
-        for name in runs:
-            d = runs[name]
-            cols[name] = text(d) if d.dtype.kind in "OSU" else d[()]
+        cols = {name: runs_column(runs[name]) for name in runs}
     if "tracking_bound" not in cols:
         return None
     keep = ~np.isnan(cols["tracking_bound"].astype(float))

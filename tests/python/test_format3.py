@@ -1,0 +1,161 @@
+"""A format_version 3 results file (tests/format3/mixed_v3.h5, written by kinesweep before format 4
+from tests/format3/mixed.toml) against the same study written now (format 4): every command and
+the Python reader give the same answers on both, and `kinesweep run --resume` continues the format 3
+file in its own layout, to the values of the format 4 file.
+
+The oracle is the format 3 file itself (written by the previous engine, whose stored values the
+regression manifest pins): only wall_time, the file name and the creation stamp may differ.
+
+usage: /usr/bin/python3 test_format3.py KINESWEEP_BINARY FORMAT3_DIR (tests/format3)
+"""
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+import h5py
+import numpy as np
+
+from e2e_common import bitwise_equal, runs_column, same_histories
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
+from kinesweep import read as ksread  # noqa: E402
+
+KS = DIR = None
+
+
+def ks(*args):
+    r = subprocess.run([KS, *args], capture_output=True, text=True)
+    if r.returncode != 0:
+        raise AssertionError(f"kinesweep {' '.join(args)} exited {r.returncode}:\n{r.stderr}")
+    return r.stdout
+
+
+def comparable(text, path):
+    """A command's output without what names the file, its source or its creation (the file, study and
+    engine lines of info)."""
+    out = []
+    for line in text.replace(path, "FILE").splitlines():
+        if line.startswith(("file ", "engine ", "study ")):
+            continue
+        out.append(line)
+    return out
+
+
+class Format3(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        d = cls.tmp.name
+        cls.v3 = os.path.join(d, "mixed_v3.h5")
+        shutil.copyfile(os.path.join(DIR, "mixed_v3.h5"), cls.v3)
+        cls.v4 = os.path.join(d, "mixed_v4.h5")
+        ks("run", os.path.join(DIR, "mixed.toml"), "-o", cls.v4, "-q")
+        with h5py.File(cls.v3, "r") as f:
+            cls.columns = [c.decode() if isinstance(c, bytes) else c for c in f["runs"].attrs["columns"]]
+            cls.version3 = int(f.attrs["format_version"])
+        with h5py.File(cls.v4, "r") as f:
+            cls.version4 = int(f.attrs["format_version"])
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_the_files_are_of_the_two_formats(self):
+        self.assertEqual(self.version3, 3)
+        self.assertEqual(self.version4, 4)
+        with h5py.File(self.v3, "r") as f3, h5py.File(self.v4, "r") as f4:
+            self.assertEqual(f3["runs"]["method"].dtype.kind, "O")  # strings ...
+            self.assertIsNotNone(h5py.check_enum_dtype(f4["runs"]["method"].dtype))  # ... and labels
+
+    def same_output(self, *args):
+        a = ks(*[self.v3 if x == "F" else x for x in args])
+        b = ks(*[self.v4 if x == "F" else x for x in args])
+        self.assertEqual(comparable(a, self.v3), comparable(b, self.v4), " ".join(args))
+
+    def test_commands_answer_alike(self):
+        cols = ",".join(c for c in self.columns if c != "wall_time")
+        self.same_output("info", "F")
+        self.same_output("info", "F", "--best", "5")
+        self.same_output("query", "F")
+        self.same_output("query", "F", "--columns", cols, "-f", "csv")
+        self.same_output("query", "F", "--columns", cols, "-f", "json", "--where", "method=newton,halley")
+        self.same_output("query", "F", "--where", "status=ok", "--sort", "E", "--limit", "5")
+        self.same_output("query", "F", "--where", "block=basins", "--sort", "iterations:desc,run_id", "--limit", "7")
+        self.same_output("query", "F", "--where", "status!=converged", "--where", "block=basins | block=grid")
+        self.same_output("query", "F", "--group-by", "block,status", "--agg", "count,min:E,argmin:iterations,median:E")
+        self.same_output("query", "F", "--group-by", "method", "--agg", "mean:E,sum:iterations,max:E,argmax:E",
+                         "-f", "csv")
+        self.same_output("query", "F", "--where", "preset=1g", "--include-pending", "--columns", "run_id,preset,E")
+        self.same_output("query", "F", "--run", "1", "--history", "all")
+
+    def test_the_python_reader_reads_alike(self):
+        with ksread.open_results(self.v3) as r3, ksread.open_results(self.v4) as r4:
+            t3, t4 = r3.runs(done_only=False), r4.runs(done_only=False)
+            self.assertEqual(list(t3), list(t4))
+            for c in t3:
+                if c == "wall_time":
+                    continue
+                self.assertTrue(bitwise_equal(np.asarray(t3[c]), np.asarray(t4[c])), c)
+                self.assertEqual(t3.units[c], t4.units[c], c)
+            d3, d4 = r3.to_pandas(), r4.to_pandas()
+            self.assertEqual(list(d3.columns), list(d4.columns))
+            for c in d3.columns:
+                if c == "wall_time":
+                    continue
+                a, b = d3[c].to_numpy(), d4[c].to_numpy()
+                if d4[c].dtype.name == "category":
+                    self.assertEqual(a.astype(object).tolist(), b.astype(object).tolist(), c)
+                else:
+                    self.assertTrue(bitwise_equal(a, b), c)
+            self.assertEqual(r3.blocks(), r4.blocks())
+            self.assertEqual(r3.row_kinds().tolist(), r4.row_kinds().tolist())
+            self.assertEqual(r3.landscapes(), r4.landscapes())
+            for b in r3.landscapes():
+                l3, l4 = r3.landscape(b), r4.landscape(b)
+                for m in l3.metrics:
+                    self.assertTrue(bitwise_equal(l3.metrics[m], l4.metrics[m]), f"{b} {m}")
+            for i in r3.history_ids():
+                h3, h4 = r3.history(i), r4.history(i)
+                self.assertEqual(list(h3), list(h4))
+                for a in h3:
+                    self.assertTrue(bitwise_equal(h3[a], h4[a]), f"run {i} {a}")
+
+    def test_resume_continues_a_format3_file_in_its_layout(self):
+        path = os.path.join(self.tmp.name, "resumed_v3.h5")
+        shutil.copyfile(self.v3, path)
+        lost = [0, 5, 30, 60, 100, 117]
+        with h5py.File(path, "r+") as f:  # as if those runs had not been done (their rows missing)
+            g = f["runs"]
+            done = g["done"][()]
+            done[lost] = 0
+            g["done"][...] = done
+            for c in g:
+                if c == "done":
+                    continue
+                v = g[c][()]
+                if v.dtype.kind == "f":
+                    v[lost] = np.nan
+                elif v.dtype.kind == "i":
+                    v[lost] = -1
+                else:
+                    v[lost] = b""
+                g[c][...] = v
+        out = ks("run", os.path.join(DIR, "mixed.toml"), "-o", path, "--resume")
+        self.assertIn(f"{len(lost)} computed now", out)
+        with h5py.File(path, "r") as fr, h5py.File(self.v4, "r") as f4:
+            self.assertEqual(int(fr.attrs["format_version"]), 3)
+            self.assertEqual(fr["runs"]["method"].dtype.kind, "O")  # still strings
+            for c in self.columns + ["done"]:
+                if c == "wall_time":
+                    continue
+                self.assertTrue(bitwise_equal(runs_column(fr["runs"][c]), runs_column(f4["runs"][c])), c)
+            same_histories(self, fr, f4)
+
+
+if __name__ == "__main__":
+    KS, DIR = sys.argv[1], sys.argv[2]
+    del sys.argv[1:3]
+    unittest.main(verbosity=2)
