@@ -22,11 +22,16 @@ namespace {
 struct BlockSummary {
   std::string name, kind;
   std::int64_t rows = 0;  ///< all rows of the block (done or not)
-  std::int64_t done = 0, good = 0;  ///< good: done runs whose status is ok / converged
+  std::int64_t done = 0, good_runs = 0;  ///< good_runs: done runs whose status is ok / converged
   std::vector<std::pair<std::string, std::int64_t>> statuses;  ///< first-seen order
   std::vector<RankKey> best;    ///< its best good runs under ranking(kind), at most --best
   RunsTable first;              ///< its first done row (parameters that differ from it vary)
   std::vector<bool> varies;     ///< per column
+  // Its kind's ranking, once its kind is known: the good status and the ranked columns.
+  bool ranked = false;
+  std::string good;
+  const RunsColumn* key = nullptr;
+  const RunsColumn* tie = nullptr;
 };
 
 std::string cell_for_humans(const RunsColumn& c, std::int64_t r) {
@@ -229,35 +234,52 @@ int run_info(const InfoArgs& args) {
   std::map<std::string, std::int64_t> example;  // kind -> a run with a history
   const RunsColumn* block = t.find("block");
   const RunsColumn* status = t.find("status");
+  // The columns the summary reads: block, status, the parameters, the kinds' ranked metrics and
+  // what a row's kind is read from (the others are read for the best rows only, by run id).
+  t.load_all(false);
+  t.load_kind_columns();
+  for (RunsColumn& c : t.cols) {
+    if (&c == block || &c == status || c.role == Role::parameter) c.loaded = true;
+    for (const BlockKind k : block_kinds())
+      if (c.role == Role::metric && (c.name == ranking(k).objective || c.name == ranking(k).tie)) c.loaded = true;
+  }
+  std::vector<bool> loaded;
+  for (const RunsColumn& c : t.cols) loaded.push_back(c.loaded);
+  std::size_t at = 0;  // the block of the previous row (rows of a block mostly follow each other)
   const bool consistent = for_each_piece(reader, t, [&](const RunsTable& p) {
     for (std::int64_t r = 0; r < p.n_runs; ++r) {
       const std::int64_t id = p.row_id(r);
-      const std::string name = block ? block->s[r] : std::string("(all)");
+      static const std::string all("(all)");
+      const std::string& name = block ? block->s[r] : all;
       const bool is_done = p.done[static_cast<std::size_t>(r)] != 0;
       if (name.empty() && !is_done) {  // a pending row holds no block name: count it apart
-        if (blocks.empty() || blocks.back().name != "(pending)") blocks.push_back({"(pending)", "", 0, 0, 0, {}, {}, {}, {}});
+        if (blocks.empty() || blocks.back().name != "(pending)") blocks.push_back(BlockSummary{}), blocks.back().name = "(pending)";
         ++blocks.back().rows;
         continue;
       }
-      auto it = std::find_if(blocks.begin(), blocks.end(), [&](const BlockSummary& b) { return b.name == name; });
-      if (it == blocks.end()) {
-        blocks.push_back({name, "", 0, 0, 0, {}, {}, {}, {}});
-        it = blocks.end() - 1;
+      if (at >= blocks.size() || blocks[at].name != name) {
+        auto it = std::find_if(blocks.begin(), blocks.end(), [&](const BlockSummary& b) { return b.name == name; });
+        if (it == blocks.end()) {
+          blocks.push_back(BlockSummary{}), blocks.back().name = name;
+          it = blocks.end() - 1;
+        }
+        at = static_cast<std::size_t>(it - blocks.begin());
       }
-      BlockSummary& b = *it;
+      BlockSummary& b = blocks[at];
       ++b.rows;
       if (!is_done) continue;
       ++n_done;
       ++b.done;
       if (b.kind.empty()) b.kind = p.kind(r);
-      const std::string st = status ? status->s[r] : "";
+      static const std::string none;
+      const std::string& st = status ? status->s[r] : none;
       auto s = std::find_if(b.statuses.begin(), b.statuses.end(), [&](auto& x) { return x.first == st; });
       if (s == b.statuses.end()) b.statuses.push_back({st, 1});
       else ++s->second;
       // Parameters that differ from the block's first done row.
       if (b.first.cols.empty()) {
         b.first = runs_header(reader);
-        append_row(b.first, p, r, std::vector<bool>(p.cols.size(), true));
+        append_row(b.first, p, r, loaded);
         b.varies.assign(p.cols.size(), false);
       }
       for (std::size_t c = 0; c < p.cols.size(); ++c)
@@ -265,12 +287,18 @@ int run_info(const InfoArgs& args) {
           b.varies[c] = true;
       // Best rows: the kind's ranking (ranking(kind)) among its good runs.
       BlockKind kind;
-      if (parse(b.kind, kind) && st == statuses(kind).front()) {
+      if (!b.ranked && !b.kind.empty() && parse(b.kind, kind)) {
+        b.ranked = true;
         const Ranking rank = ranking(kind);
-        const RunsColumn* key = metric_column(p, b.kind, rank.objective);
-        if (key) ++b.good;
+        b.good = std::string(statuses(kind).front());
+        b.key = metric_column(p, b.kind, rank.objective);
+        b.tie = rank.tie.empty() ? nullptr : metric_column(p, b.kind, rank.tie);
+      }
+      if (b.ranked && st == b.good) {
+        const RunsColumn* key = b.key;
+        if (key) ++b.good_runs;
         if (key && n_best > 0) {
-          const RunsColumn* tie = rank.tie.empty() ? nullptr : metric_column(p, b.kind, rank.tie);
+          const RunsColumn* tie = b.tie;
           const RankKey c = rank_key(value_at(key, r), tie ? value_at(tie, r) : 0.0, static_cast<std::uint64_t>(id));
           // as the run summary: a good run without a finite objective is never a best one
           if (std::isfinite(c.objective) && (b.best.size() < n_best || c < b.best.back())) {
@@ -338,7 +366,7 @@ int run_info(const InfoArgs& args) {
     const RunsColumn* key = metric_column(t, b.kind, rank.objective);
     const RunsColumn* tie = rank.tie.empty() ? nullptr : metric_column(t, b.kind, rank.tie);
     if (!key || !status) continue;
-    if (b.good == 0) {
+    if (b.good_runs == 0) {
       os << "  " << b.name << ": no " << statuses(kind).front() << " run\n";
       continue;
     }
@@ -387,7 +415,7 @@ int run_info(const InfoArgs& args) {
   const auto names = consistent_read(reader, [&] { return reader.landscapes(); });
   os << "landscapes  " << (names.empty() ? "none" : "") << (names.empty() ? "\n" : "");
   for (std::size_t i = 0; i < names.size(); ++i) {
-    const auto spec = consistent_read(reader, [&] { return reader.read_landscape(names[i]); });
+    const auto spec = consistent_read(reader, [&] { return reader.read_landscape(names[i], false); });
     os << (i ? "            " : "") << spec.block << ": ";
     for (std::size_t j = 0; j < spec.axes.size(); ++j) os << (j ? " x " : "") << axis_text(spec.axes[j]);
     os << "\n              metrics: ";

@@ -8,8 +8,10 @@
 #include <cstdlib>
 #include <iostream>
 #include <numeric>
+#include <optional>
 #include <set>
 
+#include "cli/query_groups.hpp"
 #include "cli/query_table.hpp"
 #include "cli/query_util.hpp"
 #include "cli/query_where.hpp"
@@ -147,44 +149,139 @@ int optimization_mode(const QueryArgs& a, store::ResultsReader& reader, Format f
   return table_mode(a, evaluations_table(o), fmt, w);
 }
 
-/// Rows of /runs: the file is read in pieces; the rows that pass --where (and are done, unless
-/// --include-pending) are gathered with the columns the query reads, then filtered, sorted and
-/// printed by table_mode. Memory: the matching rows' needed columns, not the file's.
+/// What the matching rows left out of the table table_mode gets add to the compact default: their
+/// number, their kinds, and the columns in which some of them differ from `ref` (a matching row).
+struct LeftOut {
+  std::int64_t rows = 0;
+  std::set<std::string> kinds;
+  std::vector<bool> varying;  ///< per column
+
+  /// Notes rows `rows_of` of `t` (whose columns `take` are loaded).
+  void note(const RunsTable& t, const std::vector<std::int64_t>& rows_of, const RunsTable& ref,
+            const std::vector<bool>& take) {
+    if (rows_of.empty()) return;
+    rows += static_cast<std::int64_t>(rows_of.size());
+    if (t.kinds.size() == 1) kinds.insert(t.kinds.front());
+    else
+      for (std::int64_t r : rows_of) kinds.insert(t.kind(r));
+    varying.resize(t.cols.size(), false);
+    if (ref.n_runs == 0) return;
+    for (std::size_t c = 0; c < t.cols.size(); ++c) {
+      if (!take[c] || varying[c]) continue;
+      for (std::int64_t r : rows_of)
+        if (!same_value(t.cols[c], r, ref.cols[c], 0)) {
+          varying[c] = true;
+          break;
+        }
+    }
+  }
+  /// Into the wording of table_mode.
+  void into(const RunsTable& t, TableWording& w) const {
+    w.more_matching = rows;
+    w.more_kinds.insert(kinds.begin(), kinds.end());
+    for (std::size_t c = 0; c < varying.size(); ++c)
+      if (varying[c]) w.more_varying.insert(t.cols[c].name);
+  }
+};
+
+/// Keeps the `limit` first rows of `g` in --sort order (in run-id order among themselves, as
+/// gathered), noting the others in `out`: a sorted query holds at most a few times --limit rows.
+void keep_best(RunsTable& g, const QueryArgs& a, const std::vector<bool>& take, const RunsTable& ref, LeftOut& out) {
+  std::vector<std::int64_t> order(static_cast<std::size_t>(g.n_runs));
+  for (std::int64_t r = 0; r < g.n_runs; ++r) order[static_cast<std::size_t>(r)] = r;
+  sort_table_rows(order, a, g);
+  std::vector<std::int64_t> keep(order.begin(), order.begin() + a.limit), drop(order.begin() + a.limit, order.end());
+  std::sort(keep.begin(), keep.end());
+  out.note(g, drop, ref, take);
+  RunsTable kept = empty_like(g);
+  for (std::int64_t r : keep) append_row(kept, g, r, take);
+  g = std::move(kept);
+}
+
+/// Rows of /runs, read in pieces: first the done flags and the --where columns; only a piece with
+/// a matching row reads the other columns the query needs. Matching rows are gathered with those
+/// columns and printed by table_mode; with --sort and --limit only the best few times --limit are
+/// held; with --group-by the rows are aggregated as they come (GroupAggregator). Memory: the
+/// gathered rows' needed columns (bounded by --limit when sorted or by the groups), plus a piece.
 int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
   RunsTable t = runs_header(reader);
   TableWording w;
   std::vector<Disjunction> filters;
   for (const auto& expr : a.where) filters.push_back(parse_where(expr, t));
   const std::vector<Condition> conds = all_conditions(filters);
-  const std::vector<bool> take = columns_read(a, t, fmt, w);
-  RunsTable g = runs_header(reader);
+  std::vector<bool> take = columns_read(a, t, fmt, w);
+  std::vector<bool> filter_cols(t.cols.size(), false);
+  for (const Condition& k : conds) filter_cols[static_cast<std::size_t>(k.col - t.cols.data())] = true;
+  std::optional<GroupAggregator> groups;
+  if (!a.group_by.empty()) groups.emplace(a, t);
+  std::vector<bool> kind_cols(t.cols.size(), false);  // what a row's kind is read from
+  t.load_all(false);
+  t.load_kind_columns();
+  for (std::size_t c = 0; c < t.cols.size(); ++c) kind_cols[c] = t.cols[c].loaded;
+  // The gathered rows hold the columns the query reads and those their kind is read from.
+  for (std::size_t c = 0; c < t.cols.size(); ++c) take[c] = take[c] || kind_cols[c];
+  RunsTable g = runs_header(reader), ref = runs_header(reader);
+  for (std::size_t c = 0; c < t.cols.size(); ++c) g.cols[c].loaded = ref.cols[c].loaded = take[c];
   HeldValues held;
   std::int64_t done = 0;
   const Selector sel{t, a.radians};
   // Rows in file order up to --limit are all table_mode prints (no sort, no groups): gather only those.
   const bool head_only = a.limit >= 0 && a.sort.empty() && a.group_by.empty();
-  const bool consistent = for_each_piece(reader, t, [&](const RunsTable& p) {
-    collect_held(conds, p, a.include_pending, held);
-    for (std::int64_t r = 0; r < p.n_runs; ++r) {
-      const bool is_done = p.done[static_cast<std::size_t>(r)] != 0;
+  const bool best_only = a.limit >= 0 && !a.sort.empty() && a.group_by.empty();
+  const std::int64_t hold = std::max<std::int64_t>(4 * a.limit, 4096);
+  bool consistent = true;
+  std::vector<std::int64_t> match, beyond;
+  LeftOut left_out;
+  const std::int64_t total = reader.n_runs();
+  for (std::int64_t first = 0; first < total; first += kPieceRows) {
+    for (std::size_t c = 0; c < t.cols.size(); ++c) t.cols[c].loaded = filter_cols[c];
+    load_piece(reader, t, first, kPieceRows);
+    consistent = consistent && t.consistent;
+    match.clear();
+    for (std::int64_t r = 0; r < t.n_runs; ++r) {
+      const bool is_done = t.done[static_cast<std::size_t>(r)] != 0;
       done += is_done;
       if (!a.include_pending && !is_done) continue;
-      if (!std::all_of(filters.begin(), filters.end(), [&](const Disjunction& d) { return sel.test(d, r); })) continue;
-      if (!head_only || g.n_runs < a.limit) {
-        append_row(g, p, r, take);
+      if (std::all_of(filters.begin(), filters.end(), [&](const Disjunction& d) { return sel.test(d, r); }))
+        match.push_back(r);
+    }
+    collect_held(conds, t, a.include_pending, held);
+    if (match.empty()) continue;
+    for (std::size_t c = 0; c < t.cols.size(); ++c) t.cols[c].loaded = take[c] || filter_cols[c];
+    load_piece(reader, t, first, kPieceRows);  // the same rows, now with every column the query needs
+    consistent = consistent && t.consistent;
+    beyond.clear();
+    for (std::int64_t r : match) {
+      if (groups) {
+        groups->add(t, r, sel);
         continue;
       }
-      // Beyond the --limit rows printed: counted, and what the compact default shows learns from it.
-      ++w.more_matching;
-      w.more_kinds.insert(p.kind(r));
-      for (std::size_t c = 0; c < p.cols.size(); ++c)
-        if (take[c] && g.n_runs > 0 && !w.more_varying.count(p.cols[c].name) && !same_value(p.cols[c], r, g.cols[c], 0))
-          w.more_varying.insert(p.cols[c].name);
+      if (ref.n_runs == 0) append_row(ref, t, r, take);
+      if (!head_only || g.n_runs < a.limit) {
+        append_row(g, t, r, take);
+        if (best_only && g.n_runs >= hold) keep_best(g, a, take, ref, left_out);
+        continue;
+      }
+      beyond.push_back(r);  // beyond the --limit rows printed: what the compact default learns from
     }
-  });
+    left_out.note(t, beyond, ref, take);
+  }
   if (!consistent)
     std::cerr << "kinesweep query: note: the file kept changing while it was read (a sweep is writing it)\n";
   for (const std::string& note : unheld_value_notes(conds, held)) std::cerr << "kinesweep query: note: " << note << '\n';
+  if (groups) {
+    groups->print(fmt, a.limit, a.radians, std::cout);
+    return 0;
+  }
+  if (best_only && g.n_runs > a.limit) keep_best(g, a, take, ref, left_out);
+  if (left_out.rows > 0) {  // rows left out: the kept ones may differ from them only through ref
+    std::vector<std::int64_t> all(static_cast<std::size_t>(g.n_runs));
+    for (std::int64_t r = 0; r < g.n_runs; ++r) all[static_cast<std::size_t>(r)] = r;
+    const std::int64_t n = left_out.rows;
+    left_out.note(g, all, ref, take);
+    left_out.rows = n;
+  }
+  left_out.into(g, w);
   w.notes_said = true;
   w.summary = std::to_string(done) + " of " + std::to_string(reader.n_runs()) + " runs done";
   return table_mode(a, g, fmt, w);

@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 
+#include "cli/query_groups.hpp"
 #include "cli/query_where.hpp"
 
 namespace ks::cli {
@@ -103,154 +104,11 @@ std::vector<const RunsColumn*> compact_columns(const RunsTable& t, const std::ve
   return cols;
 }
 
-// --- --group-by / --agg ---
-
-enum class Agg { count, min, max, mean, median, sum, argmin, argmax };
-struct AggSpec {
-  Agg fn;
-  const RunsColumn* col = nullptr;  ///< null for count
-  std::string name;                 ///< output column name: "count", "min(E)", ...
-};
-
-std::vector<AggSpec> parse_agg(const std::string& spec, const RunsTable& t) {
-  static const std::map<std::string, Agg> fns = {{"min", Agg::min},     {"max", Agg::max},       {"mean", Agg::mean},
-                                                 {"median", Agg::median}, {"sum", Agg::sum},   {"argmin", Agg::argmin},
-                                                 {"argmax", Agg::argmax}};
-  std::vector<AggSpec> out;
-  for (const std::string& part : split(spec.empty() ? "count" : spec, ',')) {
-    if (part == "count") {
-      out.push_back({Agg::count, nullptr, "count"});
-      continue;
-    }
-    const auto colon = part.find(':');
-    const std::string fn = colon == std::string::npos ? part : part.substr(0, colon);
-    const auto it = fns.find(fn);
-    if (it == fns.end() || colon == std::string::npos) {
-      std::vector<std::string> names{"count"};
-      for (auto& [k, v] : fns) names.push_back(k);
-      std::string m = "--agg '" + part + "': expected count or FN:COL with FN one of min, max, mean, median, sum, "
-                      "argmin, argmax (e.g. --agg min:E,count)";
-      if (it == fns.end() && !fn.empty()) {
-        const std::string dym = did_you_mean(fn, names);
-        if (!dym.empty()) m += "; did you mean '" + dym + "'?";
-      }
-      throw ArgError(m);
-    }
-    const std::string name = part.substr(colon + 1);
-    const RunsColumn* c = t.find(name);
-    if (!c) throw ArgError(unknown_column_message(name, t, " in --agg '" + part + "'"));
-    if (c->type == CellType::str)
-      throw ArgError("--agg '" + part + "': column " + name + " holds text; " + fn + " needs a numeric column");
-    out.push_back({it->second, c, fn + "(" + name + ")"});
-  }
-  return out;
-}
-
-/// One group's aggregate of one spec; `id` gives the run id (or row index) printed by argmin/argmax.
-OutCell aggregate(const AggSpec& s, const std::vector<std::int64_t>& rows, const Selector& sel, const RunsColumn* id) {
-  if (s.fn == Agg::count) return static_cast<std::int64_t>(rows.size());
-  std::vector<std::pair<double, std::int64_t>> v;  // finite values and their rows
-  for (auto r : rows) {
-    const double x = sel.value(*s.col, r);
-    if (!std::isnan(x)) v.emplace_back(x, r);
-  }
-  if (v.empty()) return s.fn == Agg::argmin || s.fn == Agg::argmax ? OutCell{std::int64_t{-1}} : OutCell{std::nan("")};
-  auto less = [](const auto& p, const auto& q) { return p.first < q.first; };
-  switch (s.fn) {
-    case Agg::min: return std::min_element(v.begin(), v.end(), less)->first;
-    case Agg::max: return std::max_element(v.begin(), v.end(), less)->first;
-    case Agg::argmin:
-    case Agg::argmax: {
-      const auto it = s.fn == Agg::argmin ? std::min_element(v.begin(), v.end(), less)
-                                          : std::max_element(v.begin(), v.end(), less);  // first of ties
-      return id ? id->i[it->second] : it->second;
-    }
-    case Agg::sum:
-    case Agg::mean: {
-      double sum = 0;
-      for (auto& p : v) sum += p.first;
-      return s.fn == Agg::sum ? sum : sum / static_cast<double>(v.size());
-    }
-    case Agg::median: {
-      std::sort(v.begin(), v.end(), less);
-      const std::size_t n = v.size();
-      return n % 2 ? v[n / 2].first : 0.5 * (v[n / 2 - 1].first + v[n / 2].first);
-    }
-    case Agg::count: break;
-  }
-  return {};
-}
-
-int group_mode(const QueryArgs& a, const RunsTable& t, Format fmt, const std::vector<std::int64_t>& selected,
-               const Selector& sel) {
-  if (!a.sort.empty() || !a.columns.empty())
-    throw ArgError("--group-by prints one row per group, in the order of the group values; --sort and --columns "
-                   "apply to rows (use --agg to choose the group's columns)");
-  std::vector<const RunsColumn*> keys;
-  for (const std::string& name : split(a.group_by, ',')) {
-    const RunsColumn* c = t.find(name);
-    if (!c) throw ArgError(unknown_column_message(name, t, " in --group-by"));
-    keys.push_back(c);
-  }
-  const std::vector<AggSpec> specs = parse_agg(a.agg, t);
-  const RunsColumn* id = t.find("run_id");
-  if (id && id->type != CellType::i64) id = nullptr;
-  // Groups in the order of their key values (numbers as shown, text lexicographic; NaN last).
-  std::vector<std::int64_t> order = selected;
-  std::vector<SortKey> sk;
-  for (auto* c : keys) sk.push_back({c, false});
-  sort_rows(order, sk, sel);
-  auto same = [&](std::int64_t x, std::int64_t y) {
-    for (const RunsColumn* c : keys) {
-      if (c->type == CellType::str ? c->s[x] != c->s[y] : c->type == CellType::i64 ? c->i[x] != c->i[y] : false)
-        return false;
-      if (c->type == CellType::f64) {
-        const double u = sel.value(*c, x), v = sel.value(*c, y);
-        if (!(u == v || (std::isnan(u) && std::isnan(v)))) return false;
-      }
-    }
-    return true;
-  };
-  OutTable out;
-  std::vector<std::string> converted;
-  for (const RunsColumn* c : keys) {
-    out.names.push_back(c->name);
-    out.units.push_back(shown_unit(*c, a.radians));
-    out.csv_names.push_back(c->angle() && !a.radians ? c->name + " [deg]" : c->name);
-    if (c->angle() && !a.radians) converted.push_back(c->name);
-  }
-  for (const AggSpec& s : specs) {
-    const bool value = s.col && s.fn != Agg::argmin && s.fn != Agg::argmax;
-    const std::string unit = value ? shown_unit(*s.col, a.radians) : "";
-    out.names.push_back(s.name);
-    out.units.push_back(unit);
-    out.csv_names.push_back(unit == "deg" && s.col->angle() ? s.name + " [deg]" : s.name);
-  }
-  std::size_t groups = 0;
-  for (std::size_t i = 0; i < order.size();) {
-    std::size_t j = i;
-    std::vector<std::int64_t> members;
-    while (j < order.size() && same(order[i], order[j])) members.push_back(order[j++]);
-    ++groups;
-    if (a.limit < 0 || out.rows.size() < static_cast<std::size_t>(a.limit)) {
-      std::vector<OutCell> row;
-      for (const RunsColumn* c : keys) row.push_back(cell(*c, order[i], sel));
-      for (const AggSpec& s : specs) row.push_back(aggregate(s, members, sel, id));
-      out.rows.push_back(std::move(row));
-    }
-    i = j;
-  }
-  print_out(out, fmt, std::cout);
-  if (fmt == Format::table) {
-    std::cout << "(" << out.rows.size() << " of " << groups << " groups of " << selected.size() << " rows"
-              << (id ? "; argmin/argmax give the run_id" : "; argmin/argmax give the row index");
-    if (!converted.empty()) std::cout << "; angles in degrees (stored in radians): " << join(converted, ", ");
-    std::cout << ")\n";
-  }
-  return 0;
-}
-
 }  // namespace
+
+void sort_table_rows(std::vector<std::int64_t>& rows, const QueryArgs& a, const RunsTable& t) {
+  sort_rows(rows, parse_sort(a, t), Selector{t, a.radians});
+}
 
 std::vector<bool> columns_read(const QueryArgs& a, const RunsTable& t, Format fmt, const TableWording& wording) {
   std::vector<bool> take(t.cols.size(), false);
@@ -265,8 +123,7 @@ std::vector<bool> columns_read(const QueryArgs& a, const RunsTable& t, Format fm
   for (const std::string& name : split(a.group_by, ','))
     if (!name.empty()) mark(name, " in --group-by");
   if (!a.group_by.empty())
-    for (const AggSpec& s : parse_agg(a.agg, t))
-      if (s.col) take[static_cast<std::size_t>(s.col - t.cols.data())] = true;
+    for (std::size_t c : GroupAggregator(a, t).columns()) take[c] = true;
   if (t.find("run_id")) mark("run_id", "");
   const bool all = a.columns == "all" || (a.columns.empty() && (fmt != Format::table || !wording.compact_default));
   for (std::size_t c = 0; c < t.cols.size(); ++c) {
@@ -301,7 +158,12 @@ int table_mode(const QueryArgs& a, const RunsTable& t, Format fmt, const TableWo
     if (std::all_of(filters.begin(), filters.end(), [&](const Disjunction& d) { return sel.test(d, r); }))
       selected.push_back(r);
   }
-  if (!a.group_by.empty()) return group_mode(a, t, fmt, selected, sel);
+  if (!a.group_by.empty()) {
+    GroupAggregator groups(a, t);
+    for (std::int64_t r : selected) groups.add(t, r, sel);
+    groups.print(fmt, a.limit, a.radians, std::cout);
+    return 0;
+  }
   if (!a.agg.empty()) throw ArgError("--agg needs --group-by COL (e.g. --group-by method --agg min:E,count)");
 
   std::vector<const RunsColumn*> cols;

@@ -27,6 +27,9 @@ struct TableWording {
 /// row kinds and the varying parameters decide what it prints). Throws ArgError on an unknown name.
 std::vector<bool> columns_read(const QueryArgs& a, const RunsTable& t, Format fmt, const TableWording& wording);
 
+/// Sorts `rows` (indices into t) by --sort (stable; NaN last), numbers as shown. Throws ArgError.
+void sort_table_rows(std::vector<std::int64_t>& rows, const QueryArgs& a, const RunsTable& t);
+
 /// Filter, sort and print `t` (or its groups, with --group-by) as the arguments say.
 /// Throws ArgError on a bad argument.
 int table_mode(const QueryArgs& a, const RunsTable& t, Format fmt, const TableWording& wording);

@@ -44,8 +44,17 @@ std::string RunsTable::kind(std::int64_t row) const {
   if (kinds.size() == 1) return kinds.front();
   for (const Role role : {Role::parameter, Role::metric})
     for (const auto& c : cols)
-      if (c.role == role && c.kinds.size() == 1 && !c.missing(row)) return c.kinds.front();
+      if (c.loaded && c.role == role && c.kinds.size() == 1 && !c.missing(row)) return c.kinds.front();
   return "";
+}
+
+void RunsTable::load_kind_columns() {
+  if (kinds.size() <= 1) return;
+  for (const Role role : {Role::parameter, Role::metric}) {
+    std::set<std::string> seen;
+    for (auto& c : cols)
+      if (c.role == role && c.kinds.size() == 1 && seen.insert(c.kinds.front()).second) c.loaded = true;
+  }
 }
 
 std::vector<const RunsColumn*> RunsTable::key_metrics(const std::string& kind) const {
@@ -122,6 +131,10 @@ void load_piece(store::ResultsReader& reader, RunsTable& t, std::int64_t first, 
     t.done = reader.done_mask(first, count);  // before the columns: a row done here is complete in them
     t.n_runs = static_cast<std::int64_t>(t.done.size());
     for (RunsColumn& c : t.cols) {
+      if (!c.loaded) {
+        c.f.clear(), c.i.clear(), c.s.clear();
+        continue;
+      }
       switch (c.type) {
         case CellType::f64: c.f = reader.read_f64(c.name, first, count); break;
         case CellType::i64: c.i = reader.read_i64(c.name, first, count); break;
@@ -158,6 +171,7 @@ void load_ids(store::ResultsReader& reader, RunsTable& t, const std::vector<std:
   for (std::size_t c = 0; c < t.cols.size(); ++c) {
     RunsColumn& col = t.cols[c];
     col.f.clear(), col.i.clear(), col.s.clear();
+    col.loaded = true;
     for (const Record& r : rows) {
       switch (col.type) {
         case CellType::f64: col.f.push_back(std::get<double>(r.cells[c])); break;
@@ -166,6 +180,20 @@ void load_ids(store::ResultsReader& reader, RunsTable& t, const std::vector<std:
       }
     }
   }
+}
+
+RunsTable empty_like(const RunsTable& t) {
+  RunsTable e;
+  e.meta = t.meta;
+  e.kinds = t.kinds;
+  e.cols.reserve(t.cols.size());
+  for (const RunsColumn& c : t.cols) {
+    RunsColumn k;
+    k.name = c.name, k.unit = c.unit, k.description = c.description;
+    k.type = c.type, k.role = c.role, k.kinds = c.kinds, k.loaded = c.loaded;
+    e.cols.push_back(std::move(k));
+  }
+  return e;
 }
 
 bool same_value(const RunsColumn& c, std::int64_t a, const RunsColumn& d, std::int64_t b) {

@@ -23,6 +23,9 @@ struct RunsColumn {
   std::vector<double> f;
   std::vector<std::int64_t> i;
   std::vector<std::string> s;
+  /// Whether load_piece / load_ids read this column (a command reads the columns it needs; the
+  /// vectors of the others stay empty).
+  bool loaded = true;
   bool angle() const { return unit == "rad"; }  ///< shown in degrees unless --radians
   bool applies_to(const std::string& kind) const;
   bool missing(std::int64_t row) const;  ///< NaN, -1 or ""
@@ -44,6 +47,13 @@ struct RunsTable {
   /// A row's run kind: the kind of the parameter (else metric) columns of a single kind that hold a
   /// value in the row; the file's only kind when it has one; "" when unknown (a pending row).
   std::string kind(std::int64_t row) const;
+  /// Marks loaded the columns kind() reads: in a file of several kinds, the first parameter column
+  /// of a single kind for each kind, and the first such metric column (pending rows hold neither).
+  void load_kind_columns();
+  /// Marks every column loaded (`all`) or none.
+  void load_all(bool all) {
+    for (auto& c : cols) c.loaded = all;
+  }
   /// The metric columns of `kind` that compact views show (trajectory: E, E_M, tau_inf; ik:
   /// iterations, error, solution; another kind: its first three metrics).
   std::vector<const RunsColumn*> key_metrics(const std::string& kind) const;
@@ -67,8 +77,9 @@ RunsTable runs_header(store::ResultsReader& reader);
 /// Rows a piece holds when a command streams a file (memory bounded whatever the run count).
 inline constexpr std::int64_t kPieceRows = 16384;
 /// Fills `t` (a runs_header of `reader`) with the rows `first` .. `first + count` (clamped): their
-/// done flags and values, read like load_runs (done mask first, repeated on a commit meanwhile). The
-/// column objects stay in place (pointers to them stay valid); their values are replaced.
+/// done flags and the values of its loaded columns, read like load_runs (done mask first, repeated
+/// on a commit meanwhile). The column objects stay in place (pointers to them stay valid); their
+/// values are replaced (emptied for the columns not loaded).
 void load_piece(store::ResultsReader& reader, RunsTable& t, std::int64_t first, std::int64_t count);
 /// Calls f(t) for each piece of kPieceRows rows of the file, in run-id order (t.first: the piece's
 /// first run id; rows are indexed from 0 within the piece). Returns false when some piece was read
@@ -86,6 +97,8 @@ bool for_each_piece(store::ResultsReader& reader, RunsTable& t, F&& f) {
 }
 /// Fills `t` (a runs_header of `reader`) with the rows of `ids` (ascending run ids), row i = ids[i].
 void load_ids(store::ResultsReader& reader, RunsTable& t, const std::vector<std::int64_t>& ids);
+/// A table with the columns of `t` (names, types, roles, loaded flags) and no rows.
+RunsTable empty_like(const RunsTable& t);
 /// Equal values in row `a` of column `c` and row `b` of column `d` (of the same type; NaN equals NaN).
 bool same_value(const RunsColumn& c, std::int64_t a, const RunsColumn& d, std::int64_t b);
 /// Appends row `r` of `t` to `g` (a table with t's columns): the values of the columns whose index
