@@ -1,0 +1,194 @@
+"""Results at scale: write and read back 10^5 .. 10^7-run files of a trajectory landscape and of an
+IK basin study (histories none), each command against a plain h5py read of the columns it touches,
+in the same script.
+
+usage: /usr/bin/python3 tests/bench/results_scale.py build/kinesweep [--before OLD_KINESWEEP]
+           [--runs 100000 1000000] [--kinds trajectory ik] [--repeat 3] [--workdir DIR] [--keep]
+
+For each study kind and run count: `kinesweep run` (wall time, peak RSS, file bytes per run;
+alternated with --before's binary, whose write time gives the ratio new / old), then, on the file
+just written, repeated --repeat times (min and median of each):
+  query   --where "<metric> < <its 1st percentile>" --sort <metric> --limit 3
+  group   --group-by method --agg min:<metric>,count
+  info
+  pandas  kinesweep.read.open_results(F).to_pandas() (all columns; timed inside the interpreter;
+          peak RSS of that interpreter, pandas imported; the frame's bytes)
+against h5py reading the columns each touches (query: the metric and done; group: method, the
+metric and done; info: the columns info reads; pandas: every /runs column).
+Ratios over the h5py read are what the targets are stated in. Run with Debian's /usr/bin/python3.
+"""
+import argparse
+import os
+import resource
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import h5py
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ANALYSIS = os.path.join(HERE, "..", "..", "analysis")
+
+TRAJECTORY = """[study]
+name = "scale_trajectory"
+histories = "none"
+[[block]]
+name = "local"
+kind = "trajectory"
+[block.axes]
+method = ["local_weighted"]
+alpha1A = {{ from = -20, to = 30, count = {a} }}
+k = {{ from = 0, to = 1, count = {b} }}
+"""
+IK = """[study]
+name = "scale_ik"
+histories = "none"
+[[block]]
+name = "basins"
+kind = "ik"
+problem = "scara"
+lambda = 0.1
+target_x = 50.0
+target_y = -80.0
+target_z = 10.0
+q0_3 = 50.0
+max_iter = 50
+[block.axes]
+method = ["lm"]
+q0_1 = {{ from = -180, to = 180, count = {a} }}
+q0_2 = {{ from = -180, to = 180, count = {b} }}
+"""
+METRIC = {"trajectory": "E", "ik": "iterations"}
+
+
+def timed(cmd):
+    """(wall seconds, peak RSS bytes) of a child process; its output discarded."""
+    t0 = time.perf_counter()
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(p.pid, 0)
+    err = p.stderr.read().decode()
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise SystemExit(f"failed: {' '.join(cmd)}\n{err}")
+    return time.perf_counter() - t0, usage.ru_maxrss * 1024
+
+
+PANDAS = f"""
+import resource, sys, time
+sys.path.insert(0, {ANALYSIS!r})
+from kinesweep import read
+import pandas
+t0 = time.perf_counter()
+df = read.open_results(sys.argv[1]).to_pandas()
+print(time.perf_counter() - t0, df.memory_usage(deep=True).sum())
+"""
+
+
+def h5py_read(path, columns):
+    """Seconds to read `columns` of /runs whole with h5py (a fresh open)."""
+    t0 = time.perf_counter()
+    with h5py.File(path, "r") as f:
+        for c in columns:
+            f["runs"][c][()]
+    return time.perf_counter() - t0
+
+
+def stats(values):
+    return min(values), statistics.median(values)
+
+
+def report(name, ours, base, rss=None, extra=""):
+    (mn, md), (bmn, bmd) = stats(ours), stats(base)
+    line = f"  {name:<8} {mn:8.2f} s (median {md:6.2f})   h5py {bmn:6.2f} s   ratio {mn / bmn:6.2f}"
+    if rss is not None:
+        line += f"   peak {max(rss) / 1e6:7.0f} MB"
+    print(line + extra, flush=True)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("kinesweep")
+    ap.add_argument("--before", help="an older kinesweep binary: its write time is the reference")
+    ap.add_argument("--runs", type=int, nargs="+", default=[100000, 1000000])
+    ap.add_argument("--kinds", nargs="+", default=["trajectory", "ik"], choices=["trajectory", "ik"])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--workdir")
+    ap.add_argument("--keep", action="store_true", help="keep the files written")
+    args = ap.parse_args()
+    work = args.workdir or tempfile.mkdtemp(prefix="ks_scale_")
+    os.makedirs(work, exist_ok=True)
+    ks = os.path.abspath(args.kinesweep)
+    try:
+        for kind in args.kinds:
+            for n in args.runs:
+                a = int(round(n ** 0.5))
+                b = n // a
+                study = os.path.join(work, f"{kind}_{n}.toml")
+                with open(study, "w") as f:
+                    f.write((TRAJECTORY if kind == "trajectory" else IK).format(a=a, b=b))
+                out = os.path.join(work, f"{kind}_{n}.h5")
+                print(f"{kind}, {a * b} runs", flush=True)
+                writes, before = [], []
+                for _ in range(args.repeat):
+                    writes.append(timed([ks, "run", study, "-o", out, "--overwrite", "-q", "--threads",
+                                         str(args.threads)]))
+                    if args.before:
+                        old = out + ".before.h5"
+                        before.append(timed([args.before, "run", study, "-o", old, "--overwrite", "-q",
+                                             "--threads", str(args.threads)]))
+                size = os.path.getsize(out)
+                w = [t for t, _ in writes]
+                line = (f"  write    {min(w):8.2f} s (median {statistics.median(w):6.2f})   "
+                        f"peak {max(r for _, r in writes) / 1e6:5.0f} MB   {size / (a * b):6.1f} B/run")
+                if before:
+                    wb = [t for t, _ in before]
+                    bsize = os.path.getsize(out + ".before.h5")
+                    line += (f"   before: {min(wb):.2f} s, {bsize / (a * b):.1f} B/run;"
+                             f" write ratio new/old {min(w) / min(wb):.3f} (min), "
+                             f"{statistics.median(w) / statistics.median(wb):.3f} (median)")
+                    os.remove(out + ".before.h5")
+                print(line, flush=True)
+                metric = METRIC[kind]
+                with h5py.File(out, "r") as f:
+                    v = f["runs"][metric][()]
+                    cut = float(np.nanpercentile(v, 1))
+                    columns = list(f["runs"])
+                    info_cols = [c for c in columns
+                                 if f["runs"][c].attrs.get("role") in ("parameter", b"parameter")]
+                    info_cols += ["block", "status", "done", metric]
+                runs = {"query": ([ks, "query", out, "--where", f"{metric}<{cut!r}", "--sort", metric, "--limit", "3"],
+                                  [metric, "done"]),
+                        "group": ([ks, "query", out, "--group-by", "method", "--agg", f"min:{metric},count"],
+                                  ["method", metric, "done"]),
+                        "info": ([ks, "info", out], info_cols)}
+                for name, (cmd, cols) in runs.items():
+                    ours, rss, base = [], [], []
+                    for _ in range(args.repeat):
+                        t, r = timed(cmd)
+                        ours.append(t)
+                        rss.append(r)
+                        base.append(h5py_read(out, cols))
+                    report(name, ours, base, rss)
+                ours, rss, base, frame = [], [], [], 0
+                for _ in range(args.repeat):
+                    p = subprocess.run([sys.executable, "-c", PANDAS, out], capture_output=True, text=True, check=True)
+                    seconds, frame = p.stdout.split()[-2:]
+                    ours.append(float(seconds))  # to_pandas() alone (not the interpreter's start)
+                    frame = int(frame)
+                    base.append(h5py_read(out, columns))
+                t, r = timed([sys.executable, "-c", PANDAS, out])
+                rss.append(r)
+                report("pandas", ours, base, rss, f"   frame {frame / 1e6:.0f} MB (peak/frame {max(rss) / frame:.2f})")
+                if not args.keep:
+                    os.remove(out)
+    finally:
+        if not args.keep and not args.workdir:
+            shutil.rmtree(work, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()
