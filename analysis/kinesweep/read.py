@@ -27,6 +27,7 @@ in version 4 the text columns with few distinct values are HDF5 enums (read here
 values, and by to_pandas() as pandas categoricals).
 """
 import os
+from collections.abc import Mapping
 
 import h5py
 import numpy as np
@@ -160,6 +161,28 @@ class Optimization:
     def __repr__(self):
         return (f"Optimization({self.name!r}, {self.objective!r} over {', '.join(self.variables)}, "
                 f"{self.n_evaluations} evaluations, best {self.best['objective']:.6g})")
+
+
+class _Grids(Mapping):
+    """A landscape's metric grids by name, each read from the file when first asked for (a
+    3163 x 3163 landscape's 14 grids are 1.1 GB; a plot reads one or two), so while the Results
+    that made it is open (read_landscape() reads them all)."""
+
+    def __init__(self, names, read):
+        self._names, self._read, self._grids = list(names), read, {}
+
+    def __getitem__(self, name):
+        if name not in self._names:
+            raise KeyError(name)
+        if name not in self._grids:
+            self._grids[name] = self._read(name)
+        return self._grids[name]
+
+    def __iter__(self):
+        return iter(self._names)
+
+    def __len__(self):
+        return len(self._names)
 
 
 class Results:
@@ -452,11 +475,12 @@ class Results:
             elif degrees and unit == "rad":
                 vals, unit = vals * RAD2DEG, "deg"
             axes.append(Axis(a, unit, vals, labels))
-        metrics, units, desc = {}, {}, {}
-        for m in (_s(x) for x in g.attrs["metrics"]):
-            metrics[m] = np.array(g[m][()], dtype=float)
+        units, desc = {}, {}
+        names = [_s(x) for x in g.attrs["metrics"]]
+        for m in names:
             units[m] = _s(g[m].attrs.get("unit", ""))
             desc[m] = _s(g[m].attrs.get("description", ""))
+        metrics = _Grids(names, lambda m: np.array(self.f["landscapes"][block][m][()], dtype=float))
         kind = self._block_kind(block)
         return Landscape(block, axes, metrics, units, desc, kind, self.kind_meaning(kind))
 
@@ -505,7 +529,9 @@ def read_history(path, run_id, **kw):
 
 def read_landscape(path, block=None, **kw):
     with Results(path) as r:
-        return r.landscape(block, **kw)
+        ls = r.landscape(block, **kw)
+        ls.metrics = {m: ls.metrics[m] for m in ls.metrics}  # every grid, before the file closes
+        return ls
 
 
 def read_optimization(path, name=None, **kw):

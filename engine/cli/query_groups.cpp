@@ -59,7 +59,6 @@ std::vector<std::size_t> GroupAggregator::columns() const {
   std::vector<std::size_t> out = keys_;
   for (const Spec& s : specs_)
     if (s.fn != Agg::count) out.push_back(s.col);
-  if (id_col_ >= 0) out.push_back(static_cast<std::size_t>(id_col_));
   return out;
 }
 
@@ -90,11 +89,16 @@ void GroupAggregator::add(const RunsTable& t, std::int64_t r, const Selector& se
     else key[k].num = sel.value(c, r);
     if (c.type == CellType::i64) key[k].i = c.i[r];
   }
-  Group& g = groups_[std::move(key)];
+  // rows of a group mostly follow each other: the previous row's group first
+  const bool same = last_ && !Less{this}(key, last_->first) && !Less{this}(last_->first, key);
+  if (!same) last_ = &*groups_.try_emplace(std::move(key)).first;
+  Group& g = last_->second;
   if (g.acc.empty()) g.acc.resize(specs_.size());
   ++g.rows;
   ++rows_;
-  const std::int64_t id = id_col_ >= 0 ? t.cols[static_cast<std::size_t>(id_col_)].i[r] : t.row_id(r);
+  // run_id is the row's id in /runs (row i holds run i): the column itself is not needed to name it
+  const RunsColumn* ids = id_col_ >= 0 ? &t.cols[static_cast<std::size_t>(id_col_)] : nullptr;
+  const std::int64_t id = ids && !ids->i.empty() ? ids->i[r] : t.row_id(r);
   for (std::size_t j = 0; j < specs_.size(); ++j) {
     const Spec& s = specs_[j];
     if (s.fn == Agg::count) continue;

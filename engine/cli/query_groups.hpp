@@ -19,7 +19,10 @@ class GroupAggregator {
   /// Parses --group-by and --agg against `t`'s columns (a header or a table: only its column list
   /// is used; the rows given to add() must come from tables with the same columns). Throws ArgError.
   GroupAggregator(const QueryArgs& a, const RunsTable& t);
-  /// Indices into t.cols of the columns add() reads (keys, aggregated columns, run_id).
+  GroupAggregator(const GroupAggregator&) = delete;  // its map's order refers to it
+  GroupAggregator& operator=(const GroupAggregator&) = delete;
+  /// Indices into t.cols of the columns add() reads (keys and aggregated columns; a row's run id is
+  /// its row_id, or its run_id cell when the table holds that column).
   std::vector<std::size_t> columns() const;
   /// Adds row `r` of `t` (rows in run-id order across calls: ties of argmin/argmax go to the first).
   void add(const RunsTable& t, std::int64_t r, const Selector& sel);
@@ -60,6 +63,7 @@ class GroupAggregator {
   std::vector<Spec> specs_;
   std::ptrdiff_t id_col_ = -1;              // run_id (i64), or -1: argmin/argmax give the row index
   std::map<std::vector<Part>, Group, Less> groups_;
+  std::pair<const std::vector<Part>, Group>* last_ = nullptr;  // the group of the previous row
   std::int64_t rows_ = 0;
 };
 

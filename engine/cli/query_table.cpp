@@ -124,7 +124,7 @@ std::vector<bool> columns_read(const QueryArgs& a, const RunsTable& t, Format fm
     if (!name.empty()) mark(name, " in --group-by");
   if (!a.group_by.empty())
     for (std::size_t c : GroupAggregator(a, t).columns()) take[c] = true;
-  if (t.find("run_id")) mark("run_id", "");
+  if (t.find("run_id") && a.group_by.empty()) mark("run_id", "");
   const bool all = a.columns == "all" || (a.columns.empty() && (fmt != Format::table || !wording.compact_default));
   for (std::size_t c = 0; c < t.cols.size(); ++c) {
     const RunsColumn& col = t.cols[c];

@@ -8,18 +8,20 @@ usage: /usr/bin/python3 tests/bench/results_scale.py build/kinesweep [--before O
 For each study kind and run count: `kinesweep run` (wall time, peak RSS, file bytes per run;
 alternated with --before's binary, whose write time gives the ratio new / old), then, on the file
 just written, repeated --repeat times (min and median of each):
-  query   --where "<metric> < <its 1st percentile>" --sort <metric> --limit 3
+  query   --where "<metric> < <its 1st percentile>" --sort <metric> --limit 3 --columns run_id,<metric>
+  compact the same without --columns (the compact default: it reads every parameter and metric of the
+          pieces holding a matching row, to show the parameters that vary among the matches)
   group   --group-by method --agg min:<metric>,count
   info
   pandas  kinesweep.read.open_results(F).to_pandas() (all columns; timed inside the interpreter;
           peak RSS of that interpreter, pandas imported; the frame's bytes)
-against h5py reading the columns each touches (query: the metric and done; group: method, the
-metric and done; info: the columns info reads; pandas: every /runs column).
+against h5py reading the columns each touches (query: the metric, run_id and done; compact: every
+parameter and metric, block, status and done; group: method, the metric and done; info: the
+columns info reads; pandas: every /runs column).
 Ratios over the h5py read are what the targets are stated in. Run with Debian's /usr/bin/python3.
 """
 import argparse
 import os
-import resource
 import shutil
 import statistics
 import subprocess
@@ -66,14 +68,15 @@ METRIC = {"trajectory": "E", "ik": "iterations"}
 
 
 def timed(cmd):
-    """(wall seconds, peak RSS bytes) of a child process; its output discarded."""
+    """(wall seconds, peak RSS bytes) of a command; its output discarded. The peak is GNU time's
+    (the rusage of a child forked from this interpreter would count the interpreter's pages)."""
     t0 = time.perf_counter()
-    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(p.pid, 0)
-    err = p.stderr.read().decode()
-    if os.waitstatus_to_exitcode(status) != 0:
-        raise SystemExit(f"failed: {' '.join(cmd)}\n{err}")
-    return time.perf_counter() - t0, usage.ru_maxrss * 1024
+    p = subprocess.run(["/usr/bin/time", "-f", "%M", *cmd], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                       text=True)
+    seconds = time.perf_counter() - t0
+    if p.returncode != 0:
+        raise SystemExit(f"failed: {' '.join(cmd)}\n{p.stderr}")
+    return seconds, int(p.stderr.strip().splitlines()[-1]) * 1024
 
 
 PANDAS = f"""
@@ -160,8 +163,12 @@ def main():
                     info_cols = [c for c in columns
                                  if f["runs"][c].attrs.get("role") in ("parameter", b"parameter")]
                     info_cols += ["block", "status", "done", metric]
-                runs = {"query": ([ks, "query", out, "--where", f"{metric}<{cut!r}", "--sort", metric, "--limit", "3"],
-                                  [metric, "done"]),
+                    compact = [c for c in columns if f["runs"][c].attrs.get("role") in
+                               ("parameter", b"parameter", "metric", b"metric")] + ["block", "status", "done"]
+                where = ["--where", f"{metric}<{cut!r}", "--sort", metric, "--limit", "3"]
+                runs = {"query": ([ks, "query", out, *where, "--columns", f"run_id,{metric}"],
+                                  [metric, "run_id", "done"]),
+                        "compact": ([ks, "query", out, *where], compact),
                         "group": ([ks, "query", out, "--group-by", "method", "--agg", f"min:{metric},count"],
                                   ["method", metric, "done"]),
                         "info": ([ks, "info", out], info_cols)}
