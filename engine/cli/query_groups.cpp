@@ -81,17 +81,35 @@ bool GroupAggregator::Less::operator()(const std::vector<Part>& x, const std::ve
   return false;
 }
 
-void GroupAggregator::add(const RunsTable& t, std::int64_t r, const Selector& sel) {
-  std::vector<Part> key(keys_.size());
+bool GroupAggregator::in_last(const RunsTable& t, std::int64_t r, const Selector& sel) const {
+  if (!last_) return false;
   for (std::size_t k = 0; k < keys_.size(); ++k) {
     const RunsColumn& c = t.cols[keys_[k]];
-    if (c.type == CellType::str) key[k].s = c.s[r];
-    else key[k].num = sel.value(c, r);
-    if (c.type == CellType::i64) key[k].i = c.i[r];
+    const Part& p = last_->first[k];
+    if (c.type == CellType::str) {
+      if (c.s[r] != p.s) return false;
+    } else if (c.type == CellType::i64) {
+      if (c.i[r] != p.i) return false;
+    } else {
+      const double v = sel.value(c, r);
+      if (!(v == p.num || (std::isnan(v) && std::isnan(p.num)))) return false;
+    }
   }
-  // rows of a group mostly follow each other: the previous row's group first
-  const bool same = last_ && !Less{this}(key, last_->first) && !Less{this}(last_->first, key);
-  if (!same) last_ = &*groups_.try_emplace(std::move(key)).first;
+  return true;
+}
+
+void GroupAggregator::add(const RunsTable& t, std::int64_t r, const Selector& sel) {
+  // rows of a group mostly follow each other: the previous row's group first (no key built)
+  if (!in_last(t, r, sel)) {
+    std::vector<Part> key(keys_.size());
+    for (std::size_t k = 0; k < keys_.size(); ++k) {
+      const RunsColumn& c = t.cols[keys_[k]];
+      if (c.type == CellType::str) key[k].s = c.s[r];
+      else key[k].num = sel.value(c, r);
+      if (c.type == CellType::i64) key[k].i = c.i[r];
+    }
+    last_ = &*groups_.try_emplace(std::move(key)).first;
+  }
   Group& g = last_->second;
   if (g.acc.empty()) g.acc.resize(specs_.size());
   ++g.rows;

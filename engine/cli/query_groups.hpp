@@ -64,6 +64,8 @@ class GroupAggregator {
   std::ptrdiff_t id_col_ = -1;              // run_id (i64), or -1: argmin/argmax give the row index
   std::map<std::vector<Part>, Group, Less> groups_;
   std::pair<const std::vector<Part>, Group>* last_ = nullptr;  // the group of the previous row
+  /// Row `r` of `t` belongs to last_'s group (the same key values, NaN equal to NaN).
+  bool in_last(const RunsTable& t, std::int64_t r, const Selector& sel) const;
   std::int64_t rows_ = 0;
 };
 
