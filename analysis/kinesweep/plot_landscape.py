@@ -21,6 +21,7 @@ import numpy as np
 
 from kinesweep import plotting as ksplot  # noqa: E402
 from kinesweep import read as ksread  # noqa: E402
+from kinesweep.report_grids import ordinal  # noqa: E402
 
 METRIC_LABELS = ksread.METRIC_LABELS
 MAX_PANELS = 6  # small multiples: at most this many panels, one per value of a categorical dim
@@ -190,12 +191,7 @@ def reduce_grid(ls, args):
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             z = np.nanmean(vals, axis=3) if args.reduce == "mean" else np.nanmin(vals, axis=3)
-        cat = np.full(z.shape, -1)
-        none = np.all(np.isnan(vals), axis=3)
-        for p, i, j in zip(*np.nonzero(none)):
-            s = status[p, i, j][np.isfinite(status[p, i, j])].astype(int)
-            s = s[s != good]
-            cat[p, i, j] = np.bincount(s).argmax() if s.size else -2  # -2: no run at all
+        cat = failed_category(status, np.all(np.isnan(vals), axis=3), good)
         reduce = args.reduce if [n for n in rest if len(ls.axis(n).values) > 1] else None
         if reduce:
             notes.append(f"{reduce} over {', '.join(n for n in rest if len(ls.axis(n).values) > 1)}")
@@ -210,6 +206,29 @@ def reduce_grid(ls, args):
     fa = ls.axis(facet) if facet else None
     return {"metric": metric, "x": xa, "y": ya, "z": z, "cat": cat, "notes": notes, "reduce": reduce,
             "fixed": fixed, "facet": facet, "panel_labels": list(fa.labels) if fa else [None]}
+
+
+def failed_category(status, none, good):
+    """Per cell (panels x ny x nx) of `status` (same x cells reduced): -1 where `none` is false (the
+    cell has a value), else the most common failed status of its runs (the smallest code on a tie),
+    -2 when it has no run at all."""
+    cat = np.full(none.shape, -1)
+    if not none.any():
+        return cat
+    st = status[none]  # cells without a value x their runs
+    codes = np.unique(st[np.isfinite(st) & (st != good)]).astype(int)
+    if codes.size == 0:
+        cat[none] = -2
+        return cat
+    counts = np.stack([np.sum(st == c, axis=1) for c in codes], axis=1)
+    cat[none] = np.where(counts.max(axis=1) > 0, codes[np.argmax(counts, axis=1)], -2)
+    return cat
+
+
+def draw_stride(nx, ny, pixels):
+    """Every s-th cell of each axis drawn so that neither axis draws more cells than the picture has
+    pixels across (more would not show; the minimum is marked from the full grid)."""
+    return max(1, -(-max(nx, ny) // max(1, pixels)))
 
 
 def _first_value(a):
@@ -257,7 +276,13 @@ def main(argv=None):
         axs.flat[k].set_visible(False)
     xv = np.arange(len(xa.values)) if xa.categorical else xa.values
     yv = np.arange(len(ya.values)) if ya.categorical else ya.values
-    X, Y = np.meshgrid(ksplot.cell_edges(xv, xlog), ksplot.cell_edges(yv, ylog))
+    # Big grids are drawn every s-th cell (the picture has fewer pixels); values, minimum and counts
+    # come from the full grid.
+    step = draw_stride(len(xv), len(yv), min(int(round(size[0] * args.dpi)), int(round(size[1] * args.dpi))))
+    dx, dy = xv[::step], yv[::step]
+    X, Y = np.meshgrid(ksplot.cell_edges(dx, xlog), ksplot.cell_edges(dy, ylog))
+    if step > 1:
+        d["notes"].append(f"every {ordinal(step)} cell of {len(yv)} × {len(xv)} drawn")
     finite = Z[np.isfinite(Z)]  # one colour scale for every panel
     vmin = args.vmin if args.vmin is not None else (finite.min() if finite.size else 0.0)
     vmax = args.vmax if args.vmax is not None else (finite.max() if finite.size else 1.0)
@@ -282,10 +307,10 @@ def main(argv=None):
     for p in range(n):
         ax, z, cat = axs.flat[p], Z[p], CAT[p]
         pfinite = z[np.isfinite(z)]
-        mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(z), cmap=cmap, norm=norm, shading="flat")
+        mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(z[::step, ::step]), cmap=cmap, norm=norm, shading="flat")
         # Failed cells in their own colours.
         handles = []
-        present = sorted(set(cat[cat >= 0].ravel().tolist()))
+        present = np.unique(cat[cat >= 0]).tolist()
         if present or (cat == -2).any():
             colours = ["#ffffff"] * (len(statuses) + 1)
             for s in present:
@@ -294,11 +319,11 @@ def main(argv=None):
                                      label=f"{statuses[s]} ({int((cat == s).sum())} cells)"))
             if (cat == -2).any():
                 handles.append(Patch(facecolor="#ffffff", edgecolor="0.3", label="no run"))
-            c = np.where(cat == -2, len(statuses), cat).astype(float)
+            c = np.where(cat[::step, ::step] == -2, len(statuses), cat[::step, ::step]).astype(float)
             ax.pcolormesh(X, Y, np.ma.masked_less(c, 0), cmap=ListedColormap(colours),
                           vmin=-0.5, vmax=len(statuses) + 0.5, shading="flat")
         if len(levels) and pfinite.size:
-            cs = ax.contour(xv, yv, np.ma.masked_invalid(z), levels=levels, colors="white", linewidths=0.7, alpha=0.8)
+            cs = ax.contour(dx, dy, np.ma.masked_invalid(z[::step, ::step]), levels=levels, colors="white", linewidths=0.7, alpha=0.8)
             ax.clabel(cs, fmt=lambda v: f"{v:g}", fontsize=7, inline=True)
         # Minimum (the mean for the convergence fraction).
         best = None
@@ -335,8 +360,7 @@ def main(argv=None):
                   fontsize=8 if n == 1 else 7, framealpha=0.85)
         if d["facet"]:
             ax.set_title(f"{d['facet']} = {d['panel_labels'][p]}", fontsize=9)
-        panels.append({"label": d["panel_labels"][p], "z": z, "best": best,
-                       "masked_status": [[(statuses[c] if c >= 0 else None) for c in row] for row in cat]})
+        panels.append({"label": d["panel_labels"][p], "z": z, "best": best, "cat": cat})
     cb = fig.colorbar(mesh, ax=list(axs.flat[:n]), extend="max" if args.vmax is not None else "neither")
     cb.set_label(label)
     if args.log:
@@ -349,13 +373,18 @@ def main(argv=None):
     title = args.title or (f"{what} over {xa.name} × {ya.name} — block {ls.block}{(' (' + sub + ')') if sub else ''}"
                            f"\n{os.path.basename(args.file)}{' (log colour scale)' if args.log else ''}")
     (fig.suptitle if n > 1 else axs.flat[0].set_title)(title, fontsize=10)
+    for pan in panels:  # the failed cells' statuses by name: printed data only (a list per cell)
+        cat = pan.pop("cat")
+        if args.print_data:
+            pan["masked_status"] = [[(statuses[c] if c >= 0 else None) for c in row] for row in cat]
     first = panels[0]
     return ksplot.finish(fig, args, f"landscape_{ls.block}_{metric}",
         {"file": args.file, "block": ls.block, "metric": metric, "unit": unit,
          "reduce": d["reduce"], "fixed": d["fixed"], "facet": d["facet"], "levels": levels,
          "x": {"name": xa.name, "unit": xa.unit, "values": xa.values, "labels": xa.labels, "log": xlog},
          "y": {"name": ya.name, "unit": ya.unit, "values": ya.values, "labels": ya.labels, "log": ylog},
-         "z": first["z"], "masked_status": first["masked_status"], "best": first["best"], "panels": panels,
+         "z": first["z"], "masked_status": first.get("masked_status"), "best": first["best"], "panels": panels,
+         "draw_stride": step,
          "thesis": thesis, "optimization": opt, "xscale": axs.flat[0].get_xscale(),
          "yscale": axs.flat[0].get_yscale(), "colorbar": {"ticks": cticks, "labels": clabels}})
 

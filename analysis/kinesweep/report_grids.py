@@ -209,7 +209,7 @@ def landscape_figure(ls, cap):
             f"<br>{esc(value_text(ls.axes[d], sel.fixed[d]))}" for d in sel.held)
         st = sel.slice(status, f)[np.ix_(yi, xi)]
         z = v[np.ix_(yi, xi)]
-        custom = np.stack([sel.slice(ls.metrics[m], f)[np.ix_(yi, xi)] for m in hover_metrics], axis=-1)
+        custom = hover_data([sel.slice(ls.metrics[m], f)[np.ix_(yi, xi)] for m in hover_metrics], np.isfinite(z))
         tmpl = head + ctx + "".join(f"<br>{m} = %{{customdata[{k}]:.5g}}" + (f" {ls.units[m]}" if ls.units[m] else "")
                                     for k, m in enumerate(hover_metrics)) + f"<br>status {statuses[0]}<extra></extra>"
         with np.errstate(all="ignore"):
@@ -219,23 +219,21 @@ def landscape_figure(ls, cap):
                    "colorscale": "Viridis", "zmin": zmin, "zmax": zmax, "colorbar": cb, "hoverongaps": False,
                    "showscale": dropdown or not frames, "name": metric}]
         fail = np.where(np.isfinite(st) & (st != 0), st, np.nan)
-        codes = sorted({int(c) for c in fail[np.isfinite(fail)].ravel()})
-        if codes:
-            for c in codes:
-                failed_seen[c] = failed_seen.get(c, 0) + int(np.sum(sel.slice(status, f) == c))
-            names = np.array([statuses[int(c)] if np.isfinite(c) else "" for c in fail.ravel()],
-                             dtype=object).reshape(fail.shape)
-            # the failed runs' metrics that have values (an IK failure's iterations and final error)
-            fm = [m for m in ls.metrics if m not in ls.status_grids()
-                  and np.isfinite(np.where(fail_all, ls.metrics[m], np.nan)).any()]
-            fcustom = np.stack([names] + [sel.slice(ls.metrics[m], f)[np.ix_(yi, xi)].astype(object) for m in fm],
-                               axis=-1)
-            ftmpl = head + ctx + "<br>status %{customdata[0]}" + "".join(
-                f"<br>{m} = %{{customdata[{k + 1}]:.5g}}" + (f" {ls.units[m]}" if ls.units[m] else "")
+        codes = sorted({int(c) for c in np.unique(fail[np.isfinite(fail)])})
+        # the failed runs' metrics that have values (an IK failure's iterations and final error)
+        fm = [m for m in ls.metrics if m not in ls.status_grids()
+              and np.isfinite(np.where(fail_all, ls.metrics[m], np.nan)).any()] if codes else []
+        fvals = [sel.slice(ls.metrics[m], f)[np.ix_(yi, xi)] for m in fm]
+        for c in codes:  # one trace per failed status: its name in the hover text, not in every cell
+            failed_seen[c] = failed_seen.get(c, 0) + int(np.sum(sel.slice(status, f) == c))
+            cells_c = fail == c
+            ftmpl = head + ctx + f"<br>status {esc(statuses[c])}" + "".join(
+                f"<br>{m} = %{{customdata[{k}]:.5g}}" + (f" {ls.units[m]}" if ls.units[m] else "")
                 for k, m in enumerate(fm)) + "<extra></extra>"
-            traces.append({"type": "heatmap", "x": xs, "y": ys, "z": fail, "customdata": fcustom,
+            traces.append({"type": "heatmap", "x": xs, "y": ys, "z": np.where(cells_c, fail, np.nan),
+                           "customdata": hover_data(fvals, cells_c) if fm else None,
                            "zmin": 0, "zmax": max(1, len(statuses) - 1), "colorscale": _steps(statuses),
-                           "showscale": False, "hoverongaps": False, "name": "failed", "hovertemplate": ftmpl})
+                           "showscale": False, "hoverongaps": False, "name": statuses[c], "hovertemplate": ftmpl})
         if np.isfinite(v).any():
             i, j = np.unravel_index(np.nanargmin(v), v.shape)
             bx = axis_values(xa, [j])[0]
@@ -271,6 +269,17 @@ def landscape_figure(ls, cap):
         parts.append(esc(more[0].upper() + more[1:]) + ".")
     parts.append("The star marks the smallest value of each panel; hover a cell for its parameters and metrics.")
     return fig, " ".join(parts) + capped_note(sel, s), cells
+
+
+def hover_data(values, cells):
+    """Per-cell hover values (a list per row of [v0, v1, ...]) where `cells` is true, null elsewhere
+    (cells without hover text), floats to 5 significant digits as the hover shows them."""
+    out = []
+    stacked = np.stack(values, axis=-1) if values else np.zeros(cells.shape + (0,))
+    for row, keep in zip(stacked, cells):
+        out.append([[float(f"{x:.5g}") if math.isfinite(x) else None for x in cell] if k else None
+                    for cell, k in zip(row.tolist(), keep.tolist())])
+    return out
 
 
 def _steps(statuses):

@@ -1,6 +1,6 @@
 """The HTML of analysis/report.py: the page skeleton (style, table of contents, the script that draws
 the figures and records JavaScript errors), tables and figure placeholders. Plotly's JavaScript is
-embedded from Debian's python3-plotly, so the page works offline. Run with /usr/bin/python3."""
+embedded (gzip in base64, with each figure's data), so the page works offline. Run with /usr/bin/python3."""
 import html
 import json
 import math
@@ -39,8 +39,10 @@ window.addEventListener('unhandledrejection', function (e) { window.ksErrors.pus
   window.ksErrors.push(Array.prototype.map.call(arguments, String).join(' ')); return ce.apply(console, arguments); }; })();
 """
 
-# Shows only the section named by '#only=ID' (for screenshots of one section), then draws every
-# figure from its JSON data island and writes the outcome into #ks-status (data-ready="1").
+# Shows only the section named by '#only=ID' (for screenshots of one section); inflates plotly's
+# bundle and runs it; then draws every figure from its data island and writes the outcome into
+# #ks-status (data-ready="1"). Plotly and the figures' JSON are stored gzip-compressed in base64
+# (script elements of type application/gzip), inflated by the browser's DecompressionStream.
 LOADER = """
 (function () {
   var m = /^#only=([\\w-]+)$/.exec(window.location.hash);
@@ -48,26 +50,52 @@ LOADER = """
     document.body.classList.add('only');
     document.querySelectorAll('body > section').forEach(function (s) { s.style.display = s.id === m[1] ? '' : 'none'; });
   }
-  var done = [];
+  function inflate(id) {
+    var bin = atob(document.getElementById(id).textContent.trim());
+    var bytes = new Uint8Array(bin.length);
+    for (var i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
+    return new Response(new Blob([bytes]).stream().pipeThrough(new DecompressionStream('gzip'))).text();
+  }
   var drawn = 0;
-  document.querySelectorAll('div.plot').forEach(function (div) {
-    var sec = div.closest('section');
-    if (sec && sec.style.display === 'none') return;
-    try {
-      var spec = JSON.parse(document.getElementById(div.id + '-data').textContent);
-      spec.config = Object.assign({displaylogo: false, responsive: true,
-                                   modeBarButtonsToRemove: ['sendDataToCloud']}, spec.config || {});
-      done.push(Plotly.newPlot(div, spec.data, spec.layout, spec.config).then(function () { drawn += 1; }));
-    } catch (e) { window.ksErrors.push('figure ' + div.id + ': ' + e); }
-  });
   function report() {
     var st = document.getElementById('ks-status');
     st.textContent = JSON.stringify({plots: drawn, errors: window.ksErrors});
     st.setAttribute('data-ready', '1');
   }
-  Promise.all(done).then(report, function (e) { window.ksErrors.push('plot: ' + e); report(); });
+  function draw(div) {
+    return inflate(div.id + '-data').then(function (text) {
+      var spec = JSON.parse(text);
+      spec.config = Object.assign({displaylogo: false, responsive: true,
+                                   modeBarButtonsToRemove: ['sendDataToCloud']}, spec.config || {});
+      return Plotly.newPlot(div, spec.data, spec.layout, spec.config);
+    }).then(function () { drawn += 1; }, function (e) { window.ksErrors.push('figure ' + div.id + ': ' + e); });
+  }
+  var plots = Array.prototype.filter.call(document.querySelectorAll('div.plot'), function (div) {
+    var sec = div.closest('section');
+    return !(sec && sec.style.display === 'none');
+  });
+  if (!plots.length) { report(); return; }
+  if (typeof DecompressionStream === 'undefined') {
+    window.ksErrors.push('this browser lacks DecompressionStream (Chrome 80, Firefox 113, Safari 16.4 have it): no figures');
+    report();
+    return;
+  }
+  inflate('plotly-js').then(function (code) {
+    var s = document.createElement('script');
+    s.text = code;
+    document.head.appendChild(s);
+    return Promise.all(plots.map(draw));
+  }).then(report, function (e) { window.ksErrors.push('plotly: ' + e); report(); });
 })();
 """
+
+
+def gzip_island(element_id, text):
+    """A script element holding `text` gzip-compressed in base64 (inflated by LOADER)."""
+    import base64
+    import gzip
+    data = base64.b64encode(gzip.compress(text.encode("utf-8"), compresslevel=9, mtime=0)).decode("ascii")
+    return f'<script type="application/gzip" id="{esc(element_id)}">{data}</script>'
 
 
 def esc(s):
@@ -139,12 +167,11 @@ def _clean(o):
 
 
 def figure(fid, fig, caption, title=None):
-    """A figure placeholder, its JSON data island (data, layout: plain plotly dicts; NaN -> null) and
-    its caption. Floats are kept to 7 significant digits."""
-    text = json.dumps(_clean(fig), allow_nan=False, separators=(",", ":")).replace("</", "<\\/")
+    """A figure placeholder, its data island (the JSON of data and layout, plain plotly dicts, NaN ->
+    null; gzip in base64) and its caption. Floats are kept to 7 significant digits."""
+    text = json.dumps(_clean(fig), allow_nan=False, separators=(",", ":"))
     h = f"<h3>{esc(title)}</h3>" if title else ""
-    return (f'{h}<div class="plot" id="{esc(fid)}"></div>'
-            f'<script type="application/json" id="{esc(fid)}-data">{text}</script>'
+    return (f'{h}<div class="plot" id="{esc(fid)}"></div>{gzip_island(fid + "-data", text)}'
             f'<p class="caption">{caption}</p>')
 
 
@@ -155,7 +182,7 @@ def page(title, subtitle, sections, plotly_js):
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             f"<title>{esc(title)}</title><style>{STYLE}</style>"
             f"<script>{ERROR_COLLECTOR}</script>"
-            f"<script>{plotly_js}</script></head><body>"
+            f"{gzip_island('plotly-js', plotly_js)}</head><body>"
             f"<header><h1>{esc(title)}</h1><p class=\"sub\">{subtitle}</p></header>"
             f"<nav><strong>Contents</strong><ul>{toc}</ul></nav>{body}"
             "<pre id=\"ks-status\" data-ready=\"0\"></pre>"

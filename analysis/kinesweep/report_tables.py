@@ -3,30 +3,86 @@ the best runs of each block (parameters and metrics, units in the headers, angle
 Run with /usr/bin/python3."""
 import numpy as np
 
-from kinesweep import read as ksread
+from kinesweep.kinds import enum_labels, text_values
+from kinesweep.read import RAD2DEG
 from kinesweep.report_page import esc, fmt, table
 
 
+POINT_READ_ROWS = 4096  # up to this many rows are read by index; more, as whole columns
+
+
 class RunsView:
-    """Every row of /runs (done or not, angles in degrees) with each row's kind and block order."""
+    """The /runs rows the report reads, a column at a time: the done flags and the block and status
+    codes (a byte or two per row) are held; every other column is read when asked, for the rows
+    asked (by index for a few rows, else the whole column), so the report's memory is a few columns
+    whatever the row count. Angles in degrees; a row's run id is its index."""
 
     def __init__(self, res):
         self.res = res
-        self.t = res.runs(done_only=False, degrees=True)
-        self.done = np.asarray(self.t["done"], dtype=bool)
-        self.kinds = res.row_kinds(done_only=False)
-        blocks = self.t["block"] if "block" in self.t else np.full(len(self.done), "", dtype=object)
-        self.blocks = blocks
-        self.block_names = list(dict.fromkeys(blocks.tolist()))
+        self.g = res.f["runs"]
+        self.done = self.g["done"][()].astype(bool)
+        self.n = len(self.done)
+        self.units = {c: ("deg" if u == "rad" else u) for c, u in res.units().items()}
+        self.block_codes, self.block_labels = self._codes("block")
+        self.status_codes, self.status_labels = self._codes("status")
+        order = np.unique(self.block_codes, return_index=True)
+        self.block_names = [self.block_labels[c] for c in order[0][np.argsort(order[1])]]
+
+    def _codes(self, c):
+        """A text column as (codes per row, labels by code): its enum codes (format 4, the missing value
+        as the label ""), or codes of its distinct strings (format 3); ([0] * n, [""]) without it."""
+        if c not in self.g:
+            return np.zeros(self.n, dtype=np.int64), [""]
+        d = self.g[c]
+        labels = enum_labels(d)
+        if labels is not None:
+            return d[()], labels + [""] * (256 ** d.dtype.itemsize - len(labels))
+        names, codes = np.unique(text_values(d), return_inverse=True)
+        return codes.astype(np.int64), [str(x) for x in names]
+
+    def is_text(self, c):
+        d = self.g[c]
+        return enum_labels(d) is not None or d.dtype.kind in "OSU"
+
+    def values(self, c, rows):
+        """Column c at `rows` (an index array): floats in degrees where stored in radians, text as str."""
+        d = self.g[c]
+        rows = np.asarray(rows, dtype=np.int64)
+        if len(rows) == 0:
+            v = d[0:0]
+        elif len(rows) <= POINT_READ_ROWS:
+            uniq, inverse = np.unique(rows, return_inverse=True)
+            v = d[uniq][inverse]
+        elif rows[-1] - rows[0] + 1 == len(rows) and np.all(np.diff(rows) == 1):
+            v = d[int(rows[0]):int(rows[-1]) + 1]
+        else:
+            v = d[()][rows]
+        if enum_labels(d) is not None or v.dtype.kind in "OSU":
+            return text_values(d, v)
+        if self.units.get(c) == "deg" and v.dtype.kind == "f":
+            v = v * RAD2DEG
+        return v
+
+    def value(self, c, row):
+        return self.values(c, [row])[0]
+
+    def status(self, rows):
+        return np.asarray(self.status_labels, dtype=object)[self.status_codes[rows]]
 
     def rows(self, block, done=True):
-        m = self.blocks == block
+        code = self.block_labels.index(block)
+        m = self.block_codes == code
         return np.flatnonzero(m & self.done) if done else np.flatnonzero(m)
 
+    def row_kind(self, row):
+        return self.res.row_kinds(rows=[int(row)])[0]
+
     def kind(self, block):
-        k = [x for x in self.kinds[self.rows(block)] if x]
+        """The run kind of the block's runs (of its first done row; a block's runs are of one kind)."""
+        rows = self.rows(block)
+        k = self.row_kind(rows[0]) if len(rows) else ""
         if k:
-            return k[0]
+            return k
         k = self.res.run_kinds()
         return k[0] if len(k) == 1 else ""
 
@@ -35,11 +91,12 @@ class RunsView:
         trajectory by E, IK by iterations then error); ties by run id. Returns (row indices, the
         ranking metric names)."""
         meaning = self.res.kind_meaning(self.kind(block))
-        keys = [k for k in meaning.get("ranking", []) if k in self.t]
+        keys = [k for k in meaning.get("ranking", []) if k in self.g]
         rows = self.rows(block)
-        rows = rows[np.isin(self.t["status"][rows], meaning.get("good_statuses", []))]
-        cols = [self.t["run_id"][rows]] + [np.nan_to_num(np.asarray(self.t[k][rows], dtype=float), nan=np.inf)
-                                            for k in reversed(keys)]
+        good = [i for i, s in enumerate(self.status_labels) if s in meaning.get("good_statuses", [])]
+        rows = rows[np.isin(self.status_codes[rows], good)]
+        cols = [rows] + [np.nan_to_num(np.asarray(self.values(k, rows), dtype=float), nan=np.inf)
+                         for k in reversed(keys)]
         return rows[np.lexsort(cols)], keys
 
 
@@ -68,15 +125,18 @@ def status_section(view):
     statuses = []
     for kind in view.res.run_kinds():
         statuses += [s for s in view.res.kind_meaning(kind).get("statuses", []) if s not in statuses]
-    present = set(view.t["status"][view.done].tolist())
+    present = {view.status_labels[c] for c in np.unique(view.status_codes[view.done])}
     extra = sorted(s for s in present if s not in statuses and s)
     shown = [s for s in statuses if s in present] + extra
     columns = [("block", ""), ("kind", ""), ("runs", ""), ("done", "")] + [(s, "") for s in shown] + [("not done", "")]
     rows = []
     for b in view.block_names:
         all_rows, done_rows = view.rows(b, done=False), view.rows(b)
-        st = view.t["status"][done_rows]
-        rows.append([b, view.kind(b), len(all_rows), len(done_rows)] + [int(np.sum(st == s)) for s in shown]
+        count = np.bincount(view.status_codes[done_rows], minlength=len(view.status_labels))
+        by_name = {}
+        for code, k in enumerate(count):
+            by_name[view.status_labels[code]] = by_name.get(view.status_labels[code], 0) + int(k)
+        rows.append([b, view.kind(b), len(all_rows), len(done_rows)] + [by_name.get(s, 0) for s in shown]
                     + [len(all_rows) - len(done_rows)])
     good = " and ".join(f"{'/'.join(view.res.kind_meaning(k).get('good_statuses', []))} ({k})"
                         for k in view.res.run_kinds())
@@ -87,26 +147,27 @@ def status_section(view):
 
 def varying_parameters(view, block, rows):
     """The block's parameters (of its kind) that take more than one value over its done rows, and the
-    fixed ones with their value."""
+    fixed ones. (Floats compare rounded to 12 decimals; NaN is no value.)"""
     kind = view.kind(block)
     varying, fixed = [], []
     for c in view.res.parameters(kind or None):
-        v = view.t[c][rows]
+        v = view.values(c, rows)
         if v.dtype.kind == "f":
-            n = np.unique(np.round(v[np.isfinite(v)], 12)).size
+            f = np.round(v[np.isfinite(v)], 12)
+            varies = f.size > 1 and f.min() != f.max()
         else:
-            n = len(set(v.tolist()))
-        (varying if n > 1 else fixed).append(c)
+            varies = len(v) > 1 and not np.all(v == v[0])
+        (varying if varies else fixed).append(c)
     return varying, fixed
 
 
 def shown_metrics(view, block, rows):
+    """The metrics of the block's kind that hold a value in one of `rows` at least."""
     kind = view.kind(block)
     out = []
     for c in view.res.metrics(kind or None):
-        v = view.t[c][rows]
-        held = np.isfinite(v) if v.dtype.kind == "f" else (v != -1) if v.dtype.kind in "iu" else \
-            np.array([len(str(x)) > 0 for x in v], dtype=bool)
+        v = view.values(c, rows)
+        held = np.isfinite(v) if v.dtype.kind == "f" else (v != -1) if v.dtype.kind in "iu" else (v != "")
         if held.any():
             out.append(c)
     return out
@@ -124,13 +185,16 @@ def best_section(view, n_best):
         top = ranked[:n_best]
         varying, fixed = varying_parameters(view, b, rows_done)
         metrics = shown_metrics(view, b, rows_done)
-        t = view.t
-        columns = [("rank", ""), ("run_id", ""), ("status", "")] + [(c, t.units[c]) for c in varying] + \
-                  [(c, t.units[c]) for c in metrics]
-        rows = [[i + 1, int(t["run_id"][r]), t["status"][r]] + [t[c][r] for c in varying] + [t[c][r] for c in metrics]
+        columns = [("rank", ""), ("run_id", ""), ("status", "")] + [(c, view.units[c]) for c in varying] + \
+                  [(c, view.units[c]) for c in metrics]
+        cells = {c: view.values(c, top) for c in varying + metrics}
+        status = view.status(top)
+        rows = [[i + 1, int(r), status[i]] + [cells[c][i] for c in varying] + [cells[c][i] for c in metrics]
                 for i, r in enumerate(top)]
-        fixed_text = ", ".join(f"{c} = {fmt(t[c][rows_done[0]])}{(' ' + t.units[c]) if t.units[c] else ''}"
-                               for c in fixed if fmt(t[c][rows_done[0]]) not in ("", "–"))
+        first = rows_done[0]
+        fixed_values = [(c, fmt(view.value(c, first))) for c in fixed]
+        fixed_text = ", ".join(f"{c} = {v}{(' ' + view.units[c]) if view.units[c] else ''}"
+                               for c, v in fixed_values if v not in ("", "–"))
         order = " then ".join(keys) if keys else "run id"
         cap = (f"The {len(top)} best of the block's {len(ranked)} {good} runs ({len(rows_done)} done), "
                f"smallest {order} first. " if len(top) else f"No {good} run among the block's {len(rows_done)} "
@@ -139,6 +203,6 @@ def best_section(view, n_best):
             cap += f"Fixed in this block: {esc(fixed_text)}."
         parts.append(f'<h3>Block {esc(b)} ({esc(kind)})</h3>'
                      + (table(columns, rows, f"best-{b}", text_columns=("status",) + tuple(
-                         c for c in varying if t[c].dtype.kind == "O")) if len(top) else "")
+                         c for c in varying if view.is_text(c))) if len(top) else "")
                      + f'<p class="caption">{cap}</p>')
     return "".join(parts)

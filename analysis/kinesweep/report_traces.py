@@ -25,16 +25,15 @@ def best_with_history(view, block, ids):
     """The block's best good run (report_tables ranking) that has a history, or None."""
     ranked, _ = view.ranked(block)
     for r in ranked:
-        rid = int(view.t["run_id"][r])
-        if (rid in ids) if ids is not None else view.res.has_history(rid):
+        if (int(r) in ids) if ids is not None else view.res.has_history(int(r)):
             return r
     return None
 
 
 def history_figure(view, row):
     """Returns (figure dict, caption html) for one run's history."""
-    res, t = view.res, view.t
-    rid = int(t["run_id"][row])
+    res = view.res
+    rid = int(row)  # a row's run id is its index
     h = res.history(rid, degrees=True)
     capped = ""
     if "t" in h and "tau" in h:
@@ -67,12 +66,15 @@ def history_figure(view, row):
               "xaxis": {"title": {"text": xname}}, "yaxis": {"title": {"text": yname},
                                                              **({"type": "log"} if log else {})},
               "legend": {"orientation": "h", "y": 1.08, "x": 0}}
-    varying, _ = varying_parameters(view, t["block"][row], view.rows(t["block"][row]))
-    shown = ", ".join(f"{c} = {fmt(t[c][row], 5)}{(' ' + t.units[c]) if t.units[c] else ''}" for c in varying)
-    metric = view.res.kind_meaning(view.kinds[row]).get("ranking", ["E"])[0]
-    caption = (f"{what} of run {rid} (status {esc(t['status'][row])}; {esc(shown)}), the block's best "
-               f"{esc(t['status'][row])} run with a history: {metric} = {fmt(t[metric][row], 6)}"
-               f"{(' ' + t.units[metric]) if t.units.get(metric) else ''}." + capped)
+    block = view.block_labels[view.block_codes[row]]
+    varying, _ = varying_parameters(view, block, view.rows(block))
+    shown = ", ".join(f"{c} = {fmt(view.value(c, row), 5)}{(' ' + view.units[c]) if view.units[c] else ''}"
+                      for c in varying)
+    metric = view.res.kind_meaning(view.row_kind(row)).get("ranking", ["E"])[0]
+    status = view.status([row])[0]
+    caption = (f"{what} of run {rid} (status {esc(status)}; {esc(shown)}), the block's best "
+               f"{esc(status)} run with a history: {metric} = {fmt(view.value(metric, row), 6)}"
+               f"{(' ' + view.units[metric]) if view.units.get(metric) else ''}." + capped)
     return {"data": data, "layout": layout}, caption
 
 
