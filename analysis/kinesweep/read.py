@@ -35,6 +35,7 @@ import numpy as np
 from kinesweep import frame
 from kinesweep import history as kshistory
 from kinesweep import live as kslive
+from kinesweep import where as kswhere
 from kinesweep.solutions import cluster_solutions  # noqa: F401 (part of this module's interface)
 from kinesweep.kinds import FormatVersionError  # noqa: F401 (the same)
 from kinesweep.kinds import (GOOD_STATUSES, IK_STATUSES, KIND_MEANING, METRIC_LABELS, OTHER_SOLUTION_COLOUR,  # noqa: F401
@@ -185,6 +186,28 @@ class _Grids(Mapping):
         return len(self._names)
 
 
+class _LazyColumns(Mapping):
+    """The /runs columns by name, each read when asked (text as str objects, numbers as stored, each
+    column's unit in .units): what kinesweep.where.select reads a filter's columns from."""
+
+    def __init__(self, g, names):
+        self._g, self._names = g, list(names)
+        self.units = {c: _s(g[c].attrs.get("unit", "")) for c in self._names}
+
+    def __getitem__(self, name):
+        if name not in self._names:
+            raise KeyError(name)
+        d = self._g[name]
+        v = d[()]
+        return text_values(d, v) if enum_labels(d) is not None or v.dtype.kind in "OSU" else v
+
+    def __iter__(self):
+        return iter(self._names)
+
+    def __len__(self):
+        return len(self._names)
+
+
 class Results:
     """An open results file (read-only). Safe on a file a sweep is writing: every call reads one
     committed state, the newest when it starts (kslive: retried from a fresh open when a commit lands
@@ -300,20 +323,24 @@ class Results:
         return self._by_role("bookkeeping", None)
 
     @kslive.consistent
-    def row_kinds(self, done_only=True):
+    def row_kinds(self, done_only=True, rows=None):
         """Each row's run kind, an object array aligned with runs(done_only=...): the kind of the
         single-kind parameter (else metric) columns that hold a value in the row; "" when none does
-        (a row not done yet). A file of one kind: that kind for every row."""
+        (a row not done yet). A file of one kind: that kind for every row. With `rows` (ascending
+        row indices): the kinds of those rows only, done or not, read by index."""
         g = self.f["runs"]
-        done = g["done"][()].astype(bool)
+        if rows is not None:
+            rows = np.asarray(rows, dtype=np.int64)
+            done_only = False
+        done = g["done"][()].astype(bool) if rows is None else np.ones(len(rows), dtype=bool)
         kinds = self.run_kinds()
         out = np.full(len(done), kinds[0] if len(kinds) == 1 else "", dtype=object)
-        if len(kinds) > 1:
+        if len(kinds) > 1 and len(done):
             for role in ("parameter", "metric"):
                 for c in self._by_role(role, None):
                     if len(self._kinds[c]) != 1:
                         continue
-                    v = g[c][()]
+                    v = g[c][()] if rows is None else g[c][rows]
                     labels = enum_labels(g[c])
                     if labels is not None:
                         held = v < len(labels)
@@ -331,14 +358,15 @@ class Results:
         return self.row_kinds(done_only=False)[int(run_id)]
 
     @kslive.consistent
-    def runs(self, columns=None, done_only=True, degrees=False, pandas=False):
+    def runs(self, columns=None, done_only=True, degrees=False, pandas=False, where=None):
         """The /runs table: Table (dict of arrays; strings as str objects) or a pandas DataFrame
-        (to_pandas())."""
+        (to_pandas()); `where` selects rows as in to_pandas()."""
         if pandas:
-            return self.to_pandas(columns, done_only=done_only, degrees=degrees)
+            return self.to_pandas(columns, done_only=done_only, degrees=degrees, where=where)
         g = self.f["runs"]
         done = g["done"][()].astype(bool)  # before the columns (a writer may be committing)
         names = self.columns() if columns is None else list(columns)
+        rows = self._where_rows(where, done, done_only)
         t = Table()
         for c in names:
             if c not in g:
@@ -351,31 +379,49 @@ class Results:
             unit = _s(d.attrs.get("unit", ""))
             if degrees and unit == "rad":
                 v, unit = v * RAD2DEG, "deg"
-            t[c] = v[done] if done_only else v
+            t[c] = v if rows is None else v[rows]
             t.units[c] = unit
             t.descriptions[c] = _s(d.attrs.get("description", ""))
             t.roles[c] = self._roles[c]
             t.kinds[c] = list(self._kinds[c])
         if not done_only:
-            t["done"] = done
+            t["done"] = done if rows is None else done[rows]
             t.units["done"] = ""
             t.roles["done"], t.kinds["done"] = "bookkeeping", []
-        return t.to_pandas() if pandas else t
+        return t
+
+    def _where_rows(self, where, done, done_only):
+        """The rows to read: done ones (done_only) where every expression of `where` holds (None or a
+        str or list of str, `kinesweep query --where` syntax, angles in degrees); None for all rows.
+        Only the columns the expressions name are read."""
+        rows = done if done_only else None
+        if where:
+            exprs = [where] if isinstance(where, str) else list(where)
+            g = self.f["runs"]
+            text = [c for c in self.columns() if enum_labels(g[c]) is not None or g[c].dtype.kind in "OSU"]
+            mask = kswhere.select(_LazyColumns(g, self.columns()), exprs, degrees=True, text_columns=text,
+                                  rows=len(done))
+            rows = mask if rows is None else rows & mask
+        return rows
 
     @kslive.consistent
-    def to_pandas(self, columns=None, done_only=True, degrees=False):
+    def to_pandas(self, columns=None, done_only=True, degrees=False, where=None):
         """The /runs table (or its `columns`) as a pandas.DataFrame: numbers read straight into the
         frame, labelled text as categoricals (kinesweep.frame); df.attrs["units"], ["descriptions"],
-        ["roles"], ["kinds"]. With done_only=False a bool column `done` is added."""
+        ["roles"], ["kinds"]. With done_only=False a bool column `done` is added. `where`: a row
+        filter, one expression or a list, in `kinesweep query --where` syntax (angles in degrees):
+        the columns it names are read first, then only the selected rows of the others are kept
+        (memory: the frame plus one column). Raises kinesweep.where.WhereError for a bad one."""
         g = self.f["runs"]
         done = g["done"][()].astype(bool)  # before the columns (a writer may be committing)
         names = self.columns() if columns is None else list(columns)
         for c in names:
             if c not in g:
                 raise KeyError(f"no column {c!r}; columns: {', '.join(self.columns())}")
-        df = frame.runs_frame(g, names, done if done_only else None, self._roles, self._kinds, degrees)
+        rows = self._where_rows(where, done, done_only)
+        df = frame.runs_frame(g, names, rows, self._roles, self._kinds, degrees)
         if not done_only:
-            df["done"] = done
+            df["done"] = done if rows is None else done[rows]
             df.attrs["units"]["done"] = ""
         return df
 

@@ -192,12 +192,14 @@ def parse(expr, columns, text_columns):
             for a in alts]
 
 
-def select(table, exprs, degrees=True):
+def select(table, exprs, degrees=True, text_columns=None, rows=None):
     """Boolean mask over the rows of `table` (dict of column -> 1-D array; its .units, when present,
-    tells angles: unit "rad") where every expression in `exprs` holds. Raises WhereError."""
+    tells angles: unit "rad") where every expression in `exprs` holds. Raises WhereError.
+    `text_columns` and `rows` (the row count) spare reading every column of a table that reads its
+    columns when asked (only those the expressions name are then read)."""
     columns = list(table.keys())
-    n = len(next(iter(table.values()))) if columns else 0
-    text = {c for c in columns if _is_text(table[c])}
+    n = rows if rows is not None else len(next(iter(table.values()))) if columns else 0
+    text = set(text_columns) if text_columns is not None else {c for c in columns if _is_text(table[c])}
     mask = np.ones(n, dtype=bool)
     cache = {}
     for expr in exprs or []:

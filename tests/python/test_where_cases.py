@@ -1,6 +1,7 @@
 """The --where language's shared cases (tests/query/where_cases.json), run by both implementations
-on one results file: `kinesweep query --where ... --format json` and analysis/kswhere.select. Each
-must select the rows the case's numpy oracle selects, or refuse with the case's message and
+on one results file: `kinesweep query --where ... --format json` and analysis/kswhere.select (also
+through the reader's row filter, to_pandas(where=) and runs(where=)). Each must select the rows the
+case's numpy oracle selects, or refuse with the case's message and
 suggestion.
 
 usage: /usr/bin/python3 test_where_cases.py KINESWEEP_BINARY SOURCE_DIR
@@ -46,6 +47,7 @@ class WhereCases(unittest.TestCase):
         return subprocess.run(args, capture_output=True, text=True, timeout=120)
 
     def test_every_case_in_both_implementations(self):
+        import ksread
         import kswhere
         c = {k: (np.asarray(v, dtype=object) if np.asarray(v).dtype.kind in "OUS" else np.asarray(v))
              for k, v in self.table.items()}
@@ -64,12 +66,20 @@ class WhereCases(unittest.TestCase):
                     self.assertEqual(got_cli, want, "kinesweep query")
                     got_py = sorted(int(i) for i in ids[kswhere.select(self.table, where)])
                     self.assertEqual(got_py, want, "kswhere")
+                    with ksread.open_results(self.out) as res:  # the reader's row filter
+                        df = res.to_pandas(where=where)
+                        t = res.runs(columns=["run_id", "E"], where=where)
+                    self.assertEqual(sorted(df["run_id"].tolist()), want, "to_pandas(where=)")
+                    self.assertEqual(sorted(t["run_id"].tolist()), want, "runs(where=)")
                 else:
                     self.assertEqual(r.returncode, 2, r.stdout)
                     self.assertIn(case["error"], r.stderr)
                     with self.assertRaises(kswhere.WhereError) as e:
                         kswhere.select(self.table, where)
                     self.assertIn(case["error"], str(e.exception))
+                    with ksread.open_results(self.out) as res, self.assertRaises(kswhere.WhereError) as e2:
+                        res.to_pandas(where=where)
+                    self.assertIn(case["error"], str(e2.exception))
                     if "suggest" in case:
                         self.assertIn(f"did you mean '{case['suggest']}'", r.stderr)
                         self.assertIn(f"did you mean '{case['suggest']}'", str(e.exception))
