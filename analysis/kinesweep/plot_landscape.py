@@ -187,11 +187,15 @@ def reduce_grid(ls, args):
         reduce = "mean" if multi else None
     else:
         vals = np.where(status == good, arrange(ls.metrics[metric]), np.nan)
-        import warnings
-        with np.errstate(all="ignore"), warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            z = np.nanmean(vals, axis=3) if args.reduce == "mean" else np.nanmin(vals, axis=3)
-        cat = failed_category(status, np.all(np.isnan(vals), axis=3), good)
+        if vals.shape[3] == 1:  # nothing to reduce: the grid itself (no copy)
+            z = vals[..., 0]
+        else:
+            import warnings
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)
+                z = np.nanmean(vals, axis=3) if args.reduce == "mean" else np.nanmin(vals, axis=3)
+        cat = failed_category(status, np.isnan(z) if vals.shape[3] == 1 else np.all(np.isnan(vals), axis=3), good)
+        del vals
         reduce = args.reduce if [n for n in rest if len(ls.axis(n).values) > 1] else None
         if reduce:
             notes.append(f"{reduce} over {', '.join(n for n in rest if len(ls.axis(n).values) > 1)}")
@@ -283,13 +287,13 @@ def main(argv=None):
     X, Y = np.meshgrid(ksplot.cell_edges(dx, xlog), ksplot.cell_edges(dy, ylog))
     if step > 1:
         d["notes"].append(f"every {ordinal(step)} cell of {len(yv)} × {len(xv)} drawn")
-    finite = Z[np.isfinite(Z)]  # one colour scale for every panel
-    vmin = args.vmin if args.vmin is not None else (finite.min() if finite.size else 0.0)
-    vmax = args.vmax if args.vmax is not None else (finite.max() if finite.size else 1.0)
+    any_finite = bool(np.isfinite(Z).any())  # one colour scale for every panel
+    vmin = args.vmin if args.vmin is not None else (np.nanmin(Z) if any_finite else 0.0)
+    vmax = args.vmax if args.vmax is not None else (np.nanmax(Z) if any_finite else 1.0)
     if metric == "convergence":
         vmin, vmax = (0.0 if args.vmin is None else vmin), (1.0 if args.vmax is None else vmax)
     if args.log:
-        pos = finite[finite > 0]
+        pos = Z[np.isfinite(Z) & (Z > 0)]
         vmin = max(vmin, pos.min() if pos.size else 1e-12)
         norm = LogNorm(vmin=vmin, vmax=max(vmax, vmin * 1.0001))
     else:
@@ -297,7 +301,7 @@ def main(argv=None):
     cmap = plt.get_cmap("viridis").copy()
     cmap.set_bad((0, 0, 0, 0))
     levels = []
-    if args.levels > 0 and finite.size and len(xv) > 2 and len(yv) > 2 and metric != "convergence":
+    if args.levels > 0 and any_finite and len(xv) > 2 and len(yv) > 2 and metric != "convergence":
         levels = ksplot.round_levels(norm.vmin, norm.vmax, args.levels, log=args.log,
                                      integer=is_integer_metric(res, metric))
     statuses = ls.statuses
@@ -306,7 +310,7 @@ def main(argv=None):
         opt = optimization_overlay(res, args.optimization, xa, ya)
     for p in range(n):
         ax, z, cat = axs.flat[p], Z[p], CAT[p]
-        pfinite = z[np.isfinite(z)]
+        has_values = bool(np.isfinite(z).any())
         mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(z[::step, ::step]), cmap=cmap, norm=norm, shading="flat")
         # Failed cells in their own colours.
         handles = []
@@ -322,14 +326,14 @@ def main(argv=None):
             c = np.where(cat[::step, ::step] == -2, len(statuses), cat[::step, ::step]).astype(float)
             ax.pcolormesh(X, Y, np.ma.masked_less(c, 0), cmap=ListedColormap(colours),
                           vmin=-0.5, vmax=len(statuses) + 0.5, shading="flat")
-        if len(levels) and pfinite.size:
+        if len(levels) and has_values:
             cs = ax.contour(dx, dy, np.ma.masked_invalid(z[::step, ::step]), levels=levels, colors="white", linewidths=0.7, alpha=0.8)
             ax.clabel(cs, fmt=lambda v: f"{v:g}", fontsize=7, inline=True)
         # Minimum (the mean for the convergence fraction).
         best = None
-        if metric == "convergence" and pfinite.size:
+        if metric == "convergence" and has_values:
             ax.plot([], [], ls="none", label=f"mean convergence fraction {np.nanmean(z):.0%}")
-        elif pfinite.size:
+        elif has_values:
             i, j = np.unravel_index(np.nanargmin(z), z.shape)
             best = {"value": z[i, j], "x": xa.values[j], "y": ya.values[i], "i": int(i), "j": int(j)}
             xs = xa.labels[j] if xa.categorical else f"{ksplot.fmt_num(xa.values[j])}{'°' if xa.unit == 'deg' else ''}"

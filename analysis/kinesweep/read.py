@@ -531,14 +531,20 @@ class Results:
         return Landscape(block, axes, metrics, units, desc, kind, self.kind_meaning(kind))
 
     def _block_kind(self, block):
-        """The run kind of a block's (done) rows, "" when it has none."""
+        """The run kind of a block's (done) rows, "" when it has none: its first done row's (a block's
+        runs are of one kind), that row read by index."""
         if "block" not in self._roles:
             return self.run_kinds()[0] if len(self.run_kinds()) == 1 else ""
-        blocks = text_values(self.f["runs"]["block"])
-        done = self.f["runs"]["done"][()].astype(bool)
-        kinds = self.row_kinds(done_only=False)[(blocks == block) & done]
-        kinds = [k for k in kinds if k]
-        return kinds[0] if kinds else ""
+        d = self.f["runs"]["block"]
+        labels = enum_labels(d)
+        if labels is not None:
+            if block not in labels:
+                return ""
+            mine = d[()] == labels.index(block)
+        else:
+            mine = text_values(d) == block
+        rows = np.flatnonzero(mine & self.f["runs"]["done"][()].astype(bool))
+        return self.row_kinds(rows=rows[:1])[0] if len(rows) else ""
 
 
     @kslive.consistent

@@ -26,7 +26,7 @@ from kinesweep.report_page import esc, figure, page  # noqa: E402
 from kinesweep.report_tables import RunsView, best_section, metadata_section, status_section  # noqa: E402
 from kinesweep.report_traces import best_with_history, history_figure, history_ids, optimization_figure  # noqa: E402
 
-CELL_BUDGET = 60000   # heatmap cells over all landscape and basin figures (about 110 bytes each)
+CELL_BUDGET = 40000   # heatmap cells over all landscape and basin figures (about 40 bytes each, compressed)
 MAX_HISTORY_FIGURES = 12
 
 
