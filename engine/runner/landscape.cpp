@@ -40,14 +40,30 @@ void LandscapeGrid::add(std::uint64_t local, const Record& row, const StudySchem
   double code = kNaN;
   for (std::size_t s = 0; s < names.size(); ++s)
     if (names[s] == status) code = static_cast<double>(s);
+  values_.clear();
+  for (std::size_t column : columns(schema, b)) values_.push_back(cell_number(row.cells[column]));
+  add_cell(local, code, values_.data(), schema, b, writer);
+}
+
+std::vector<std::size_t> LandscapeGrid::columns(const StudySchema& schema, std::size_t b) const {
+  std::vector<std::size_t> out;
+  for (std::size_t m = 0; m < names_.size(); ++m)
+    if (sources_[m] == Source::column) out.push_back(schema.metric_column[b][metric_index_[m]]);
+  return out;
+}
+
+void LandscapeGrid::add_cell(std::uint64_t local, double code, const double* values, const StudySchema& schema,
+                             std::size_t b, store::ResultsWriter& writer) {
+  if (!enabled_) return;
+  std::size_t j = 0;  // index into values (the Source::column metrics, in order)
   for (std::size_t m = 0; m < names_.size(); ++m) {
     double v = kNaN;
     switch (sources_[m]) {
       case Source::is_ok: v = code == 0.0 ? 1.0 : 0.0; break;  // ok / converged are code 0
       case Source::status_code: v = code; break;
       case Source::column:
-        v = cell_number(row.cells[schema.metric_column[b][metric_index_[m]]]);
-        if (std::holds_alternative<std::int64_t>(row.cells[schema.metric_column[b][metric_index_[m]]]) && v == -1.0)
+        v = values[j++];
+        if (schema.columns[schema.metric_column[b][metric_index_[m]]].type == CellType::i64 && v == -1.0)
           v = kNaN;  // the missing integer (solution -1: none reached)
         break;
     }

@@ -24,6 +24,12 @@ class LandscapeGrid {
   /// Write the cell of run `local` of this block (block index `b` in the schema) from its row.
   void add(std::uint64_t local, const Record& row, const StudySchema& schema, std::size_t b,
            store::ResultsWriter& writer);
+  /// The same from the run's status index `code` (in statuses(kind); NaN for none) and `values`,
+  /// the run's values of columns(schema, b) in that order: runs counted without their Records.
+  void add_cell(std::uint64_t local, double code, const double* values, const StudySchema& schema, std::size_t b,
+                store::ResultsWriter& writer);
+  /// The schema columns the grid's metrics take their values from, in order.
+  std::vector<std::size_t> columns(const StudySchema& schema, std::size_t b) const;
   /// Which value a grid takes from a row: a metric column, or a status-derived value.
   enum class Source { column, is_ok, status_code };
   /// The axes (one per dimension; a zipped dimension is named "a+b" and takes the first axis'
@@ -39,6 +45,7 @@ class LandscapeGrid {
   std::vector<Source> sources_;               // per metric
   std::vector<std::size_t> metric_index_;     // per metric: index into metrics(kind) (Source::column)
   std::vector<double> cell_;                  // one cell's values, per metric
+  std::vector<double> values_;                // add(): a row's values of columns()
 };
 
 }  // namespace ks

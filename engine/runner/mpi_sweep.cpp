@@ -92,34 +92,34 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
   if (missing)
     throw store::StoreError(out, std::to_string(missing) + " runs are in neither the results file nor a shard");
 
-  // Copy the shards' runs in run-id order (the single-process write order). Histories are copied
-  // chunk by chunk, as the shards store them (the writer decodes and re-cuts them only when a
-  // shard's chunk size differs from the results file's).
+  // The runs, column by column (histories as the shards store them; /runs chunks a shard holds
+  // whole copied as stored). A results file of format 3 (a resumed one) takes them run by run.
   const int level = run.options.compression;
-  std::vector<std::uint64_t> ids;
-  for (std::uint64_t id = 0; id < total; ++id)
-    if (owner[id] >= 0) ids.push_back(id);
-  // Pieces of up to 4096 runs: each shard's rows of a piece in one range read per column (its runs
-  // in the piece, and any between them it does not own), then each run's history chunks.
-  constexpr std::size_t kPiece = 4096;
-  for (std::size_t at = 0; at < ids.size(); at += kPiece) {
-    const std::size_t n = std::min(kPiece, ids.size() - at);
-    std::vector<Record> rows(n);
-    for (std::size_t s = 0; s < readers.size(); ++s) {
-      std::size_t first = n, last = 0;
-      for (std::size_t i = 0; i < n; ++i)
-        if (owner[ids[at + i]] == static_cast<std::int32_t>(s)) first = std::min(first, i), last = i;
-      if (first == n) continue;
-      const auto from = static_cast<std::int64_t>(ids[at + first]);
-      std::vector<Record> got = readers[s]->read_rows(from, static_cast<std::int64_t>(ids[at + last]) - from + 1);
-      for (std::size_t i = first; i <= last; ++i)
-        if (owner[ids[at + i]] == static_cast<std::int32_t>(s))
-          rows[i] = std::move(got[static_cast<std::size_t>(static_cast<std::int64_t>(ids[at + i]) - from)]);
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint64_t id = ids[at + i];
-      const store::EncodedHistory enc = readers[owner[id]]->read_history_chunks(static_cast<std::int64_t>(id), level);
-      writer->write_run(static_cast<std::int64_t>(id), rows[i], enc);
+  std::vector<const store::ResultsReader*> sources;
+  for (const auto& r : readers) sources.push_back(r.get());
+  if (!writer->copy_runs(sources, owner, level)) {
+    constexpr std::size_t kPiece = 4096;  // each shard's rows of a piece in one range read per column
+    std::vector<std::uint64_t> ids;
+    for (std::uint64_t id = 0; id < total; ++id)
+      if (owner[id] >= 0) ids.push_back(id);
+    for (std::size_t at = 0; at < ids.size(); at += kPiece) {
+      const std::size_t n = std::min(kPiece, ids.size() - at);
+      std::vector<Record> rows(n);
+      for (std::size_t s = 0; s < readers.size(); ++s) {
+        std::size_t first = n, last = 0;
+        for (std::size_t i = 0; i < n; ++i)
+          if (owner[ids[at + i]] == static_cast<std::int32_t>(s)) first = std::min(first, i), last = i;
+        if (first == n) continue;
+        const auto from = static_cast<std::int64_t>(ids[at + first]);
+        std::vector<Record> got = readers[s]->read_rows(from, static_cast<std::int64_t>(ids[at + last]) - from + 1);
+        for (std::size_t i = first; i <= last; ++i)
+          if (owner[ids[at + i]] == static_cast<std::int32_t>(s))
+            rows[i] = std::move(got[static_cast<std::size_t>(static_cast<std::int64_t>(ids[at + i]) - from)]);
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::uint64_t id = ids[at + i];
+        writer->write_run(static_cast<std::int64_t>(id), rows[i], readers[owner[id]]->read_history_chunks(static_cast<std::int64_t>(id), level));
+      }
     }
   }
   writer->flush();
@@ -305,7 +305,7 @@ SweepResult MpiBackend::sweep(const Study& study, const StudySchema& schema, con
   std::vector<std::atomic<std::uint64_t>> remote_done(size_);
   std::thread coordinator;
   if (rank_ == 0) {
-    pool = std::make_unique<WorkPool>(std::move(done_), size_);
+    pool = std::make_unique<WorkPool>(std::move(done_), size_, store::kRunsChunkRows);
     o.source = [&](std::vector<std::uint64_t>& ids, std::size_t max) {
       ids = pool->take(max);
       return !ids.empty();

@@ -44,6 +44,46 @@ void bcast_string(std::string& s, MPI_Comm comm) {
   s.assign(bytes.begin(), bytes.end());
 }
 
+WorkPool::WorkPool(std::vector<bool> done, int ranks, std::uint64_t region)
+    : done_(std::move(done)), ranges_(static_cast<std::size_t>(std::max(1, ranks))),
+      region_(std::max<std::uint64_t>(1, region)), ranks_(std::max(1, ranks)) {
+  for (bool d : done_) remaining_ += d ? 0 : 1;
+}
+
+bool WorkPool::refill_locked(int rank) {
+  Range& mine = ranges_[static_cast<std::size_t>(rank)];
+  const std::uint64_t total = done_.size();
+  if (next_region_ < total) {
+    mine = {next_region_, std::min(total, next_region_ + region_)};
+    next_region_ = mine.end;
+    return true;
+  }
+  // No region left: the upper half of the largest range another rank has not drawn yet.
+  Range* victim = nullptr;
+  for (Range& r : ranges_)
+    if (&r != &mine && r.end > r.next && (!victim || r.end - r.next > victim->end - victim->next)) victim = &r;
+  if (!victim) return false;
+  const std::uint64_t mid = victim->next + (victim->end - victim->next) / 2;
+  mine = {mid, victim->end};
+  victim->end = mid;
+  return true;
+}
+
+std::vector<std::uint64_t> WorkPool::slice_locked(int rank, std::size_t n) {
+  std::vector<std::uint64_t> ids;
+  if (halted_) return ids;
+  n = static_cast<std::size_t>(std::min<std::uint64_t>(n, remaining_));
+  ids.reserve(n);
+  Range& mine = ranges_[static_cast<std::size_t>(rank)];
+  while (ids.size() < n) {
+    if (mine.next == mine.end && !refill_locked(rank)) break;
+    for (; mine.next < mine.end && ids.size() < n; ++mine.next)
+      if (!done_[mine.next]) ids.push_back(mine.next);
+  }
+  remaining_ -= ids.size();
+  return ids;
+}
+
 /// Rank 0's coordinator thread: answers chunk requests until every other rank has retired (got an
 /// empty chunk or said it quits). Request: {quit, runs written so far, threads}.
 void coordinate(MPI_Comm comm, int size, std::size_t batch, WorkPool& pool, std::vector<std::atomic<std::uint64_t>>& remote_done,
@@ -63,7 +103,7 @@ void coordinate(MPI_Comm comm, int size, std::size_t batch, WorkPool& pool, std:
       continue;
     }
     std::vector<std::uint64_t> ids;
-    if (!(stop && stop->load())) ids = pool.take_chunk(req[2], batch);
+    if (!(stop && stop->load())) ids = pool.take_chunk(src, req[2], batch);
     MPI_Send(ids.data(), static_cast<int>(ids.size()), MPI_UINT64_T, src, kTagReply, comm);
     if (ids.empty()) retired[src] = 1, --active;
   }

@@ -29,26 +29,28 @@ void bcast_bits(std::vector<bool>& v, MPI_Comm comm);
 /// MPI_Bcast from rank 0 of a string (its size included).
 void bcast_string(std::string& s, MPI_Comm comm);
 
-/// The run ids not done yet, handed out in ascending order (rank 0). Holds one bit per run.
+/// The run ids not done yet (rank 0), handed out by regions: each rank draws consecutive ids from a
+/// region of `region` ids of its own (the /runs chunk of the results file, so that most chunks of a
+/// shard are whole and the merge copies them without decoding); a rank whose region is spent gets
+/// the next unassigned one, and once none is left it takes the upper half of the largest remaining
+/// range of another rank (the tail stays balanced). Holds one bit per run.
 class WorkPool {
  public:
-  WorkPool(std::vector<bool> done, int ranks) : done_(std::move(done)), ranks_(ranks) {
-    for (bool d : done_) remaining_ += d ? 0 : 1;
-  }
+  WorkPool(std::vector<bool> done, int ranks, std::uint64_t region);
   /// The number of ids not handed out yet.
   std::uint64_t remaining() const { return remaining_; }
   /// Up to `max` ids for rank 0's own pipeline.
   std::vector<std::uint64_t> take(std::size_t max) {
     std::lock_guard<std::mutex> lock(m_);
-    return slice_locked(max);
+    return slice_locked(0, max);
   }
-  /// A chunk for a remote rank with `threads` threads: guided (remaining / 4 ranks), at least two
-  /// rounds of its pipeline, at most kMaxChunk.
-  std::vector<std::uint64_t> take_chunk(std::uint64_t threads, std::size_t batch) {
+  /// A chunk for remote rank `rank` with `threads` threads: guided (remaining / 4 ranks), at least
+  /// two rounds of its pipeline, at most kMaxChunk.
+  std::vector<std::uint64_t> take_chunk(int rank, std::uint64_t threads, std::size_t batch) {
     std::lock_guard<std::mutex> lock(m_);
     const std::uint64_t lo = std::max<std::uint64_t>(1, 2 * threads * batch);
     const std::uint64_t n = std::min(kMaxChunk, std::max(lo, remaining_ / (4 * static_cast<std::uint64_t>(ranks_))));
-    return slice_locked(n);
+    return slice_locked(rank, n);
   }
   void halt() {
     std::lock_guard<std::mutex> lock(m_);
@@ -56,19 +58,15 @@ class WorkPool {
   }
 
  private:
-  std::vector<std::uint64_t> slice_locked(std::size_t n) {
-    std::vector<std::uint64_t> ids;
-    if (halted_) return ids;
-    n = static_cast<std::size_t>(std::min<std::uint64_t>(n, remaining_));
-    ids.reserve(n);
-    for (; ids.size() < n; ++next_)
-      if (!done_[next_]) ids.push_back(next_);
-    remaining_ -= n;
-    return ids;
-  }
+  struct Range {
+    std::uint64_t next = 0, end = 0;  ///< ids [next, end) not handed out yet
+  };
+  std::vector<std::uint64_t> slice_locked(int rank, std::size_t n);
+  bool refill_locked(int rank);  ///< a new range for `rank`; false when no id is left anywhere
   std::mutex m_;
   std::vector<bool> done_;
-  std::uint64_t next_ = 0, remaining_ = 0;
+  std::vector<Range> ranges_;  ///< per rank
+  std::uint64_t region_, next_region_ = 0, remaining_ = 0;
   int ranks_;
   bool halted_ = false;
 };

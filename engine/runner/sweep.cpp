@@ -23,6 +23,7 @@ namespace ks {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 struct Job {
   std::uint64_t id = 0;
@@ -75,6 +76,7 @@ class Accumulator {
       }
       columns_.push_back(c);
     }
+    candidates_.assign(study.blocks.size(), {});
   }
 
   void add(std::uint64_t id, const RunRef& ref, const Record& row) {
@@ -89,18 +91,96 @@ class Accumulator {
     if (good)
       consider_best(br, rank_key(cell_number(row.cells[c.value]), c.tie == Columns::npos ? 0.0 : cell_number(row.cells[c.tie]), id),
                     row, ref.block);
-    if (traj) {
-      const std::string& preset = as_str(row.cells[c.preset]);
-      if (c.seed_arm && !preset.empty() && seed_.size() < 1000 && find_seed_case(preset)) {
-        SeedRow s;
-        s.preset = preset;
-        s.inertia = c.inertia == Columns::npos ? "chain" : as_str(row.cells[c.inertia]);
-        s.status = status;
-        s.E = cell_number(row.cells[c.value]);
-        for (int j = 0; j < 3; ++j) s.tau[j] = cell_number(row.cells[c.tau[j]]);
-        seed_[id] = std::move(s);
+    if (traj && c.seed_arm && is_seed_preset(as_str(row.cells[c.preset]))) add_seed(id, row, ref.block);
+  }
+
+  /// Whether the columns a done run is counted by (status, and a seed arm's preset) are labelled in
+  /// the file, so that add_columns can read them as codes (format 4 files; the file's columns are
+  /// the schema's, in its order).
+  bool columnar() const {
+    const auto& file = writer_.columns();
+    if (file.size() != schema_.columns.size()) return false;
+    const auto labelled = [&](std::size_t col) { return !file[col].labels.empty(); };
+    if (!labelled(schema_.status)) return false;
+    for (std::size_t b = 0; b < columns_.size(); ++b)
+      if (study_.blocks[b].kind() == BlockKind::trajectory && columns_[b].seed_arm && !labelled(columns_[b].preset))
+        return false;
+    return true;
+  }
+
+  /// What add() does for the done runs among [first, first + n) (done[id]), from typed column reads
+  /// instead of Records: status counts and landscape cells at once; the best-run candidates' keys
+  /// and the seed runs' ids kept for finish_columns(), which reads those few rows whole.
+  void add_columns(std::uint64_t first, std::uint64_t n, const std::vector<bool>& done) {
+    const auto& labels = writer_.columns()[schema_.status].labels;
+    const std::vector<std::uint16_t> codes = writer_.read_codes(schema_.columns[schema_.status].name,
+                                                                static_cast<std::int64_t>(first), static_cast<std::int64_t>(n));
+    std::map<std::size_t, std::vector<double>> numbers;  // schema column -> this piece's values
+    const auto column = [&](std::size_t col) -> const std::vector<double>& {
+      auto it = numbers.find(col);
+      if (it == numbers.end())
+        it = numbers.emplace(col, writer_.read_numbers(schema_.columns[col].name, static_cast<std::int64_t>(first),
+                                                       static_cast<std::int64_t>(n))).first;
+      return it->second;
+    };
+    for (std::size_t b = 0; b < study_.blocks.size(); ++b) {
+      const Block& block = study_.blocks[b];
+      const std::uint64_t lo = std::max(first, study_.first_run(b)), hi = std::min(first + n, study_.first_run(b) + block.run_count());
+      if (lo >= hi) continue;
+      BlockReport& br = report_.blocks[b];
+      const Columns& c = columns_[b];
+      const auto names = statuses(block.kind());
+      std::vector<double> kind_code(labels.size() + 1, kNaN);  // label code -> index in statuses(kind)
+      for (std::size_t l = 0; l < labels.size(); ++l)
+        for (std::size_t s = 0; s < names.size(); ++s)
+          if (names[s] == labels[l]) kind_code[l] = static_cast<double>(s);
+      std::vector<std::uint64_t> count(labels.size() + 1, 0);
+      const std::vector<double>& value = column(c.value);
+      const std::vector<double>* tie = c.tie == Columns::npos ? nullptr : &column(c.tie);
+      std::vector<const double*> grid_columns;  // the grid's metric columns, in its order
+      if (grids_[b].enabled())
+        for (std::size_t col : grids_[b].columns(schema_, b)) grid_columns.push_back(column(col).data());
+      std::vector<double> values(grid_columns.size());
+      const bool seeds = block.kind() == BlockKind::trajectory && c.seed_arm;
+      const std::vector<std::uint16_t> presets =
+          seeds ? writer_.read_codes(schema_.columns[c.preset].name, static_cast<std::int64_t>(first), static_cast<std::int64_t>(n))
+                : std::vector<std::uint16_t>{};
+      auto& keys = candidates_[b];
+      for (std::uint64_t id = lo; id < hi; ++id) {
+        if (!done[id]) continue;
+        const std::size_t i = id - first;
+        const std::size_t code = std::min<std::size_t>(codes[i], labels.size());
+        ++count[code];
+        if (grids_[b].enabled()) {
+          for (std::size_t j = 0; j < grid_columns.size(); ++j) values[j] = grid_columns[j][i];
+          grids_[b].add_cell(id - study_.first_run(b), kind_code[code], values.data(), schema_, b, writer_);
+        }
+        if (kind_code[code] == 0.0) {  // the good status: a best-run candidate by the ranking rule
+          const RankKey k = rank_key(value[i], tie ? (*tie)[i] : 0.0, id);
+          if (std::isfinite(k.objective) && (keys.size() < 3 || k < keys.back())) {
+            keys.insert(std::upper_bound(keys.begin(), keys.end(), k), k);
+            if (keys.size() > 3) keys.pop_back();
+          }
+        }
+        if (seeds && presets[i] < writer_.columns()[c.preset].labels.size() &&
+            is_seed_preset(writer_.columns()[c.preset].labels[presets[i]]))
+          seed_ids_.push_back(id);
       }
+      for (std::size_t l = 0; l < count.size(); ++l)
+        if (count[l]) br.by_status[l < labels.size() ? labels[l] : std::string()] += count[l];
     }
+  }
+
+  /// The rows add_columns set aside, read whole: the best-run candidates (in rank order, so the
+  /// block's best rows are those add() would have kept) and the seed runs.
+  void finish_columns() {
+    for (std::size_t b = 0; b < candidates_.size(); ++b)
+      for (const RankKey& k : candidates_[b])
+        consider_best(report_.blocks[b], k, writer_.read_rows(static_cast<std::int64_t>(k.run), 1).front(), b);
+    candidates_.assign(candidates_.size(), {});
+    for (std::uint64_t id : seed_ids_)
+      if (seed_.size() < 1000) add_seed(id, writer_.read_rows(static_cast<std::int64_t>(id), 1).front(), study_.locate(id).block);
+    seed_ids_.clear();
   }
 
   SweepReport finish() {
@@ -111,6 +191,20 @@ class Accumulator {
   SweepReport& report() { return report_; }
 
  private:
+  bool is_seed_preset(const std::string& preset) const {
+    return !preset.empty() && seed_.size() + seed_ids_.size() < 1000 && find_seed_case(preset);
+  }
+  /// A run of a seed-arm block whose preset names a Table 4 row (the thesis comparison).
+  void add_seed(std::uint64_t id, const Record& row, std::size_t b) {
+    const Columns& c = columns_[b];
+    SeedRow s;
+    s.preset = as_str(row.cells[c.preset]);
+    s.inertia = c.inertia == Columns::npos ? "chain" : as_str(row.cells[c.inertia]);
+    s.status = as_str(row.cells[schema_.status]);
+    s.E = cell_number(row.cells[c.value]);
+    for (int j = 0; j < 3; ++j) s.tau[j] = cell_number(row.cells[c.tau[j]]);
+    seed_[id] = std::move(s);
+  }
   /// The run keyed `k` among the block's best three (ranking(kind): NaN objectives never are).
   void consider_best(BlockReport& br, const RankKey& k, const Record& row, std::size_t b) {
     if (!std::isfinite(k.objective)) return;
@@ -152,6 +246,8 @@ class Accumulator {
   };
   std::vector<Columns> columns_;
   std::map<std::size_t, std::vector<RankKey>> best_keys_;  // per block: the keys of report_'s best rows
+  std::vector<std::vector<RankKey>> candidates_;  // per block: add_columns' best keys, rows not read yet
+  std::vector<std::uint64_t> seed_ids_;           // add_columns' seed runs, rows not read yet
 };
 
 }  // namespace
@@ -164,21 +260,29 @@ PreviousRuns previous_runs(const store::ResultsWriter& writer) {
 }
 
 namespace {
-/// Feeds the rows of the runs done in `previous` to `acc`, read from `writer` in pieces of
-/// kPiece rows (memory bounded whatever the run count). Returns their number.
+/// Feeds the runs done in `previous` to `acc`, read from `writer` in pieces (memory bounded whatever
+/// the run count): by typed column reads of four /runs chunks at a time where the file's columns
+/// allow (Accumulator::columnar), else as Records of 8192 rows. Returns their number.
 std::uint64_t add_previous(const Study& study, const PreviousRuns& previous, store::ResultsWriter& writer,
                            Accumulator& acc) {
-  constexpr std::uint64_t kPiece = 8192;
+  const bool columnar = acc.columnar();
+  const std::uint64_t kPiece = columnar ? 4 * store::kRunsChunkRows : 8192;
   const std::uint64_t total = std::min<std::uint64_t>(study.run_count(), previous.done.size());
   std::uint64_t added = 0;
   for (std::uint64_t first = 0; first < total; first += kPiece) {
     const std::uint64_t n = std::min(kPiece, total - first);
     if (std::none_of(previous.done.begin() + first, previous.done.begin() + first + n, [](bool d) { return d; }))
       continue;
+    if (columnar) {
+      acc.add_columns(first, n, previous.done);
+      added += static_cast<std::uint64_t>(std::count(previous.done.begin() + first, previous.done.begin() + first + n, true));
+      continue;
+    }
     const std::vector<Record> rows = writer.read_rows(static_cast<std::int64_t>(first), static_cast<std::int64_t>(n));
     for (std::uint64_t i = 0; i < n; ++i)
       if (previous.done[first + i]) acc.add(first + i, study.locate(first + i), rows[i]), ++added;
   }
+  if (columnar) acc.finish_columns();
   return added;
 }
 }  // namespace

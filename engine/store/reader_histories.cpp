@@ -116,6 +116,17 @@ bool ResultsReader::has_history(std::int64_t run_id) const {
   return !index_entry(cache_of(r.hist, r.file, r.path), run_id, r.n_runs, r.path).datasets.empty();
 }
 
+bool ResultsReader::has_histories() const {
+  QuietHdf5 quiet;
+  Impl& r = *impl_;
+  if (r.meta.format_version <= 2) {  // one group per run's history
+    H5G_info_t info;
+    return link_exists(r.file, "histories") && H5Gget_info_by_name(r.file, "histories", &info, H5P_DEFAULT) >= 0 &&
+           info.nlinks > 0;
+  }
+  return link_exists(r.file, "histories/start");  // the index, created with the first history
+}
+
 RunHistory ResultsReader::read_history(std::int64_t run_id) const {
   QuietHdf5 quiet;
   Impl& r = *impl_;

@@ -45,6 +45,9 @@ inline constexpr const char* kFormatName = "kinesweep-results";
 /// histories as ragged arrays sharing one row space; 2: one group per run's history; all three:
 /// /runs columns carry `role` and `kinds` attributes).
 inline constexpr std::int64_t kFormatVersion = 4;
+/// Rows per chunk of the fixed-size /runs columns (format 4; FORMAT.md, /runs): the unit in which
+/// they are compressed, and in which a distributed sweep hands out work (so its shards merge by chunk).
+inline constexpr std::uint64_t kRunsChunkRows = 16384;
 /// The oldest format ResultsReader still opens (1: no role/kinds; see ResultsReader's V1ColumnRoles).
 inline constexpr std::int64_t kOldestReadableFormatVersion = 1;
 /// The oldest format ResultsWriter::open_for_resume continues (a format 3 file differs from 4 only in
@@ -209,6 +212,8 @@ struct OptimizationRecord {
   std::size_t size() const { return value.size(); }
 };
 
+class ResultsReader;
+
 class ResultsWriter {
  public:
   struct Impl;
@@ -236,6 +241,17 @@ class ResultsWriter {
   /// visible (done) at the next flush, automatic or explicit; its history is stored at once.
   void write_run(std::int64_t run_id, const Record& record, const EncodedHistory& history = {});
   void write_run(std::int64_t run_id, const Record& record, const RunHistory& history, int level = 1);
+  /// Copy the runs that `owner` assigns to a source (owner[id]: an index into `sources`, or -1) and
+  /// this file does not hold yet: their histories (chunks as stored; re-encoded at `level` only from
+  /// a format 2 source) and /runs rows, counted done (visible at the next flush, which holds both).
+  /// Every source is a results file of this file's columns and run count. A chunk of /runs whose
+  /// rows all come from one source, and of which this file holds none, is copied as stored (no
+  /// decoding); the other chunks are assembled per column from the sources' rows and encoded once
+  /// complete (writer_merge.cpp). Landscapes are not copied. Returns false, having copied nothing,
+  /// when a layout does not allow it (a format 3 file or source, a variable-length column, other
+  /// columns or chunk sizes); the caller then copies rows with write_run.
+  bool copy_runs(const std::vector<const ResultsReader*>& sources, const std::vector<std::int32_t>& owner,
+                 int level = 1);
   /// Rows per chunk of the file's history datasets: what encode_history should be given for
   /// write_run to store the chunks as they are (others are re-cut). 0 until the first history sets
   /// it (from that run's rows). Thread-safe: worker threads read it while the writer thread writes.
@@ -270,6 +286,13 @@ class ResultsWriter {
   /// Rows `first` .. `first + count` (clamped to n_runs) as they are in the file, pending rows
   /// included (written to their datasets first, without a commit): what a resumed sweep already holds.
   std::vector<Record> read_rows(std::int64_t first, std::int64_t count);
+  /// Rows `first` .. `first + count` (clamped) of one numeric column (an i64 column's values
+  /// converted), pending rows included, without building Records: what a resumed sweep or a merge
+  /// counts and grids its done runs by.
+  std::vector<double> read_numbers(const std::string& column, std::int64_t first, std::int64_t count);
+  /// The same of a labelled text column: each row's code, an index into the column's labels (a code
+  /// past them: the missing value ""). Throws StoreError for a column without labels.
+  std::vector<std::uint16_t> read_codes(const std::string& column, std::int64_t first, std::int64_t count);
   std::size_t pending() const;              ///< runs written since the last flush
 
  private:
@@ -328,6 +351,7 @@ class ResultsReader {
   std::vector<Record> read_rows(const std::vector<std::int64_t>& ids) const;
   Record read_record(std::int64_t run_id) const;
   bool has_history(std::int64_t run_id) const;
+  bool has_histories() const;  ///< whether any run has a history
   RunHistory read_history(std::int64_t run_id) const;  ///< empty when the run has none
   /// The run's history as the file stores it, chunks undecoded (for copying runs between files:
   /// ResultsWriter::write_run stores them without decompressing when the chunk sizes agree). Empty
@@ -342,6 +366,7 @@ class ResultsReader {
   OptimizationRecord read_optimization(const std::string& name) const;
 
  private:
+  friend class ResultsWriter;                ///< copy_runs reads a source's chunks as stored
   std::int64_t raw_file_id() const;          ///< the open HDF5 file id (reader.cpp)
   const std::string& raw_path() const;       ///< the file's path (reader.cpp)
   struct Impl;

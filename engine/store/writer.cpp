@@ -63,9 +63,6 @@ std::unique_ptr<ResultsWriter::Impl> open_writer_impl(const std::string& path, c
 
 namespace {
 
-/// Rows per chunk of the fixed-size /runs columns (FORMAT.md, /runs).
-constexpr hsize_t kRunsChunkRows = 16384;
-
 const char* type_word(CellType t) { return t == CellType::f64 ? "f64" : t == CellType::i64 ? "i64" : "str"; }
 
 std::string join_labels(const std::vector<std::string>& labels) {

@@ -215,12 +215,15 @@ void ResultsWriter::Impl::write_landscape_cells() {
   for (LandscapeStream& s : landscape_streams) {
     if (s.cells.empty()) continue;
     // ascending cells, the last value written for a cell kept
-    std::vector<std::size_t> order(s.cells.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return s.cells[a] < s.cells[b]; });
-    std::vector<std::size_t> keep;
-    for (std::size_t i = 0; i < order.size(); ++i)
-      if (i + 1 == order.size() || s.cells[order[i + 1]] != s.cells[order[i]]) keep.push_back(order[i]);
+    std::vector<std::size_t> keep(s.cells.size());
+    std::iota(keep.begin(), keep.end(), 0);
+    if (!std::is_sorted(s.cells.begin(), s.cells.end(), std::less_equal<>())) {  // not already strictly ascending
+      std::vector<std::size_t> order = std::move(keep);
+      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return s.cells[a] < s.cells[b]; });
+      keep.clear();
+      for (std::size_t i = 0; i < order.size(); ++i)
+        if (i + 1 == order.size() || s.cells[order[i + 1]] != s.cells[order[i]]) keep.push_back(order[i]);
+    }
     const std::size_t metrics = s.metrics.size(), n = keep.size();
     std::vector<double> v(n);
     for (std::size_t mt = 0; mt < metrics; ++mt) {

@@ -1,4 +1,5 @@
-// ResultsWriter::open_for_resume (see store.hpp, FORMAT.md "Creation, overwrite, resume").
+// ResultsWriter::open_for_resume (see store.hpp, FORMAT.md "Creation, overwrite, resume"), and the
+// typed column reads by which a resumed sweep or a merge counts the runs a file already holds.
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -10,6 +11,8 @@
 
 #include "store/h5util.hpp"
 #include "store/journal_vfd.hpp"
+#include "store/label_columns.hpp"
+#include "store/runs_read.hpp"
 #include "store/store.hpp"
 #include "store/writer_impl.hpp"
 
@@ -118,5 +121,44 @@ ResultsWriter::Resumed ResultsWriter::open_for_resume(const std::string& path, c
   r.writer = std::unique_ptr<ResultsWriter>(new ResultsWriter(std::move(impl)));
   return r;
 }
+
+namespace {
+/// The column named `name` of `m` (its index), or StoreError.
+std::size_t column_of(const ResultsWriter::Impl& m, const std::string& name) {
+  for (std::size_t c = 0; c < m.columns.size(); ++c)
+    if (m.columns[c].name == name) return c;
+  throw StoreError(m.path, "no /runs column '" + name + "'");
+}
+}  // namespace
+
+std::vector<double> ResultsWriter::read_numbers(const std::string& column, std::int64_t first, std::int64_t count) {
+  QuietHdf5 quiet;
+  Impl& m = *impl_;
+  m.usable();
+  const std::size_t c = column_of(m, column);
+  if (m.columns[c].type == CellType::str) throw StoreError(m.path, "/runs column '" + column + "' holds text");
+  first = std::clamp<std::int64_t>(first, 0, m.n_runs);
+  count = std::clamp<std::int64_t>(count, 0, m.n_runs - first);
+  m.write_rows();
+  m.runs_chunks.write_partial();
+  const RowSelection sel{static_cast<hsize_t>(first), static_cast<hsize_t>(count)};
+  if (m.columns[c].type == CellType::f64) return read_runs_column<double>(m.file, m.path, column, H5T_NATIVE_DOUBLE, sel);
+  const auto v = read_runs_column<std::int64_t>(m.file, m.path, column, H5T_NATIVE_INT64, sel);
+  return std::vector<double>(v.begin(), v.end());
+}
+
+std::vector<std::uint16_t> ResultsWriter::read_codes(const std::string& column, std::int64_t first, std::int64_t count) {
+  QuietHdf5 quiet;
+  Impl& m = *impl_;
+  m.usable();
+  const std::size_t c = column_of(m, column);
+  if (m.columns[c].labels.empty()) throw StoreError(m.path, "/runs column '" + column + "' has no labels");
+  first = std::clamp<std::int64_t>(first, 0, m.n_runs);
+  count = std::clamp<std::int64_t>(count, 0, m.n_runs - first);
+  m.write_rows();
+  m.runs_chunks.write_partial();
+  return read_label_codes(m.file, m.path, column, {static_cast<hsize_t>(first), static_cast<hsize_t>(count)});
+}
+
 
 }  // namespace ks::store

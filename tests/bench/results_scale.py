@@ -3,7 +3,7 @@ IK basin study (histories none), each command against a plain h5py read of the c
 in the same script.
 
 usage: /usr/bin/python3 tests/bench/results_scale.py build/kinesweep [--before OLD_KINESWEEP]
-           [--runs 100000 1000000] [--kinds trajectory ik] [--repeat 3] [--workdir DIR] [--keep]
+           [--runs 100000 1000000] [--kinds trajectory ik] [--repeat 3] [--mpi] [--workdir DIR] [--keep]
 
 For each study kind and run count: `kinesweep run` (wall time, peak RSS, file bytes per run;
 alternated with --before's binary, whose write time gives the ratio new / old), then, on the file
@@ -15,6 +15,10 @@ just written, repeated --repeat times (min and median of each):
   info
   pandas  kinesweep.read.open_results(F).to_pandas() (all columns; timed inside the interpreter;
           peak RSS of that interpreter, pandas imported; the frame's bytes)
+  plot    analysis/plot_landscape.py F, and report: analysis/report.py F (wall, peak RSS, output size)
+  merge   (--mpi, trajectory) `mpirun -np 2 kinesweep run` with one thread per rank: the merge time it
+          prints against a `cp` of its two shard files (hard-linked as they appear, so the copy reads
+          the shards as the merge found them)
 against h5py reading the columns each touches (query: the metric, run_id and done; compact: every
 parameter and metric, block, status and done; group: method, the metric and done; info: the
 columns info reads; pandas: every /runs column).
@@ -111,6 +115,45 @@ def report(name, ours, base, rss=None, extra=""):
     print(line + extra, flush=True)
 
 
+def mpi_merge(ks, study, out, args):
+    """`mpirun -np 2 kinesweep run` (1 thread per rank): its merge time (from its output) against `cp`
+    of its shard files, which are hard-linked as they appear so that the copy reads them as the
+    merge did (just written, in the page cache)."""
+    merges, copies = [], []
+    for _ in range(args.repeat):
+        keep = []
+        mpi_out = out + ".mpi.h5"
+        p = subprocess.Popen(["mpirun", "--oversubscribe", "--allow-run-as-root", "--bind-to", "none", "-np", "2",
+                              ks, "run", study, "-o", mpi_out, "--overwrite", "--threads", "1"],
+                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+        while p.poll() is None:
+            for r in range(2):
+                shard, link = f"{mpi_out}.rank{r}.h5", f"{out}.keep{r}.h5"
+                if link not in keep and os.path.exists(shard):
+                    try:
+                        os.link(shard, link)
+                        keep.append(link)
+                    except OSError:
+                        pass
+            time.sleep(0.05)
+        text = p.stdout.read()
+        merge = float(text.split("merge ")[1].split(" s")[0])
+        merges.append(merge)
+        dst = out + ".copies"
+        os.makedirs(dst, exist_ok=True)
+        t0 = time.perf_counter()
+        subprocess.run(["cp", *keep, dst], check=True)
+        copies.append(time.perf_counter() - t0)
+        size = sum(os.path.getsize(k) for k in keep)
+        shutil.rmtree(dst)
+        for k in keep:
+            os.remove(k)
+        os.remove(mpi_out)
+    (mn, md), (cmn, cmd) = stats(merges), stats(copies)
+    print(f"  merge    {mn:8.2f} s (median {md:6.2f})   cp of the 2 shards ({size / 1e6:.0f} MB) {cmn:6.2f} s "
+          f"(median {cmd:.2f})   ratio {mn / cmn:6.2f}", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("kinesweep")
@@ -121,6 +164,7 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--workdir")
     ap.add_argument("--keep", action="store_true", help="keep the files written")
+    ap.add_argument("--mpi", action="store_true", help="also time the merge of `mpirun -np 2` (trajectory) against cp")
     args = ap.parse_args()
     work = args.workdir or tempfile.mkdtemp(prefix="ks_scale_")
     os.makedirs(work, exist_ok=True)
@@ -190,6 +234,19 @@ def main():
                 t, r = timed([sys.executable, "-c", PANDAS, out])
                 rss.append(r)
                 report("pandas", ours, base, rss, f"   frame {frame / 1e6:.0f} MB (peak/frame {max(rss) / frame:.2f})")
+                for name, script in (("plot", "plot_landscape.py"), ("report", "report.py")):
+                    ours, rss = [], []
+                    page = out + "." + name + (".png" if name == "plot" else ".html")
+                    for _ in range(args.repeat):
+                        t, r = timed([sys.executable, os.path.join(ANALYSIS, script), out, "-o", page])
+                        ours.append(t)
+                        rss.append(r)
+                    mn, md = stats(ours)
+                    print(f"  {name:<8} {mn:8.2f} s (median {md:6.2f})   peak {max(rss) / 1e6:7.0f} MB   "
+                          f"output {os.path.getsize(page) / 1e6:.2f} MB", flush=True)
+                    os.remove(page)
+                if args.mpi and kind == "trajectory":
+                    mpi_merge(ks, study, out, args)
                 if not args.keep:
                     os.remove(out)
     finally:

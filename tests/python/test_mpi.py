@@ -126,6 +126,46 @@ class Merged(Base):
         self.assertEqual(glob.glob(v1 + ".rank*"), [])
 
 
+# Three /runs chunks and a part (16384 rows each): shards hold whole chunks, which the merge copies
+# as stored, and the tail's shared chunk, which it assembles row by row.
+MANY = """[study]
+name = "mpi_many"
+histories = "none"
+[[block]]
+name = "grid"
+kind = "trajectory"
+[block.axes]
+method = ["local_weighted"]
+alpha1A = { from = -20, to = 30, count = 230 }
+k = { from = 0, to = 1, count = 230 }
+"""
+
+
+class MergedByChunks(Base):
+    def test_a_study_of_several_chunks_gives_the_single_process_file_and_summary(self):
+        study = self.write("many.toml", MANY)
+        ref, out = os.path.join(self.dir, "ref.h5"), os.path.join(self.dir, "mpi.h5")
+        r0 = run("run", study, "-o", ref)
+        self.assertEqual(r0.returncode, 0, r0.stderr)
+        r = mpirun("run", study, "-o", out, "--threads", "1")
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        self.assertSameFile(ref, out)
+        with h5py.File(ref, "r") as fa, h5py.File(out, "r") as fb:  # chunk for chunk the same bytes
+            for c in fa["runs"]:
+                if c == "wall_time" or fa["runs"][c].chunks is None:
+                    continue
+                da, db = fa["runs"][c], fb["runs"][c]
+                self.assertEqual(da.id.get_num_chunks(), db.id.get_num_chunks(), c)
+                for i in range(da.id.get_num_chunks()):
+                    off = da.id.get_chunk_info(i).chunk_offset
+                    self.assertEqual(da.id.read_direct_chunk(off)[1], db.id.read_direct_chunk(off)[1], f"{c} {off}")
+        # the run summary (status counts, best runs) is the single process's
+        def summary(text):
+            return [ln for ln in text.splitlines() if ln.startswith(("block ", "  best:"))]
+        self.assertTrue(summary(r0.stdout))
+        self.assertEqual(summary(r.stdout), summary(r0.stdout))
+
+
 class KillOneRank(Base):
     def test_sigkill_of_one_rank_then_resume_completes_the_study(self):
         study = self.write("long.toml", LONG)
