@@ -12,19 +12,21 @@ def cluster_solutions(q, revolute, tolerance=1e-3):
     q = np.asarray(q, dtype=float)
     rev = np.asarray(revolute, dtype=bool)
     labels = np.full(len(q), -1, dtype=int)
-    firsts = np.empty((len(q), q.shape[1] if q.ndim == 2 else 0))  # the clusters' first members, in order
+    if q.ndim != 2 or not len(q):
+        return labels
+    # Cluster by cluster: the earliest row not yet named opens the next cluster and takes every later
+    # row not yet named within tolerance of it. A row so named is within tolerance of its cluster's
+    # first member and of no earlier cluster's (those took their rows first): the row-by-row rule,
+    # in time linear in the rows per cluster.
+    rest = np.flatnonzero(np.all(np.isfinite(q), axis=1))  # rows not named yet, ascending
     count = 0
-    for i, row in enumerate(q):
-        if not np.all(np.isfinite(row)):
-            continue
-        if count:
-            d = row - firsts[:count]
-            d[:, rev] = np.remainder(d[:, rev] + np.pi, 2 * np.pi) - np.pi
-            near = np.flatnonzero(np.max(np.abs(d), axis=1) <= tolerance)
-            if near.size:
-                labels[i] = near[0]  # the first cluster (lowest label) within tolerance
-                continue
-        labels[i] = count
-        firsts[count] = row
+    while rest.size:
+        first = rest[0]
+        d = q[rest[1:]] - q[first]
+        d[:, rev] = np.remainder(d[:, rev] + np.pi, 2 * np.pi) - np.pi
+        near = np.max(np.abs(d), axis=1) <= tolerance if d.shape[1] else np.ones(len(d), dtype=bool)
+        labels[first] = count
+        labels[rest[1:][near]] = count
+        rest = rest[1:][~near]
         count += 1
     return labels

@@ -72,6 +72,35 @@ void LandscapeGrid::add_cell(std::uint64_t local, double code, const double* val
   writer.write_landscape_cell(handle_, local, cell_.data());
 }
 
+void LandscapeGrid::add_range(std::uint64_t first, std::uint64_t count, const double* codes,
+                              const std::vector<const double*>& columns, const StudySchema& schema, std::size_t b,
+                              store::ResultsWriter& writer) {
+  if (!enabled_ || count == 0) return;
+  // The same values add_cell computes, a metric at a time.
+  std::vector<std::vector<double>> own;  // metrics whose values are not a column as it is
+  std::vector<const double*> values;
+  std::size_t j = 0;
+  for (std::size_t m = 0; m < names_.size(); ++m) {
+    if (sources_[m] == Source::column) {
+      const double* v = columns[j++];
+      if (schema.columns[schema.metric_column[b][metric_index_[m]]].type == CellType::i64) {
+        own.emplace_back(v, v + count);
+        for (double& x : own.back())
+          if (x == -1.0) x = kNaN;  // the missing integer (solution -1: none reached)
+        v = own.back().data();
+      }
+      values.push_back(v);
+    } else if (sources_[m] == Source::status_code) {
+      values.push_back(codes);
+    } else {  // is_ok: ok / converged are code 0
+      own.emplace_back(count);
+      for (std::uint64_t i = 0; i < count; ++i) own.back()[i] = codes[i] == 0.0 ? 1.0 : 0.0;
+      values.push_back(own.back().data());
+    }
+  }
+  writer.write_landscape_range(handle_, first, count, values);
+}
+
 store::LandscapeSpec LandscapeGrid::spec() const {
   store::LandscapeSpec s;
   s.block = block_.name();

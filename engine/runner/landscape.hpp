@@ -28,6 +28,10 @@ class LandscapeGrid {
   /// the run's values of columns(schema, b) in that order: runs counted without their Records.
   void add_cell(std::uint64_t local, double code, const double* values, const StudySchema& schema, std::size_t b,
                 store::ResultsWriter& writer);
+  /// The cells of the `count` runs from local index `first` at once: codes[i] as add_cell's `code`,
+  /// columns[j][i] the values of columns(schema, b)[j].
+  void add_range(std::uint64_t first, std::uint64_t count, const double* codes, const std::vector<const double*>& columns,
+                 const StudySchema& schema, std::size_t b, store::ResultsWriter& writer);
   /// The schema columns the grid's metrics take their values from, in order.
   std::vector<std::size_t> columns(const StudySchema& schema, std::size_t b) const;
   /// Which value a grid takes from a row: a metric column, or a status-derived value.

@@ -146,12 +146,22 @@ class Accumulator {
           seeds ? writer_.read_codes(schema_.columns[c.preset].name, static_cast<std::int64_t>(first), static_cast<std::int64_t>(n))
                 : std::vector<std::uint16_t>{};
       auto& keys = candidates_[b];
+      // Every run of the range done (a merge, a finished file): its cells in one write per metric.
+      const bool whole = grids_[b].enabled() && std::all_of(done.begin() + lo, done.begin() + hi, [](bool d) { return d; });
+      if (whole) {
+        std::vector<double> range_codes(hi - lo);
+        for (std::uint64_t id = lo; id < hi; ++id)
+          range_codes[id - lo] = kind_code[std::min<std::size_t>(codes[id - first], labels.size())];
+        std::vector<const double*> at(grid_columns.size());
+        for (std::size_t j = 0; j < at.size(); ++j) at[j] = grid_columns[j] + (lo - first);
+        grids_[b].add_range(lo - study_.first_run(b), hi - lo, range_codes.data(), at, schema_, b, writer_);
+      }
       for (std::uint64_t id = lo; id < hi; ++id) {
         if (!done[id]) continue;
         const std::size_t i = id - first;
         const std::size_t code = std::min<std::size_t>(codes[i], labels.size());
         ++count[code];
-        if (grids_[b].enabled()) {
+        if (grids_[b].enabled() && !whole) {
           for (std::size_t j = 0; j < grid_columns.size(); ++j) values[j] = grid_columns[j][i];
           grids_[b].add_cell(id - study_.first_run(b), kind_code[code], values.data(), schema_, b, writer_);
         }

@@ -270,6 +270,11 @@ class ResultsWriter {
   /// metric, in the spec's order). Written with the rows and committed with them; a cell set twice
   /// keeps its last values. Memory: only cells not yet written are held.
   void write_landscape_cell(std::size_t landscape, std::uint64_t cell, const double* values);
+  /// Set the `count` consecutive cells (row-major) from `first` of a begun landscape at once:
+  /// values[m] points to metric m's count values (the spec's order). Cells set before are written
+  /// first, so the last value set for a cell is kept. Committed with the rows.
+  void write_landscape_range(std::size_t landscape, std::uint64_t first, std::uint64_t count,
+                             const std::vector<const double*>& values);
   /// Write /landscapes/<block>/ with every cell of `spec` (replacing an existing one) and flush.
   void write_landscape(const LandscapeSpec& spec);
   /// Write /optimizations/<record.name>/ (replacing an existing one) and flush (optimizations.cpp).

@@ -211,6 +211,38 @@ void ResultsWriter::write_landscape_cell(std::size_t landscape, std::uint64_t ce
   }
 }
 
+void ResultsWriter::write_landscape_range(std::size_t landscape, std::uint64_t first, std::uint64_t count,
+                                          const std::vector<const double*>& values) {
+  QuietHdf5 quiet;
+  Impl& m = *impl_;
+  m.usable();
+  if (landscape >= m.landscape_streams.size() || m.landscape_streams[landscape].metrics.empty())
+    throw StoreError(m.path, "write_landscape_range: no landscape " + std::to_string(landscape));
+  Impl::LandscapeStream& s = m.landscape_streams[landscape];
+  const hsize_t cells = std::accumulate(s.dims.begin(), s.dims.end(), hsize_t{1}, std::multiplies<>());
+  if (first > cells || count > cells - first || values.size() != s.metrics.size() || s.dims.empty())
+    throw StoreError(m.path, "landscape " + s.block + ": cells " + std::to_string(first) + " + " +
+                                 std::to_string(count) + " of " + std::to_string(cells));
+  m.write_landscape_cells();  // the cells set one by one before these
+  for (std::size_t mt = 0; mt < s.metrics.size(); ++mt) {
+    Hid fspace(H5Dget_space(s.metrics[mt]));
+    hsize_t done = 0;
+    const bool ok = fspace.ok() && for_each_block(s.dims, first, count,
+                                                  [&](const std::vector<hsize_t>& start, const std::vector<hsize_t>& shape,
+                                                      hsize_t n) {
+      Hid mspace(H5Screate_simple(1, &n, nullptr));
+      const bool written = mspace.ok() &&
+                           H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start.data(), nullptr, shape.data(), nullptr) >= 0 &&
+                           H5Dwrite(s.metrics[mt], H5T_NATIVE_DOUBLE, mspace, fspace, H5P_DEFAULT, values[mt] + done) >= 0;
+      done += n;
+      return written;
+    });
+    if (!ok) m.fail("cannot write landscape cells of " + s.block);
+  }
+  m.uncommitted_bytes += count * s.metrics.size() * sizeof(double);
+  if (m.uncommitted_bytes >= Impl::kMaxUncommittedBytes) m.do_flush();
+}
+
 void ResultsWriter::Impl::write_landscape_cells() {
   for (LandscapeStream& s : landscape_streams) {
     if (s.cells.empty()) continue;

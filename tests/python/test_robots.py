@@ -186,6 +186,39 @@ class ClusterSolutions(unittest.TestCase):
         self.assertEqual(sorted(firsts.values()), [firsts[l] for l in range(len(firsts))])
         self.assertEqual(len(firsts), 5)  # 5 well separated centres, one turn counted as the same
 
+    def test_the_row_by_row_rule_on_overlapping_clusters(self):
+        """Rows near two clusters' first members (the tolerance of the order of the spread): each row
+        takes the lowest-labelled cluster whose first member is within tolerance among those opened
+        before it, else opens one (the rule written row by row here as the oracle)."""
+        sys.path.insert(0, os.path.join(REPO, "analysis"))
+        import ksread
+
+        def row_by_row(q, rev, tol):
+            labels, firsts = np.full(len(q), -1), []
+            for i, row in enumerate(q):
+                if not np.all(np.isfinite(row)):
+                    continue
+                for c, f in enumerate(firsts):
+                    d = row - f
+                    d[rev] = np.remainder(d[rev] + np.pi, 2 * np.pi) - np.pi
+                    if np.max(np.abs(d)) <= tol:
+                        labels[i] = c
+                        break
+                else:
+                    labels[i] = len(firsts)
+                    firsts.append(row)
+            return labels
+
+        rng = np.random.default_rng(11)
+        for trial in range(20):
+            n, k = int(rng.integers(1, 600)), int(rng.integers(1, 4))
+            centres = rng.uniform(-4, 4, size=(int(rng.integers(1, 8)), k))
+            q = centres[rng.integers(0, len(centres), n)] + rng.normal(0, rng.choice([1e-4, 1e-3, 3e-2]), size=(n, k))
+            q[rng.random(n) < 0.05, 0] = np.nan
+            rev = rng.random(k) < 0.6
+            tol = float(rng.choice([1e-3, 1e-2, 0.1]))
+            np.testing.assert_array_equal(ksread.cluster_solutions(q, rev, tol), row_by_row(q, rev, tol), str(trial))
+
 
 if __name__ == "__main__":
     KS, STUDIES = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
