@@ -284,6 +284,12 @@ TEST(Store, CommitsOnceTheUncommittedRowsReachAFewMiB) {
     w->write_run(id, test_record(id));
     for (int m = 0; m < 64; ++m) cell[static_cast<std::size_t>(m)] = static_cast<double>(id * 64 + m);
     w->write_landscape_cell(grid, static_cast<std::uint64_t>(id), cell.data());
+    if (id == 0) {
+      // Until a commit, the new grid lies past the committed size, where writes go straight to the
+      // file: its cells hold no journal memory and do not count. Committed, it counts.
+      EXPECT_EQ(w->pending(), 1u);
+      w->flush();
+    }
   }
   EXPECT_LT(w->pending(), static_cast<std::size_t>(n) / 2);  // 4 MiB: about 7400 runs of 569 bytes
   {
@@ -301,6 +307,36 @@ TEST(Store, CommitsOnceTheUncommittedRowsReachAFewMiB) {
     for (std::int64_t id : {std::int64_t{0}, std::int64_t{7777}, n - 1})
       EXPECT_EQ(got.metrics[static_cast<std::size_t>(m)].grid[static_cast<std::size_t>(id)],
                 static_cast<double>(id * 64 + m));
+}
+
+// A grid created since the last commit lies past the committed size (written straight to the file,
+// not held by the journal): filling it, 10 MB here, forces no commit; after close it reads back.
+TEST(Store, ANewGridIsFilledWithoutCommits) {
+  TempDir td;
+  const std::string path = td.file("fresh.h5");
+  StoreOptions opt;
+  opt.flush_every_runs = 0;
+  opt.flush_every_seconds = 0;
+  const std::int64_t n = 20000;
+  LandscapeSpec spec;
+  spec.block = "b";
+  spec.axes.push_back({"i", "", {}});
+  for (std::int64_t i = 0; i < n; ++i) spec.axes[0].values.push_back(static_cast<double>(i));
+  for (int m = 0; m < 64; ++m) spec.metrics.push_back({"m" + std::to_string(m), "", "", {}});
+  auto w = make_writer(path, n, opt);
+  const std::size_t grid = w->begin_landscape(spec);
+  w->write_run(0, test_record(0));
+  std::vector<double> cell(64);
+  for (std::int64_t id = 0; id < n; ++id) {
+    for (int m = 0; m < 64; ++m) cell[static_cast<std::size_t>(m)] = static_cast<double>(id * 64 + m);
+    w->write_landscape_cell(grid, static_cast<std::uint64_t>(id), cell.data());
+  }
+  EXPECT_EQ(w->pending(), 1u);  // no commit: the run is still pending
+  w->close();
+  ResultsReader r(path);
+  const LandscapeSpec got = r.read_landscape("b");
+  for (std::int64_t id : {std::int64_t{0}, std::int64_t{12345}, n - 1})
+    EXPECT_EQ(got.metrics[63].grid[static_cast<std::size_t>(id)], static_cast<double>(id * 64 + 63));
 }
 
 // The writer's done flags (one bit per run) against the runs written, at the edges of 64-run words

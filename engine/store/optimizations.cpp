@@ -96,8 +96,10 @@ void ResultsWriter::write_optimization(const OptimizationRecord& r) {
   }
   Hid root(H5Gopen2(m.file, "optimizations", H5P_DEFAULT));
   if (!root.ok()) m.fail("cannot open /optimizations");
-  if (link_exists(root, r.name) && H5Ldelete(root, r.name.c_str(), H5P_DEFAULT) < 0)
-    m.fail("cannot replace /optimizations/" + r.name);
+  if (link_exists(root, r.name)) {
+    if (H5Ldelete(root, r.name.c_str(), H5P_DEFAULT) < 0) m.fail("cannot replace /optimizations/" + r.name);
+    m.freed_space = true;
+  }
   Out o{m, "/optimizations/" + r.name};
   Hid g = o.group(root, r.name);
   write_str_attr(g, "kind", r.kind);

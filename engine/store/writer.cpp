@@ -534,6 +534,7 @@ void ResultsWriter::Impl::do_flush() {
   }
   if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) fail("flush (commit) failed");
   uncommitted_bytes = 0;
+  for (auto& s : landscape_streams) s.fresh = false;  // committed: later writes to them are journaled
   last_flush = std::chrono::steady_clock::now();
 }
 

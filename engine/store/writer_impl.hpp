@@ -42,6 +42,9 @@ struct ResultsWriter::Impl {
     std::vector<detail::Hid> metrics;
     std::vector<std::uint64_t> cells;
     std::vector<double> values;
+    /// Created by this writer since its last commit: its grids lie past the committed size, where
+    /// writes go straight to the file (journal_vfd.cpp), so they hold no journal memory.
+    bool fresh = false;
   };
   std::vector<LandscapeStream> landscape_streams;
   /// The histories' shared row space (writer_histories.cpp, FORMAT.md: /histories).
@@ -63,6 +66,9 @@ struct ResultsWriter::Impl {
     }
   } hist;
   std::set<std::string> begun_landscapes;  // blocks begin_landscape was called for by this writer
+  /// This writer deleted an object (a replaced landscape or optimisation): HDF5 may place new
+  /// objects in the space it freed, below the committed size, so no new landscape counts as fresh.
+  bool freed_space = false;
   static constexpr std::size_t kRowBatch = 512;
   /// Bytes of rows, done flags and landscape cells written into their datasets since the last commit.
   /// Those datasets lie in the committed part of the file, so until the commit the journal holds

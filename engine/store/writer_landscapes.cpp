@@ -139,6 +139,7 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
   m.begun_landscapes.insert(spec.block);
   if (exists && H5Ldelete(m.landscapes, spec.block.c_str(), H5P_DEFAULT) < 0)
     m.fail("cannot replace /landscapes/" + spec.block);
+  m.freed_space = m.freed_space || exists;
   Hid g(H5Gcreate2(m.landscapes, spec.block.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
   if (!g.ok()) m.fail("cannot create /landscapes/" + spec.block);
   write_str_list_attr(g, "axes", axis_names);
@@ -165,6 +166,7 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
   Impl::LandscapeStream stream;
   stream.block = spec.block;
   stream.dims = dims;
+  stream.fresh = !m.freed_space;
   Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
   const double nan = std::numeric_limits<double>::quiet_NaN();
   if (!dcpl.ok() || H5Pset_layout(dcpl, H5D_CONTIGUOUS) < 0 || H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_LATE) < 0 ||
@@ -239,7 +241,7 @@ void ResultsWriter::write_landscape_range(std::size_t landscape, std::uint64_t f
     });
     if (!ok) m.fail("cannot write landscape cells of " + s.block);
   }
-  m.uncommitted_bytes += count * s.metrics.size() * sizeof(double);
+  if (!s.fresh) m.uncommitted_bytes += count * s.metrics.size() * sizeof(double);
   if (m.uncommitted_bytes >= Impl::kMaxUncommittedBytes) m.do_flush();
 }
 
@@ -286,7 +288,7 @@ void ResultsWriter::Impl::write_landscape_cells() {
         i = j;
       }
     }
-    uncommitted_bytes += n * metrics * sizeof(double);
+    if (!s.fresh) uncommitted_bytes += n * metrics * sizeof(double);
     s.cells.clear();
     s.values.clear();
   }
