@@ -247,6 +247,7 @@ int run_info(const InfoArgs& args) {
   for (const RunsColumn& c : t.cols) loaded.push_back(c.loaded);
   std::size_t at = 0;  // the block of the previous row (rows of a block mostly follow each other)
   const bool consistent = for_each_piece(reader, t, [&](const RunsTable& p) {
+    const bool any_history = reader.has_histories();  // else no row is asked (a lookup per row)
     for (std::int64_t r = 0; r < p.n_runs; ++r) {
       const std::int64_t id = p.row_id(r);
       static const std::string all("(all)");
@@ -307,7 +308,7 @@ int run_info(const InfoArgs& args) {
           }
         }
       }
-      if (reader.has_history(id)) {
+      if (any_history && reader.has_history(id)) {
         ++with;
         if (first_h < 0) first_h = id;
         last_h = id;
