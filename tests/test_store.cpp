@@ -262,23 +262,33 @@ TEST(Store, ResumeFillsGapsAndEqualsUninterruptedRun) {
   for (std::int64_t id = 0; id < n; ++id) expect_same_history(b.read_history(id), a.read_history(id), id);
 }
 
+/// A landscape of `n` cells over one axis with 64 metrics: 512 bytes of cells per run.
+LandscapeSpec wide_landscape(std::int64_t n) {
+  LandscapeSpec spec;
+  spec.block = "b";
+  spec.axes.push_back({"i", "", {}});
+  for (std::int64_t i = 0; i < n; ++i) spec.axes[0].values.push_back(static_cast<double>(i));
+  for (int m = 0; m < 64; ++m) spec.metrics.push_back({"m" + std::to_string(m), "", "", {}});
+  return spec;
+}
+
+StoreOptions no_automatic_flush() {
+  StoreOptions opt;
+  opt.flush_every_runs = 0;
+  opt.flush_every_seconds = 0;
+  return opt;
+}
+
 // Rows and landscape cells written since the last commit are held in memory (the journal's pages)
 // until the commit, so the writer commits once they reach a few MiB even when neither
 // flush_every_runs nor flush_every_seconds asks for a commit.
 TEST(Store, CommitsOnceTheUncommittedRowsReachAFewMiB) {
   TempDir td;
   const std::string path = td.file("bound.h5");
-  StoreOptions opt;
-  opt.flush_every_runs = 0;
-  opt.flush_every_seconds = 0;
   const std::int64_t n = 20000;
-  LandscapeSpec spec;  // 64 metrics: 512 bytes of cells per run, 10 MB for all runs
-  spec.block = "b";
-  spec.axes.push_back({"i", "", {}});
-  for (std::int64_t i = 0; i < n; ++i) spec.axes[0].values.push_back(static_cast<double>(i));
-  for (int m = 0; m < 64; ++m) spec.metrics.push_back({"m" + std::to_string(m), "", "", {}});
+  const LandscapeSpec spec = wide_landscape(n);
   std::vector<double> cell(64);
-  auto w = make_writer(path, n, opt);
+  auto w = make_writer(path, n, no_automatic_flush());
   const std::size_t grid = w->begin_landscape(spec);
   for (std::int64_t id = 0; id < n; ++id) {
     w->write_run(id, test_record(id));
@@ -314,16 +324,9 @@ TEST(Store, CommitsOnceTheUncommittedRowsReachAFewMiB) {
 TEST(Store, ANewGridIsFilledWithoutCommits) {
   TempDir td;
   const std::string path = td.file("fresh.h5");
-  StoreOptions opt;
-  opt.flush_every_runs = 0;
-  opt.flush_every_seconds = 0;
   const std::int64_t n = 20000;
-  LandscapeSpec spec;
-  spec.block = "b";
-  spec.axes.push_back({"i", "", {}});
-  for (std::int64_t i = 0; i < n; ++i) spec.axes[0].values.push_back(static_cast<double>(i));
-  for (int m = 0; m < 64; ++m) spec.metrics.push_back({"m" + std::to_string(m), "", "", {}});
-  auto w = make_writer(path, n, opt);
+  const LandscapeSpec spec = wide_landscape(n);
+  auto w = make_writer(path, n, no_automatic_flush());
   const std::size_t grid = w->begin_landscape(spec);
   w->write_run(0, test_record(0));
   std::vector<double> cell(64);

@@ -48,6 +48,31 @@ bool for_each_block(const std::vector<hsize_t>& dims, hsize_t first, hsize_t cou
   return true;
 }
 
+/// Writes `count` consecutive cells (row-major) from `first` of the metric dataset `d` of a grid of
+/// shape `dims` from `v`: one hyperslab write per block of for_each_block. False on an HDF5 error.
+bool write_consecutive(hid_t d, const std::vector<hsize_t>& dims, hsize_t first, hsize_t count, const double* v) {
+  Hid fspace(H5Dget_space(d));
+  if (!fspace.ok()) return false;
+  hsize_t done = 0;
+  return for_each_block(dims, first, count, [&](const std::vector<hsize_t>& start, const std::vector<hsize_t>& shape, hsize_t n) {
+    Hid mspace(H5Screate_simple(1, &n, nullptr));
+    const bool written = mspace.ok() &&
+                         H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start.data(), nullptr, shape.data(), nullptr) >= 0 &&
+                         H5Dwrite(d, H5T_NATIVE_DOUBLE, mspace, fspace, H5P_DEFAULT, v + done) >= 0;
+    done += n;
+    return written;
+  });
+}
+
+/// The stream of begun landscape `landscape` of `m` and its number of cells; StoreError naming `call`.
+std::pair<ResultsWriter::Impl::LandscapeStream*, hsize_t> begun_stream(ResultsWriter::Impl& m, std::size_t landscape,
+                                                                      const char* call) {
+  if (landscape >= m.landscape_streams.size() || m.landscape_streams[landscape].metrics.empty())
+    throw StoreError(m.path, std::string(call) + ": no landscape " + std::to_string(landscape));
+  ResultsWriter::Impl::LandscapeStream& s = m.landscape_streams[landscape];
+  return {&s, std::accumulate(s.dims.begin(), s.dims.end(), hsize_t{1}, std::multiplies<>())};
+}
+
 /// The doubles of a 1-D dataset (empty when it cannot be read).
 std::vector<double> read_doubles(hid_t d) {
   Hid space(H5Dget_space(d));
@@ -195,10 +220,8 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
 void ResultsWriter::write_landscape_cell(std::size_t landscape, std::uint64_t cell, const double* values) {
   Impl& m = *impl_;
   m.usable();
-  if (landscape >= m.landscape_streams.size() || m.landscape_streams[landscape].metrics.empty())
-    throw StoreError(m.path, "write_landscape_cell: no landscape " + std::to_string(landscape));
-  Impl::LandscapeStream& s = m.landscape_streams[landscape];
-  const hsize_t cells = std::accumulate(s.dims.begin(), s.dims.end(), hsize_t{1}, std::multiplies<>());
+  const auto [stream, cells] = begun_stream(m, landscape, "write_landscape_cell");
+  Impl::LandscapeStream& s = *stream;
   if (cell >= cells)
     throw StoreError(m.path, "landscape " + s.block + ": cell " + std::to_string(cell) + " of " + std::to_string(cells));
   s.cells.push_back(cell);
@@ -218,29 +241,14 @@ void ResultsWriter::write_landscape_range(std::size_t landscape, std::uint64_t f
   QuietHdf5 quiet;
   Impl& m = *impl_;
   m.usable();
-  if (landscape >= m.landscape_streams.size() || m.landscape_streams[landscape].metrics.empty())
-    throw StoreError(m.path, "write_landscape_range: no landscape " + std::to_string(landscape));
-  Impl::LandscapeStream& s = m.landscape_streams[landscape];
-  const hsize_t cells = std::accumulate(s.dims.begin(), s.dims.end(), hsize_t{1}, std::multiplies<>());
+  const auto [stream, cells] = begun_stream(m, landscape, "write_landscape_range");
+  Impl::LandscapeStream& s = *stream;
   if (first > cells || count > cells - first || values.size() != s.metrics.size() || s.dims.empty())
     throw StoreError(m.path, "landscape " + s.block + ": cells " + std::to_string(first) + " + " +
                                  std::to_string(count) + " of " + std::to_string(cells));
   m.write_landscape_cells();  // the cells set one by one before these
-  for (std::size_t mt = 0; mt < s.metrics.size(); ++mt) {
-    Hid fspace(H5Dget_space(s.metrics[mt]));
-    hsize_t done = 0;
-    const bool ok = fspace.ok() && for_each_block(s.dims, first, count,
-                                                  [&](const std::vector<hsize_t>& start, const std::vector<hsize_t>& shape,
-                                                      hsize_t n) {
-      Hid mspace(H5Screate_simple(1, &n, nullptr));
-      const bool written = mspace.ok() &&
-                           H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start.data(), nullptr, shape.data(), nullptr) >= 0 &&
-                           H5Dwrite(s.metrics[mt], H5T_NATIVE_DOUBLE, mspace, fspace, H5P_DEFAULT, values[mt] + done) >= 0;
-      done += n;
-      return written;
-    });
-    if (!ok) m.fail("cannot write landscape cells of " + s.block);
-  }
+  for (std::size_t mt = 0; mt < s.metrics.size(); ++mt)
+    if (!write_consecutive(s.metrics[mt], s.dims, first, count, values[mt])) m.fail("cannot write landscape cells of " + s.block);
   if (!s.fresh) m.uncommitted_bytes += count * s.metrics.size() * sizeof(double);
   if (m.uncommitted_bytes >= Impl::kMaxUncommittedBytes) m.do_flush();
 }
@@ -268,23 +276,11 @@ void ResultsWriter::Impl::write_landscape_cells() {
         continue;
       }
       // one write per hyperslab block of each run of consecutive cells (simple selections only)
-      Hid fspace(H5Dget_space(s.metrics[mt]));
-      if (!fspace.ok()) fail("cannot write landscape cells of " + s.block);
-      std::size_t done = 0;
       for (std::size_t i = 0; i < n;) {
         std::size_t j = i + 1;
         while (j < n && s.cells[keep[j]] == s.cells[keep[j - 1]] + 1) ++j;
-        const bool ok = for_each_block(s.dims, s.cells[keep[i]], j - i,
-                                       [&](const std::vector<hsize_t>& start, const std::vector<hsize_t>& shape, hsize_t cells) {
-          Hid mspace(H5Screate_simple(1, &cells, nullptr));
-          const bool written =
-              mspace.ok() &&
-              H5Sselect_hyperslab(fspace, H5S_SELECT_SET, start.data(), nullptr, shape.data(), nullptr) >= 0 &&
-              H5Dwrite(s.metrics[mt], H5T_NATIVE_DOUBLE, mspace, fspace, H5P_DEFAULT, v.data() + done) >= 0;
-          done += cells;
-          return written;
-        });
-        if (!ok) fail("cannot write landscape cells of " + s.block);
+        if (!write_consecutive(s.metrics[mt], s.dims, s.cells[keep[i]], j - i, v.data() + i))
+          fail("cannot write landscape cells of " + s.block);
         i = j;
       }
     }
