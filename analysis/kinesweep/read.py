@@ -94,6 +94,13 @@ class _Grids(Mapping):
             self._grids[name] = self._read(name)
         return self._grids[name]
 
+    def read(self, name):
+        """The grid `name` without keeping it (the kept one when it was read before): for a caller
+        that goes through every grid once and keeps less than all of them."""
+        if name not in self._names:
+            raise KeyError(name)
+        return self._grids[name] if name in self._grids else self._read(name)
+
     def __iter__(self):
         return iter(self._names)
 

@@ -191,8 +191,23 @@ def landscape_figure(ls, cap):
     s = sel.stride(cap)
     xi = np.arange(0, len(xa.values), s)
     yi = np.arange(0, len(ya.values), s) if ya is not None else np.array([0])
-    hover_metrics = [m for m in ls.metrics if m not in ls.status_grids()
-                     and np.isfinite(np.where(good, ls.metrics[m], np.nan)).any()]
+    # One pass over the metric grids, each read once and let go (a grid not kept: kinesweep.read's
+    # lazy grids), keeping the drawn cells: memory is a few grids, not all of them.
+    fail_all = np.isfinite(status) & (status != 0)
+    read = getattr(ls.metrics, "read", ls.metrics.__getitem__)
+    sampled, hover_metrics, fail_metrics = {}, [], []
+    for m in ls.metrics:
+        if m in ls.status_grids():
+            continue
+        g = ls.metrics[m] if m == metric else read(m)
+        finite = np.isfinite(g)
+        if (finite & good).any():
+            hover_metrics.append(m)
+        if (finite & fail_all).any():  # the failed runs' metrics that have values (IK: iterations, error)
+            fail_metrics.append(m)
+        if m in hover_metrics or m in fail_metrics:
+            sampled[m] = [sel.slice(g, f)[np.ix_(yi, xi)] for _, f in sel.frames]
+        del g, finite
     frames_val = [sel.slice(val, f) for _, f in sel.frames]
     transform, zmin, zmax, ticks = colour_scale(np.concatenate([v.ravel() for v in frames_val]))
     statuses = ls.statuses
@@ -202,14 +217,13 @@ def landscape_figure(ls, cap):
     pos = "%{x}" + (f" {xa.unit}" if xa.unit else "")
     head = f"{xa.name} = {pos}" + (f"<br>{ya.name} = %{{y}}" + (f" {ya.unit}" if ya.unit else "") if ya else "")
     frames, failed_seen, cells = [], {}, 0
-    fail_all = np.isfinite(status) & (status != 0)
     dropdown = len(sel.frames) > MAX_FACETS  # then every frame carries its colour bar and legend entry
-    for (flabel, f), v in zip(sel.frames, frames_val):
+    for k_frame, ((flabel, f), v) in enumerate(zip(sel.frames, frames_val)):
         ctx = (f"<br>{esc(flabel)}" if flabel else "") + "".join(
             f"<br>{esc(value_text(ls.axes[d], sel.fixed[d]))}" for d in sel.held)
         st = sel.slice(status, f)[np.ix_(yi, xi)]
         z = v[np.ix_(yi, xi)]
-        custom = hover_data([sel.slice(ls.metrics[m], f)[np.ix_(yi, xi)] for m in hover_metrics], np.isfinite(z))
+        custom = hover_data([sampled[m][k_frame] for m in hover_metrics], np.isfinite(z))
         tmpl = head + ctx + "".join(f"<br>{m} = %{{customdata[{k}]:.5g}}" + (f" {ls.units[m]}" if ls.units[m] else "")
                                     for k, m in enumerate(hover_metrics)) + f"<br>status {statuses[0]}<extra></extra>"
         with np.errstate(all="ignore"):
@@ -220,10 +234,8 @@ def landscape_figure(ls, cap):
                    "showscale": dropdown or not frames, "name": metric}]
         fail = np.where(np.isfinite(st) & (st != 0), st, np.nan)
         codes = sorted({int(c) for c in np.unique(fail[np.isfinite(fail)])})
-        # the failed runs' metrics that have values (an IK failure's iterations and final error)
-        fm = [m for m in ls.metrics if m not in ls.status_grids()
-              and np.isfinite(np.where(fail_all, ls.metrics[m], np.nan)).any()] if codes else []
-        fvals = [sel.slice(ls.metrics[m], f)[np.ix_(yi, xi)] for m in fm]
+        fm = fail_metrics if codes else []
+        fvals = [sampled[m][k_frame] for m in fm]
         for c in codes:  # one trace per failed status: its name in the hover text, not in every cell
             failed_seen[c] = failed_seen.get(c, 0) + int(np.sum(sel.slice(status, f) == c))
             cells_c = fail == c
