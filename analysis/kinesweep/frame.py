@@ -4,6 +4,8 @@ codes, other text as str objects. Memory: the frame itself plus one column, what
 selected.
 Run with Debian's interpreter: /usr/bin/python3.
 """
+from collections.abc import Mapping
+
 import numpy as np
 
 from kinesweep.kinds import _s, enum_labels, text_values
@@ -60,3 +62,25 @@ def runs_frame(g, names, rows, roles, kinds, degrees=False):
     df.attrs["roles"] = {c: roles.get(c, "bookkeeping") for c in names}
     df.attrs["kinds"] = {c: list(kinds.get(c, [])) for c in names}
     return df
+
+
+class LazyColumns(Mapping):
+    """The /runs columns by name, each read when asked (text as str objects, numbers as stored, each
+    column's unit in .units): what kinesweep.where.select reads a filter's columns from."""
+
+    def __init__(self, g, names):
+        self._g, self._names = g, list(names)
+        self.units = {c: _s(g[c].attrs.get("unit", "")) for c in self._names}
+
+    def __getitem__(self, name):
+        if name not in self._names:
+            raise KeyError(name)
+        d = self._g[name]
+        v = d[()]
+        return text_values(d, v) if enum_labels(d) is not None or v.dtype.kind in "OSU" else v
+
+    def __iter__(self):
+        return iter(self._names)
+
+    def __len__(self):
+        return len(self._names)

@@ -108,28 +108,6 @@ class _Grids(Mapping):
         return len(self._names)
 
 
-class _LazyColumns(Mapping):
-    """The /runs columns by name, each read when asked (text as str objects, numbers as stored, each
-    column's unit in .units): what kinesweep.where.select reads a filter's columns from."""
-
-    def __init__(self, g, names):
-        self._g, self._names = g, list(names)
-        self.units = {c: _s(g[c].attrs.get("unit", "")) for c in self._names}
-
-    def __getitem__(self, name):
-        if name not in self._names:
-            raise KeyError(name)
-        d = self._g[name]
-        v = d[()]
-        return text_values(d, v) if enum_labels(d) is not None or v.dtype.kind in "OSU" else v
-
-    def __iter__(self):
-        return iter(self._names)
-
-    def __len__(self):
-        return len(self._names)
-
-
 class Results:
     """An open results file (read-only). Safe on a file a sweep is writing: every call reads one
     committed state, the newest when it starts (kslive: retried from a fresh open when a commit lands
@@ -321,7 +299,7 @@ class Results:
             exprs = [where] if isinstance(where, str) else list(where)
             g = self.f["runs"]
             text = [c for c in self.columns() if enum_labels(g[c]) is not None or g[c].dtype.kind in "OSU"]
-            mask = kswhere.select(_LazyColumns(g, self.columns()), exprs, degrees=True, text_columns=text,
+            mask = kswhere.select(frame.LazyColumns(g, self.columns()), exprs, degrees=True, text_columns=text,
                                   rows=len(done))
             rows = mask if rows is None else rows & mask
         return rows
