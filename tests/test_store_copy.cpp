@@ -1,7 +1,8 @@
 // ResultsWriter::copy_runs (the merge of a distributed sweep's shards): rows and histories copied
 // from several source files equal the same runs written directly; a chunk one source holds whole is
 // copied byte for byte (HDF5's own chunk reads as the oracle); layouts that do not match are
-// refused with nothing copied. And the typed column reads (read_numbers, read_codes) against the
+// refused with nothing copied. Landscape cells copied from their owner's grid (kept where no source
+// owns them; a source without the landscape refused). And the typed column reads (read_numbers, read_codes) against the
 // rows' own values.
 #include <gtest/gtest.h>
 #include <hdf5.h>
@@ -140,6 +141,67 @@ TEST(StoreCopy, SourcesOfAnotherLayoutAreRefusedWithNothingCopied) {
   EXPECT_FALSE(w->copy_runs({&r}, std::vector<std::int32_t>(n, 0)));
   for (std::int64_t id = 0; id < n; ++id) EXPECT_FALSE(w->is_done(id));
   w->close();
+}
+
+/// A landscape of block "b" over a 3 x 7 x 2500 grid (more cells than one piece of copy_landscape)
+/// with metrics "u" and "v": cell c of metric m holds value(c, m, source).
+LandscapeSpec copy_grid() {
+  LandscapeSpec spec;
+  spec.block = "b";
+  const std::size_t dims[3] = {3, 7, 2500};
+  for (int a = 0; a < 3; ++a) {
+    LandscapeAxis ax{std::string(1, static_cast<char>('p' + a)), "1", {}};
+    for (std::size_t i = 0; i < dims[a]; ++i) ax.values.push_back(static_cast<double>(i));
+    spec.axes.push_back(ax);
+  }
+  spec.metrics = {{"u", "m", "first", {}}, {"v", "s", "second", {}}};
+  return spec;
+}
+double grid_value(std::size_t c, std::size_t m, int source) { return 1000.0 * source + 0.5 * m + 1e-3 * static_cast<double>(c); }
+
+TEST(StoreCopy, LandscapeCellsCopiedFromTheirOwnersGrid) {
+  TempDir td;
+  const std::int64_t n = 10;
+  const LandscapeSpec spec = copy_grid();
+  const std::size_t cells = 3 * 7 * 2500;
+  // owners: runs of several lengths (some longer than a piece), unowned cells among them
+  std::vector<std::int32_t> owner(cells);
+  for (std::size_t c = 0; c < cells; ++c) owner[c] = c < 70000 ? static_cast<std::int32_t>((c / 9973) % 3) - 1 : 1;
+  for (int s = 0; s < 2; ++s) {
+    auto w = ResultsWriter::create(td.file("src" + std::to_string(s) + ".h5"), test_meta(), copy_columns(), n);
+    const std::size_t h = w->begin_landscape(spec);
+    for (std::size_t c = 0; c < cells; ++c)
+      if (owner[c] == s) {
+        const double v[2] = {grid_value(c, 0, s), grid_value(c, 1, s)};
+        w->write_landscape_cell(h, c, v);
+      }
+    w->close();
+  }
+  auto w = ResultsWriter::create(td.file("dst.h5"), test_meta(), copy_columns(), n);
+  const std::size_t h = w->begin_landscape(spec);
+  const double mine[2] = {-1.0, -2.0};
+  for (std::size_t c = 0; c < cells; ++c)
+    if (owner[c] < 0) w->write_landscape_cell(h, c, mine);
+  ResultsReader r0(td.file("src0.h5")), r1(td.file("src1.h5"));
+  ASSERT_TRUE(w->copy_landscape(h, {&r0, &r1}, owner.data()));
+  w->close();
+  const LandscapeSpec got = ResultsReader(td.file("dst.h5")).read_landscape("b");
+  ASSERT_EQ(got.metrics.size(), 2u);
+  for (std::size_t m = 0; m < 2; ++m) {
+    ASSERT_EQ(got.metrics[m].grid.size(), cells);
+    for (std::size_t c = 0; c < cells; ++c)
+      ASSERT_EQ(got.metrics[m].grid[c], owner[c] < 0 ? mine[m] : grid_value(c, m, owner[c])) << "metric " << m << " cell " << c;
+  }
+  // a source without this landscape: refused, nothing written
+  auto w2 = ResultsWriter::create(td.file("dst2.h5"), test_meta(), copy_columns(), n);
+  const std::size_t h2 = w2->begin_landscape(spec);
+  auto w3 = ResultsWriter::create(td.file("bare.h5"), test_meta(), copy_columns(), n);
+  w3->close();
+  ResultsReader bare(td.file("bare.h5"));
+  EXPECT_FALSE(w2->copy_landscape(h2, {&r0, &bare}, owner.data()));
+  w2->close();
+  const LandscapeSpec untouched = ResultsReader(td.file("dst2.h5")).read_landscape("b");
+  for (double x : untouched.metrics[0].grid) ASSERT_TRUE(std::isnan(x)) << x;
 }
 
 }  // namespace

@@ -21,6 +21,8 @@ class LandscapeGrid {
   /// Create the block's landscape in `writer` (replacing one there; a resumed sweep writes the
   /// cells of its done runs again through add).
   void begin(store::ResultsWriter& writer);
+  /// The writer's handle of the landscape begin() created.
+  std::size_t handle() const { return handle_; }
   /// Write the cell of run `local` of this block (block index `b` in the schema) from its row.
   void add(std::uint64_t local, const Record& row, const StudySchema& schema, std::size_t b,
            store::ResultsWriter& writer);

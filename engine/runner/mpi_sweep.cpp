@@ -75,6 +75,7 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
   PreviousRuns all;
   if (opened.previous) all = std::move(*opened.previous);
   all.done.resize(total, false);
+  const bool fresh = std::none_of(all.done.begin(), all.done.end(), [](bool d) { return d; });
 
   const std::vector<std::string> shards = find_shards(out);
   std::vector<std::unique_ptr<store::ResultsReader>> readers;
@@ -97,7 +98,8 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
   const int level = run.options.compression;
   std::vector<const store::ResultsReader*> sources;
   for (const auto& r : readers) sources.push_back(r.get());
-  if (!writer->copy_runs(sources, owner, level)) {
+  const bool copied = writer->copy_runs(sources, owner, level);
+  if (!copied) {
     constexpr std::size_t kPiece = 4096;  // each shard's rows of a piece in one range read per column
     std::vector<std::uint64_t> ids;
     for (std::uint64_t id = 0; id < total; ++id)
@@ -123,14 +125,21 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
     }
   }
   writer->flush();
-  readers.clear();
 
+  // Landscapes and the summary: each shard holds the landscape cells of its runs, as this file
+  // would compute them from the same rows; when every run came from a shard as stored, the cells
+  // are copied from their shard and the summary reads only the columns it ranks and counts by.
   SweepOptions o;
   o.threads = threads;
   o.histories = histories;
   o.compression = level;
+  if (copied && fresh)
+    o.fill_landscape = [&](std::size_t b, std::size_t landscape) {
+      return writer->copy_landscape(landscape, sources, owner.data() + study.first_run(b));
+    };
   SweepResult res;
   res.report = run_sweep(study, schema, *writer, o, &all);
+  readers.clear();
   writer->flush();
   for (const auto& s : shards) store::remove_results_file(s);
   res.writer = std::move(writer);

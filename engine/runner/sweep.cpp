@@ -44,11 +44,14 @@ const std::string& as_str(const Cell& c) {
 /// The writer-side bookkeeping: landscape cells, status counts, best rows, seed rows.
 class Accumulator {
  public:
-  Accumulator(const Study& study, const StudySchema& schema, store::ResultsWriter& writer)
+  /// `fill` (SweepOptions::fill_landscape, may be empty) is given each landscape once begun.
+  Accumulator(const Study& study, const StudySchema& schema, store::ResultsWriter& writer,
+              const std::function<bool(std::size_t, std::size_t)>& fill)
       : study_(study), schema_(schema), writer_(writer) {
     for (std::size_t b = 0; b < study.blocks.size(); ++b) {
       grids_.emplace_back(study.blocks[b]);
       grids_.back().begin(writer);
+      filled_.push_back(grids_.back().enabled() && fill && fill(b, grids_.back().handle()));
       BlockReport r;
       r.name = study.blocks[b].name();
       r.kind = study.blocks[b].kind();
@@ -138,7 +141,8 @@ class Accumulator {
       const std::vector<double>& value = column(c.value);
       const std::vector<double>* tie = c.tie == Columns::npos ? nullptr : &column(c.tie);
       std::vector<const double*> grid_columns;  // the grid's metric columns, in its order
-      if (grids_[b].enabled())
+      const bool gridded = grids_[b].enabled() && !filled_[b];
+      if (gridded)
         for (std::size_t col : grids_[b].columns(schema_, b)) grid_columns.push_back(column(col).data());
       std::vector<double> values(grid_columns.size());
       const bool seeds = block.kind() == BlockKind::trajectory && c.seed_arm;
@@ -147,7 +151,7 @@ class Accumulator {
                 : std::vector<std::uint16_t>{};
       auto& keys = candidates_[b];
       // Every run of the range done (a merge, a finished file): its cells in one write per metric.
-      const bool whole = grids_[b].enabled() && std::all_of(done.begin() + lo, done.begin() + hi, [](bool d) { return d; });
+      const bool whole = gridded && std::all_of(done.begin() + lo, done.begin() + hi, [](bool d) { return d; });
       if (whole) {
         std::vector<double> range_codes(hi - lo);
         for (std::uint64_t id = lo; id < hi; ++id)
@@ -161,7 +165,7 @@ class Accumulator {
         const std::size_t i = id - first;
         const std::size_t code = std::min<std::size_t>(codes[i], labels.size());
         ++count[code];
-        if (grids_[b].enabled() && !whole) {
+        if (gridded && !whole) {
           for (std::size_t j = 0; j < grid_columns.size(); ++j) values[j] = grid_columns[j][i];
           grids_[b].add_cell(id - study_.first_run(b), kind_code[code], values.data(), schema_, b, writer_);
         }
@@ -247,6 +251,7 @@ class Accumulator {
   const StudySchema& schema_;
   store::ResultsWriter& writer_;  // the landscapes' cells go there with their rows
   std::vector<LandscapeGrid> grids_;
+  std::vector<bool> filled_;  // per block: the previous runs' cells set by SweepOptions::fill_landscape
   SweepReport report_;
   std::map<std::uint64_t, SeedRow> seed_;
   struct Columns {  // schema columns a block's rows are read at
@@ -300,7 +305,7 @@ std::uint64_t add_previous(const Study& study, const PreviousRuns& previous, sto
 SweepReport run_sweep(const Study& study, const StudySchema& schema, store::ResultsWriter& writer,
                       const SweepOptions& options, const PreviousRuns* previous) {
   const std::uint64_t total = study.run_count();
-  Accumulator acc(study, schema, writer);
+  Accumulator acc(study, schema, writer, options.fill_landscape);
   const std::uint64_t skipped = previous ? add_previous(study, *previous, writer, acc) : 0;
   const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
   const int stride = options.histories.mode == HistoryPolicy::Mode::none ? 0
@@ -366,8 +371,10 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
             tbb::make_filter<std::shared_ptr<Batch>, void>(
                 tbb::filter_mode::serial_in_order, [&](std::shared_ptr<Batch> b) {
                   for (Job& j : b->jobs) {
-                    writer.write_run(static_cast<std::int64_t>(j.id), j.row, j.history);
+                    // the landscape cell before the row: a commit that holds a run done holds its
+                    // cell (a distributed merge copies the cells of the shards' done runs)
                     acc.add(j.id, j.ref, j.row);
+                    writer.write_run(static_cast<std::int64_t>(j.id), j.row, j.history);
                     ++written;
                   }
                   const auto now = Clock::now();

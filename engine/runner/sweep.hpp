@@ -42,6 +42,11 @@ struct SweepOptions {
   /// The number of runs `source` will hand out (for progress); 0: all runs not done.
   std::uint64_t source_runs = 0;
   double progress_interval_s = 0.25;  ///< minimum time between on_progress calls
+  /// Sets a block's landscape cells from elsewhere (a distributed sweep's shards): called once per
+  /// block with a landscape, with the block's index and its begun landscape (the writer's handle);
+  /// true when it set the cells of every previous run (run_sweep's `previous`), which are then not
+  /// gridded from their rows (the runs computed in the sweep are). Empty: every cell from its row.
+  std::function<bool(std::size_t block, std::size_t landscape)> fill_landscape;
 };
 
 /// One notable row for the summary.

@@ -275,6 +275,12 @@ class ResultsWriter {
   /// first, so the last value set for a cell is kept. Committed with the rows.
   void write_landscape_range(std::size_t landscape, std::uint64_t first, std::uint64_t count,
                              const std::vector<const double*>& values);
+  /// Set the cells of a begun landscape from the same landscape (the same block's group, metric names
+  /// and shape) of other results files of the same study (the shards of a distributed sweep): cell
+  /// c from sources[owner[c]] (owner: one entry per cell; -1 leaves the cell as it is), read and
+  /// written by ranges of cells of one owner. Returns false, having written nothing, when a source
+  /// named by `owner` lacks that landscape; the caller then computes the cells from the rows.
+  bool copy_landscape(std::size_t landscape, const std::vector<const ResultsReader*>& sources, const std::int32_t* owner);
   /// Write /landscapes/<block>/ with every cell of `spec` (replacing an existing one) and flush.
   void write_landscape(const LandscapeSpec& spec);
   /// Write /optimizations/<record.name>/ (replacing an existing one) and flush (optimizations.cpp).

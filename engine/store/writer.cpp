@@ -521,7 +521,7 @@ void ResultsWriter::Impl::do_flush() {
     // 1. the rows (and, already, the histories) are committed before the done flags ...
     if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) fail("flush (commit of rows) failed");
     // 2. ... so a concurrent reader that sees done = 1 sees the row.
-    std::sort(unflagged.begin(), unflagged.end());
+    if (!std::is_sorted(unflagged.begin(), unflagged.end())) std::sort(unflagged.begin(), unflagged.end());
     unflagged.erase(std::unique(unflagged.begin(), unflagged.end()), unflagged.end());
     hsize_t k = unflagged.size();
     Hid mspace(H5Screate_simple(1, &k, nullptr));
