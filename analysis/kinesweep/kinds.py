@@ -20,8 +20,9 @@ KIND_MEANING = {
            "history_arrays": ["k", "q", "F", "norm_F", "step", "lambda"]},
 }
 GOOD_STATUSES = [s for m in KIND_MEANING.values() for s in m["good_statuses"]]
-# Display labels of metrics in plot axes and captions (a metric not listed shows its name; its unit
-# comes from the file).
+# Display labels of metrics for files written before the engine recorded them (the attribute
+# `display_name` of each metric column and landscape metric, from the kind's metric table); a metric
+# not listed shows its name. "convergence" is the fraction of converged runs the plots derive.
 METRIC_LABELS = {"E": "E (mean ‖τ‖)", "E_M": "E_M (mean ‖τ‖ in M⁻¹ norm)", "tau_inf": "‖τ‖∞",
                  "tau1_inf": "‖τ1‖∞", "tau2_inf": "‖τ2‖∞", "tau3_inf": "‖τ3‖∞",
                  "iterations": "iterations", "convergence": "convergence fraction", "error": "final ‖F‖",
@@ -43,6 +44,13 @@ class FormatVersionError(ValueError):
 
 def _s(v):
     return v.decode() if isinstance(v, bytes) else str(v)
+
+
+def display_name(dset, name):
+    """How plots name the column or landscape metric `name` stored in `dset`: its `display_name`
+    attribute, else (older files) METRIC_LABELS, else the name."""
+    v = dset.attrs.get("display_name")
+    return _s(v) if v is not None else METRIC_LABELS.get(name, name)
 
 
 def enum_labels(dset):
@@ -68,13 +76,15 @@ def text_values(dset, codes=None):
 
 
 class Table(dict):
-    """dict of column name -> 1-D numpy array, with .units and .descriptions dicts (runs(): also .roles,
-    column -> "parameter" | "metric" | "bookkeeping", and .kinds, column -> list of run kinds, [] = all)."""
+    """dict of column name -> 1-D numpy array, with .units, .descriptions and .display_names (how plots
+    name a column) dicts (runs(): also .roles, column -> "parameter" | "metric" | "bookkeeping", and
+    .kinds, column -> list of run kinds, [] = all)."""
 
     def __init__(self, *a, **kw):
         super().__init__(*a, **kw)
         self.units = {}
         self.descriptions = {}
+        self.display_names = {}
         self.roles = {}
         self.kinds = {}
 
@@ -105,14 +115,19 @@ class Axis:
 
 class Landscape:
     """A block's gridded metrics: .axes (list of Axis), .metrics (name -> N-D array, NaN = no value),
-    .units / .descriptions (name -> str), .kind (the block's run kind, from its /runs rows).
-    metrics[m][i, j, ...] is at axes[0].values[i], ..."""
+    .units / .descriptions / .display_names (name -> str; display_names: how plots name a metric),
+    .kind (the block's run kind, from its /runs rows). metrics[m][i, j, ...] is at axes[0].values[i], ..."""
 
-    def __init__(self, block, axes, metrics, units, descriptions, kind="", meaning=None):
+    def __init__(self, block, axes, metrics, units, descriptions, kind="", meaning=None, display_names=None):
         self.block, self.axes, self.metrics, self.units, self.descriptions = block, axes, metrics, units, descriptions
+        self.display_names = display_names if display_names is not None else {m: METRIC_LABELS.get(m, m) for m in units}
         self._kind = kind
         # what the block's run kind means (ksread.Results.kind_meaning): statuses, ranking, ...
         self.meaning = meaning if meaning is not None else {k: list(v) for k, v in KIND_MEANING.get(kind, {}).items()}
+
+    def label(self, metric):
+        """How plots name `metric`: its display name, or a derived metric's ("convergence")."""
+        return self.display_names.get(metric) or METRIC_LABELS.get(metric, metric)
 
     def axis(self, name):
         for a in self.axes:

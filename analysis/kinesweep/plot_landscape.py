@@ -23,7 +23,6 @@ from kinesweep import plotting as ksplot  # noqa: E402
 from kinesweep import read as ksread  # noqa: E402
 from kinesweep.report_grids import ordinal  # noqa: E402
 
-METRIC_LABELS = ksread.METRIC_LABELS
 MAX_PANELS = 6  # small multiples: at most this many panels, one per value of a categorical dim
 STATUS_COLOURS = ksread.STATUS_COLOURS
 
@@ -263,7 +262,7 @@ def main(argv=None):
     d = reduce_grid(ls, args)
     xa, ya, Z, CAT, metric = d["x"], d["y"], d["z"], d["cat"], d["metric"]
     unit = "" if metric == "convergence" else ls.units.get(metric, "")
-    label = METRIC_LABELS.get(metric, metric) + (f" [{unit}]" if unit else "")
+    label = ls.label(metric) + (f" [{unit}]" if unit else "")
     xlog = not xa.categorical and ksplot.is_log_spaced(xa.values)
     ylog = not ya.categorical and ksplot.is_log_spaced(ya.values)
 
@@ -344,7 +343,7 @@ def main(argv=None):
         # Thesis optimum (of the panel's method).
         if args.thesis and {xa.name, ya.name} == {"alpha1A", "k"}:
             m = d["panel_labels"][p] if d["facet"] == "method" else block_method(res, ls, d["fixed"])
-            thesis += thesis_overlay(ax, m, metric, xa, patheffects)
+            thesis += thesis_overlay(ax, m, metric, ls.label(metric), xa, patheffects)
         if opt is not None:
             optimization_draw(ax, opt, xa, ya, patheffects)
         for a, setticks, setlab, log, which in ((xa, ax.set_xticks, ax.set_xlabel, xlog, "x"),
@@ -372,7 +371,7 @@ def main(argv=None):
     fig.canvas.draw()  # the colour bar's ticks, as drawn
     cticks = [t for t in cb.ax.yaxis.get_majorticklocs() if norm.vmin <= t <= norm.vmax]
     clabels = [t.get_text() for t in cb.ax.yaxis.get_majorticklabels() if t.get_text()]
-    what = "convergence fraction" if metric == "convergence" else METRIC_LABELS.get(metric, metric)
+    what = ls.label(metric)
     sub = "; ".join(d["notes"] + ([f"one panel per {d['facet']}"] if d["facet"] else []))
     title = args.title or (f"{what} over {xa.name} × {ya.name} — block {ls.block}{(' (' + sub + ')') if sub else ''}"
                            f"\n{os.path.basename(args.file)}{' (log colour scale)' if args.log else ''}")
@@ -393,8 +392,9 @@ def main(argv=None):
          "yscale": axs.flat[0].get_yscale(), "colorbar": {"ticks": cticks, "labels": clabels}})
 
 
-def thesis_overlay(ax, method, metric, xa, patheffects):
-    """Seed 000's optimum points of `method` on an (alpha1A, k) panel; returns what it drew."""
+def thesis_overlay(ax, method, metric, label, xa, patheffects):
+    """Seed 000's optimum points of `method` on an (alpha1A, k) panel (`label`: how the plot names
+    `metric`); returns what it drew."""
     opt = ksread.THESIS_OPTIMA.get(method)
     if opt is None:
         print(f"plot_landscape: --thesis: no thesis optimum for method {method!r} (fix method=local_weighted "
@@ -404,7 +404,7 @@ def thesis_overlay(ax, method, metric, xa, patheffects):
     for case in [opt["global"]] + opt["partial"]:
         _, kk, alpha, e, taus = ksread.THESIS_TABLE4[case]
         tv = {"E": e, "tau_inf": max(taus), "tau1_inf": taus[0], "tau2_inf": taus[1], "tau3_inf": taus[2]}.get(metric)
-        tl = (f"{METRIC_LABELS.get(metric, metric)} = {tv} Nm" if tv is not None else f"E = {e} Nm")
+        tl = (f"{label} = {tv} Nm" if tv is not None else f"E = {e} Nm")
         px, py = (alpha, kk) if xa.name == "alpha1A" else (kk, alpha)
         glob = case == opt["global"]
         ax.plot([px], [py], ls="none", marker="P" if glob else "D", ms=11 if glob else 7,

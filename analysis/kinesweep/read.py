@@ -40,7 +40,7 @@ from kinesweep.optimization import Optimization  # noqa: F401 (part of this modu
 from kinesweep.solutions import cluster_solutions  # noqa: F401 (part of this module's interface)
 from kinesweep.kinds import FormatVersionError  # noqa: F401 (the same)
 from kinesweep.kinds import (GOOD_STATUSES, IK_STATUSES, KIND_MEANING, METRIC_LABELS, OTHER_SOLUTION_COLOUR,  # noqa: F401
-                             STATUS_COLOURS, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s, enum_labels,
+                             STATUS_COLOURS, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s, display_name, enum_labels,
                              text_values)
 
 RAD2DEG = 180.0 / np.pi
@@ -282,6 +282,7 @@ class Results:
             t[c] = v if rows is None else v[rows]
             t.units[c] = unit
             t.descriptions[c] = _s(d.attrs.get("description", ""))
+            t.display_names[c] = display_name(d, c)
             t.roles[c] = self._roles[c]
             t.kinds[c] = list(self._kinds[c])
         if not done_only:
@@ -421,14 +422,15 @@ class Results:
             elif degrees and unit == "rad":
                 vals, unit = vals * RAD2DEG, "deg"
             axes.append(Axis(a, unit, vals, labels))
-        units, desc = {}, {}
+        units, desc, shown = {}, {}, {}
         names = [_s(x) for x in g.attrs["metrics"]]
         for m in names:
             units[m] = _s(g[m].attrs.get("unit", ""))
             desc[m] = _s(g[m].attrs.get("description", ""))
+            shown[m] = display_name(g[m], m)
         metrics = _Grids(names, lambda m: np.array(self.f["landscapes"][block][m][()], dtype=float))
         kind = self._block_kind(block)
-        return Landscape(block, axes, metrics, units, desc, kind, self.kind_meaning(kind))
+        return Landscape(block, axes, metrics, units, desc, kind, self.kind_meaning(kind), shown)
 
     def _block_kind(self, block):
         """The run kind of a block's (done) rows, "" when it has none: its first done row's (a block's

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from kinesweep.kinds import METRIC_LABELS, STATUS_COLOURS  # noqa: F401 (used below)
+from kinesweep.kinds import STATUS_COLOURS  # noqa: F401 (used below)
 from kinesweep.report_page import esc, fmt
 
 MAX_FRAMES = 24      # facets / dropdown entries per figure; further dims are held at the best cell
@@ -212,7 +212,7 @@ def landscape_figure(ls, cap):
     transform, zmin, zmax, ticks = colour_scale(np.concatenate([v.ravel() for v in frames_val]))
     statuses = ls.statuses
     unit = ls.units.get(metric, "")
-    label = METRIC_LABELS.get(metric, metric) + (f" [{unit}]" if unit else "")
+    label = ls.label(metric) + (f" [{unit}]" if unit else "")
     xs, ys = axis_values(xa, xi), (axis_values(ya, yi) if ya is not None else [""])
     pos = "%{x}" + (f" {xa.unit}" if xa.unit else "")
     head = f"{xa.name} = {pos}" + (f"<br>{ya.name} = %{{y}}" + (f" {ya.unit}" if ya.unit else "") if ya else "")

@@ -1,6 +1,6 @@
 #pragma once
 // Trajectory metrics declared as a reduction over the samples of a run: one entry each, with its
-// name, unit, description, reduction and the line that computes its per-sample value from the sample
+// name, unit, description, display label, reduction and the line that computes its per-sample value from the sample
 // state. The three trajectory loops (the closed-form 3R kernel over SIMD lanes, the chain loop, the
 // fixed-size planar-chain loop) hand every sample's state to SampleSums (methods/sample_sums.hpp),
 // which reduces each entry; finish_run stores the results in TrajectoryMetrics::sampled; the run
@@ -47,21 +47,22 @@ enum class Reduce {
   min,   ///< smallest (std::min semantics)
 };
 
-/// One metric: what /runs shows (name, unit, description, whether landscapes grid it), how the
-/// samples reduce, and `value(v)` the value of sample v (SampleValues).
+/// One metric: what /runs shows (name, unit, description, display label, whether landscapes grid
+/// it), how the samples reduce, and `value(v)` the value of sample v (SampleValues).
 template <class F>
 struct SampleMetric {
-  std::string_view name, unit, description;
+  std::string_view name, unit, description, label;
   bool gridded;
   Reduce reduce;
   F value;
 };
 template <class F>
-SampleMetric(std::string_view, std::string_view, std::string_view, bool, Reduce, F) -> SampleMetric<F>;
+SampleMetric(std::string_view, std::string_view, std::string_view, std::string_view, bool, Reduce, F) -> SampleMetric<F>;
 
 /// The table. Values must be written for any T (see the header comment).
 inline constexpr auto kSampleMetrics = std::tuple{
-    SampleMetric{"peak_joint_power", "W", "max over samples and joints of |tau_i qd_i| (actuator power)", true,
+    SampleMetric{"peak_joint_power", "W", "max over samples and joints of |tau_i qd_i| (actuator power)",
+                 "peak joint power", true,
                  Reduce::max,
                  [](const auto& s) {
                    auto p = vabs(s.tau[0] * s.qd[0]);

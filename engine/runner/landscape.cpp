@@ -125,7 +125,12 @@ store::LandscapeSpec LandscapeGrid::spec() const {
   for (std::size_t m = 0; m < names_.size(); ++m) {
     store::LandscapeMetric lm;
     lm.name = names_[m];
-    if (sources_[m] == Source::column) lm.unit = ms[metric_index_[m]].unit, lm.description = ms[metric_index_[m]].description;
+    lm.display_name = lm.name;
+    if (sources_[m] == Source::column) {
+      const MetricDef& md = ms[metric_index_[m]];
+      lm.unit = md.unit, lm.description = md.description;
+      if (!md.label.empty()) lm.display_name = md.label;
+    }
     if (sources_[m] == Source::is_ok) lm.description = "1 where the run's status is " + lm.name + ", else 0";
     if (sources_[m] == Source::status_code) {
       lm.description = "index of the run's status in:";

@@ -112,14 +112,17 @@ std::vector<MetricDef> ik_metrics(const KindContext& ctx) {
   using R = IkResult;
   MetricDef iterations = metric<R>("iterations", CellType::i64, "",
                                    "updates made (the seed's count; summed over restarts)", true,
-                                   [](const R& r) { return std::int64_t(r.iterations); });
+                                   [](const R& r) { return std::int64_t(r.iterations); })
+                             .labelled("iterations");
   iterations.if_failed = [](const RunSpec& r) { return double(std::get<IkRun>(r).options.max_iter); };
   std::vector<MetricDef> m{
       iterations,
       metric<R>("error", CellType::f64, "problem units", "||F|| at the final iterate (mm for scara, m/rad for planar3r)",
-                true, [](const R& r) { return r.error; }),
+                true, [](const R& r) { return r.error; })
+          .labelled("final ‖F‖"),
       metric<R>("solution", CellType::i64, "", "index of the known exact solution reached (mod 2 pi), -1 if none",
-                true, [](const R& r) { return std::int64_t(r.solution); }),
+                true, [](const R& r) { return std::int64_t(r.solution); })
+          .labelled("solution reached"),
       metric<R>("rejected", CellType::i64, "", "lm_adaptive: rejected trial steps", false,
                 [](const R& r) { return std::int64_t(r.rejected); }),
       metric<R>("min_rcond", CellType::f64, "", "smallest reciprocal condition number met", false,

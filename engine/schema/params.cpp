@@ -65,7 +65,7 @@ ColumnSpec ParamDef::column(BlockKind kind) const {
   return c;
 }
 ColumnSpec MetricDef::column(BlockKind kind) const {
-  return {name, type, unit, description, Role::metric, std::string(to_string(kind))};
+  return {name, type, unit, description, Role::metric, std::string(to_string(kind)), {}, label.empty() ? name : label};
 }
 
 std::span<const BlockKind> block_kinds() { return kKindList; }

@@ -90,7 +90,13 @@ struct MetricDef {
   /// The value an [[optimize]] objective term takes for a run whose status is not the good one
   /// (empty: the metric's own value): e.g. a failed IK run counts max_iter iterations.
   std::function<double(const RunSpec&)> if_failed;
+  std::string label;  ///< how plots and reports name it, e.g. "E (mean ‖τ‖)" (empty: its name)
   ColumnSpec column(BlockKind kind) const;
+  /// This metric with display label `l` (the tables' way to set `label`).
+  MetricDef labelled(std::string l) && {
+    label = std::move(l);
+    return std::move(*this);
+  }
 };
 
 /// The kinds, in order; their names are the study file's `kind` values.

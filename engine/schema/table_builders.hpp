@@ -70,7 +70,7 @@ std::vector<std::string> names_of(V... values) {
 /// A metric whose value is `f(result)` for the kind's result type.
 template <class Result, class F>
 MetricDef metric(std::string name, CellType type, std::string unit, std::string description, bool gridded, F f) {
-  MetricDef m{std::move(name), type, std::move(unit), std::move(description), gridded, {}, {}};
+  MetricDef m{std::move(name), type, std::move(unit), std::move(description), gridded, {}, {}, {}};
   m.get = [f](const RunOutcome& o) { return Cell(f(std::get<Result>(o.result))); };
   return m;
 }

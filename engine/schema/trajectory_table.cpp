@@ -108,9 +108,11 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
   using M = TrajectoryMetrics;
   std::vector<MetricDef> m{
       metric<M>("E", CellType::f64, "Nm", "mean over samples of sqrt(tau^T tau) (seed Eq. 60)", true,
-                [](const M& r) { return r.E; }),
+                [](const M& r) { return r.E; })
+          .labelled("E (mean ‖τ‖)"),
       metric<M>("E_M", CellType::f64, "Nm/sqrt(kg m^2)", "mean over samples of sqrt(tau^T M^-1 tau)", true,
-                [](const M& r) { return r.E_M; }),
+                [](const M& r) { return r.E_M; })
+          .labelled("E_M (mean ‖τ‖ in M⁻¹ norm)"),
       metric<M>("tau_inf", CellType::f64, "Nm", "max over samples and revolute joints of |tau_i|", true,
                 [robot = ctx.robot](const M& r) {
                   double a = -std::numeric_limits<double>::infinity();
@@ -118,18 +120,22 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
                   for (int j = 0; j < r.tau_inf.size(); ++j)
                     if (!robot.is_prismatic(j)) a = any ? std::max(a, r.tau_inf[j]) : r.tau_inf[j], any = true;
                   return any ? a : std::numeric_limits<double>::quiet_NaN();
-                }),
+                })
+          .labelled("‖τ‖∞"),
       metric<M>("min_manipulability", CellType::f64, "m^2", "min over samples of sqrt(det(J J^T))", true,
-                [](const M& r) { return r.min_manipulability; }),
+                [](const M& r) { return r.min_manipulability; })
+          .labelled("min manipulability"),
       metric<M>("torque_sq_integral", CellType::f64, "N^2 m^2 s",
                 "trapezoidal integral of sum tau_i^2 (seed 002 f5)", false,
                 [](const M& r) { return r.torque_sq_integral; }),
       metric<M>("power_sq_integral", CellType::f64, "W^2 s", "trapezoidal integral of sum (tau_i qd_i)^2 (seed 002 f6)",
                 false, [](const M& r) { return r.power_sq_integral; }),
       metric<M>("max_tracking_error", CellType::f64, "m", "max over samples of |tip - path| (open-loop drift)", true,
-                [](const M& r) { return r.max_tracking_error; }),
+                [](const M& r) { return r.max_tracking_error; })
+          .labelled("max tracking error"),
       metric<M>("mean_tracking_error", CellType::f64, "m", "mean over samples of |tip - path|", true,
-                [](const M& r) { return r.mean_tracking_error; }),
+                [](const M& r) { return r.mean_tracking_error; })
+          .labelled("mean tracking error"),
       metric<M>("final_alpha", CellType::f64, "rad", "end-effector orientation at the last sample", false,
                 [](const M& r) { return r.final_alpha; }),
       metric<M>("samples", CellType::i64, "", "samples computed (2001 for the seed's square)", false,
@@ -144,7 +150,7 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
     joints.push_back(metric<M>("tau" + i + "_inf", CellType::f64, ctx.robot.is_prismatic(j) ? "N" : "Nm",
                                "max over samples of |tau_" + i + "|", true, [j](const M& r) {
                                  return j < r.tau_inf.size() ? r.tau_inf[j] : std::numeric_limits<double>::quiet_NaN();
-                               }));
+                               }).labelled("‖τ" + i + "‖∞"));
   }
   m.insert(m.begin() + 3, joints.begin(), joints.end());
   const RobotShape& robot = ctx.robot;
@@ -168,7 +174,8 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
   }
   for_each_sample_metric([&](const auto& e, int k) {
     m.push_back(metric<M>(std::string(e.name), CellType::f64, std::string(e.unit), std::string(e.description),
-                          e.gridded, [k](const M& r) { return r.sampled[k]; }));
+                          e.gridded, [k](const M& r) { return r.sampled[k]; })
+                    .labelled(std::string(e.label)));
   });
   if (robot.chain) {
     m.push_back(metric<M>("max_q_limit_ratio", CellType::f64, "",

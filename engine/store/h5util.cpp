@@ -224,6 +224,7 @@ std::vector<ColumnSpec> read_run_columns(hid_t file, const std::string& path, st
       if (!has_attr(d, "kinds"))
         throw StoreError(path, std::string(kBadColumnAttribute) + "/runs/" + name + " has no kinds attribute");
       c.kinds = read_str_attr(d, "kinds");
+      if (has_attr(d, "display_name")) c.display_name = read_str_attr(d, "display_name");
     }
     columns.push_back(std::move(c));
   }

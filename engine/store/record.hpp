@@ -54,6 +54,9 @@ struct ColumnSpec {
   /// value), stored as an HDF5 enum of codes 0..labels.size()-1 (FORMAT.md, /runs). Empty: the column
   /// holds any text, stored as variable-length strings. Ignored for numeric columns.
   std::vector<std::string> labels = {};
+  /// How plots and reports name the column (metrics: the kind's display label, e.g. "E (mean ‖τ‖)");
+  /// empty: its name. Stored as the attribute `display_name` when set.
+  std::string display_name = {};
 };
 
 /// One result row: one cell per ColumnSpec of the study's schema, in schema order.

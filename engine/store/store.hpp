@@ -161,6 +161,7 @@ struct LandscapeAxis {
 struct LandscapeMetric {
   std::string name, unit, description;
   std::vector<double> grid;
+  std::string display_name = {};  ///< as ColumnSpec::display_name (attribute `display_name` when set)
 };
 struct LandscapeSpec {
   std::string block;

@@ -151,6 +151,7 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
     write_str_attr(d, "type", type_attr);
     write_str_attr(d, "role", std::string(to_string(c.role)));
     write_str_attr(d, "kinds", c.kinds);
+    if (!c.display_name.empty()) write_str_attr(d, "display_name", c.display_name);
   };
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::int64_t minus1 = -1;

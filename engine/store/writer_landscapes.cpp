@@ -161,6 +161,7 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
     write_str_attr(d, "units", mt.unit);
     write_str_attr(d, "description", mt.description);
     write_str_attr(d, "long_name", mt.description);
+    if (!mt.display_name.empty()) write_str_attr(d, "display_name", mt.display_name);
     write_str_attr(d, "kind", "metric");
     write_str_list_attr(d, "axes", axis_names);
     for (std::size_t i = 0; i < axis_dsets.size(); ++i)

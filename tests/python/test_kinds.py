@@ -1,7 +1,8 @@
 """The run kinds' meaning as a results file records it (/kinds/<kind>): the same as the Python
 readers' fallback for older files (kstypes.KIND_MEANING), objectives = every numeric metric column
 of the kind plus failure_rate (read from the /runs column attributes), history arrays named and
-united as the runs' histories are written.
+united as the runs' histories are written; every metric's display name recorded once per column and
+landscape metric, the same in both, read by ksread (and the fallback table for older files agrees).
 
 usage: /usr/bin/python3 test_kinds.py KINESWEEP_BINARY ANALYSIS_DIR
 """
@@ -114,6 +115,44 @@ class Kinds(TempDirTest):
             self.assertEqual(res.kind_meaning("trajectory")["good_statuses"], ["ok"])
             self.assertEqual(res.kind_meaning("nonsense"), {})
 
+
+    def test_every_metric_has_one_display_name_that_the_readers_use(self):
+        import ksread
+        import kstypes
+        with h5py.File(self.out, "r") as f:
+            shown = {}
+            for c in strings(f["runs"].attrs["columns"]):
+                at = f["runs"][c].attrs
+                if strings([at["role"]])[0] == "metric":
+                    self.assertIn("display_name", at, c)
+                    shown[c] = strings([at["display_name"]])[0]
+                    self.assertTrue(shown[c], c)
+                else:
+                    self.assertNotIn("display_name", at, c)
+            for block in f["landscapes"]:
+                g = f["landscapes"][block]
+                for m in strings(g.attrs["metrics"]):
+                    want = shown.get(m, m)  # the status grids (ok, converged, status_code): their names
+                    self.assertEqual(strings([g[m].attrs["display_name"]])[0], want, f"{block}/{m}")
+        self.assertEqual(shown["E"], "E (mean ‖τ‖)")
+        self.assertEqual(shown["tau4_inf"], "‖τ4‖∞")
+        self.assertEqual(shown["q_final_1"], "q_final_1")  # no label: the name
+        # the fallback for older files says what the engine says, for every metric it lists
+        for m, label in kstypes.METRIC_LABELS.items():
+            if m in shown:
+                self.assertEqual(label, shown[m], m)
+        with ksread.open_results(self.out) as res:
+            self.assertEqual(res.landscape("traj").label("tau_inf"), shown["tau_inf"])
+            self.assertEqual(res.runs(["error"]).display_names["error"], shown["error"])
+        old = os.path.join(self.dir, "old.h5")
+        with open(self.out, "rb") as a, open(old, "wb") as b:
+            b.write(a.read())
+        with h5py.File(old, "r+") as f:
+            del f["runs"]["E"].attrs["display_name"]
+            del f["landscapes"]["traj"]["E"].attrs["display_name"]
+        with ksread.open_results(old) as res:
+            self.assertEqual(res.landscape("traj").label("E"), kstypes.METRIC_LABELS["E"])
+            self.assertEqual(res.runs(["E"]).display_names["E"], kstypes.METRIC_LABELS["E"])
 
 if __name__ == "__main__":
     KS = os.path.abspath(sys.argv[1])
