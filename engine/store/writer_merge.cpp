@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <numeric>
 
 #include "store/writer_impl.hpp"
 
@@ -120,11 +121,19 @@ bool ResultsWriter::copy_runs(const std::vector<const ResultsReader*>& sources, 
     } catch (const StoreError&) {
       m.fail("cannot copy the /runs rows of a shard");
     }
-    for (const auto& v : ids)
-      for (hsize_t id : v) {
-        m.mark_done(static_cast<std::int64_t>(id));
-        m.unflagged.push_back(id);
-      }
+    if (taken == hi - lo && m.chunk_done[k] == 0) {  // the whole chunk, none of it here before
+      std::fill(m.done.begin() + static_cast<std::ptrdiff_t>(lo), m.done.begin() + static_cast<std::ptrdiff_t>(hi), true);
+      m.chunk_done[k] = static_cast<std::uint32_t>(hi - lo);
+      const std::size_t at = m.unflagged.size();
+      m.unflagged.resize(at + (hi - lo));
+      std::iota(m.unflagged.begin() + static_cast<std::ptrdiff_t>(at), m.unflagged.end(), lo);
+    } else {
+      for (const auto& v : ids)
+        for (hsize_t id : v) {
+          m.mark_done(static_cast<std::int64_t>(id));
+          m.unflagged.push_back(id);
+        }
+    }
     if (m.chunk_done[k] == hi - lo) {
       try {
         m.runs_chunks.write_complete({k});

@@ -18,7 +18,8 @@ just written, repeated --repeat times (min and median of each):
   plot    analysis/plot_landscape.py F, and report: analysis/report.py F (wall, peak RSS, output size)
   merge   (--mpi, trajectory) `mpirun -np 2 kinesweep run` with one thread per rank: the merge time it
           prints against a `cp` of its two shard files (hard-linked as they appear, so the copy reads
-          the shards as the merge found them)
+          the shards as the merge found them; coreutils' cp copies inside the kernel) and against `dd
+          bs=1M` of them (the same bytes read into a buffer and written, as a program's copy does)
 against h5py reading the columns each touches (query: the metric, run_id and done; compact: every
 parameter and metric, block, status and done; group: method, the metric and done; info: the
 columns info reads; pandas: every /runs column).
@@ -119,7 +120,7 @@ def mpi_merge(ks, study, out, args):
     """`mpirun -np 2 kinesweep run` (1 thread per rank): its merge time (from its output) against `cp`
     of its shard files, which are hard-linked as they appear so that the copy reads them as the
     merge did (just written, in the page cache)."""
-    merges, copies = [], []
+    merges, copies, dds = [], [], []
     for _ in range(args.repeat):
         keep = []
         mpi_out = out + ".mpi.h5"
@@ -146,12 +147,20 @@ def mpi_merge(ks, study, out, args):
         copies.append(time.perf_counter() - t0)
         size = sum(os.path.getsize(k) for k in keep)
         shutil.rmtree(dst)
+        os.makedirs(dst, exist_ok=True)
+        t0 = time.perf_counter()  # the same bytes through a user-space buffer (read, then write)
+        for k in keep:
+            subprocess.run(["dd", f"if={k}", f"of={os.path.join(dst, os.path.basename(k))}", "bs=1M", "status=none"],
+                           check=True)
+        dds.append(time.perf_counter() - t0)
+        shutil.rmtree(dst)
         for k in keep:
             os.remove(k)
         os.remove(mpi_out)
-    (mn, md), (cmn, cmd) = stats(merges), stats(copies)
+    (mn, md), (cmn, cmd), (dmn, dmd) = stats(merges), stats(copies), stats(dds)
     print(f"  merge    {mn:8.2f} s (median {md:6.2f})   cp of the 2 shards ({size / 1e6:.0f} MB) {cmn:6.2f} s "
-          f"(median {cmd:.2f})   ratio {mn / cmn:6.2f}", flush=True)
+          f"(median {cmd:.2f})   ratio {mn / cmn:6.2f}   dd bs=1M of them {dmn:6.2f} s (median {dmd:.2f})   "
+          f"ratio {mn / dmn:6.2f}", flush=True)
 
 
 def main():
