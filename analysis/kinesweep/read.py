@@ -188,6 +188,11 @@ class Results:
         """column -> the run kinds it applies to (its kinds attribute split at commas; [] = every run)."""
         return {c: list(k) for c, k in self._kinds.items()}
 
+    def sensitivity(self, **kw):
+        """Sobol' indices of the blocks run as a Saltelli design (kinesweep.sensitivity.sensitivity)."""
+        from kinesweep.sensitivity import sensitivity
+        return sensitivity(self, **kw)
+
     @kslive.consistent
     def kind_meaning(self, kind):
         """What runs of `kind` mean, as the file records it (/kinds/<kind>): {"statuses": in code

@@ -3,7 +3,8 @@
 
 Sections (those that do not apply are left out; the contents list what is there): the study text
 and file metadata, status counts per block, the best runs of each block, interactive landscapes,
-IK basins, the histories of the best runs, and the optimisation traces. Plotly's JavaScript is
+IK basins, Sobol' indices of the blocks run as a Saltelli design, the histories of the best runs, and
+the optimisation traces. Plotly's JavaScript is
 embedded (Debian's python3-plotly, minified by esbuild when installed) and, with the figures' data,
 gzip-compressed (inflated by the browser), so the page works offline and can be mailed as one file.
 Reads files a sweep is still writing (done rows only). Big grids and long traces are subsampled so
@@ -12,7 +13,7 @@ that the page stays small (the captions say where).
     /usr/bin/python3 analysis/report.py results/examples_landscape.h5 -o report.html
 
 Open a single section with report.html#only=SECTION (study, status, best, landscapes, basins,
-histories, optimizations).
+sensitivity, histories, optimizations).
 """
 import argparse
 import datetime
@@ -28,6 +29,7 @@ from kinesweep.report_traces import best_with_history, history_figure, history_i
 
 CELL_BUDGET = 40000   # heatmap cells over all landscape and basin figures (about 40 bytes each, compressed)
 MAX_HISTORY_FIGURES = 12
+MAX_SENSITIVITY_FIGURES = 12
 
 
 def parse_args(argv=None):
@@ -142,6 +144,34 @@ def optimizations_section(res):
     return "".join(parts)
 
 
+def sensitivity_section(res, limit=MAX_SENSITIVITY_FIGURES):
+    """One bar chart per block run as a Saltelli design (and combination of its other axes): each
+    factor's first-order and total Sobol' index of the kind's objective, with bootstrap intervals."""
+    parts = []
+    results = res.sensitivity()
+    for i, r in enumerate(results[:limit]):
+        bars = []
+        for key, name, colour in (("first", "first order S1", "#1f77b4"), ("total", "total ST", "#ff7f0e")):
+            v, lo, hi = (list(map(float, r[k])) for k in (key, key + "_lo", key + "_hi"))
+            bars.append({"type": "bar", "name": name, "x": r["factors"], "y": v, "marker": {"color": colour},
+                         "error_y": {"type": "data", "symmetric": False, "array": [h - x for h, x in zip(hi, v)],
+                                     "arrayminus": [x - lo_ for x, lo_ in zip(v, lo)]}})
+        fig = {"data": bars, "layout": {"barmode": "group", "height": 340, "margin": {"t": 20},
+                                        "yaxis": {"title": {"text": f"Sobol' index of {r['metric']}"}},
+                                        "legend": {"orientation": "h"}}}
+        at = ", ".join(f"{k}={v}" for k, v in r["at"].items())
+        failed = ", ".join(f"{s} {c}" for s, c in r["failed_runs"].items())
+        caption = (f"{esc(r['metric'])}{' at ' + esc(at) if at else ''}: {r['samples']} of {r['base_samples']} samples "
+                   f"used" + (f" ({r['dropped']} left out: a run failed or is not done; {esc(failed)})" if r["dropped"] else "")
+                   + "; bars: Saltelli 2010 (S1) and Jansen (ST) estimators; whiskers: 95 % percentile bootstrap "
+                   "intervals. An index is the share of the metric's variance a factor explains alone (S1) or "
+                   "with its interactions (ST).")
+        parts.append(figure(f"sensitivity-{i}", fig, caption, title=f"Block {r['block']} ({r['kind']})"))
+    if len(results) > limit:
+        parts.append(f"<p class=\"caption\">{len(results) - limit} more (kinesweep sensitivity FILE lists all).</p>")
+    return "".join(parts)
+
+
 def build(path, best=5, max_cells=CELL_BUDGET, title=None):
     """The page's html for one results file."""
     with ksread.open_results(path) as res:
@@ -156,6 +186,9 @@ def build(path, best=5, max_cells=CELL_BUDGET, title=None):
             sections.append(("landscapes", "Landscapes", land))
         if basins:
             sections.append(("basins", "IK basins of attraction", basins))
+        sens = sensitivity_section(res)
+        if sens:
+            sections.append(("sensitivity", "Which parameter matters: Sobol' indices", sens))
         hist = histories_section(view)
         if hist:
             sections.append(("histories", "Histories of the best runs", hist))

@@ -1,4 +1,5 @@
-// kinesweep: the command-line front end (run, table4, schema, robot; info and query read results files).
+// kinesweep: the command-line front end (run, table4, schema, robot; info, query and sensitivity read
+// results files).
 #include <malloc.h>
 
 #include <CLI/CLI.hpp>
@@ -9,6 +10,7 @@
 #include "cli/robot_command.hpp"
 #include "cli/run_command.hpp"
 #include "cli/schema_command.hpp"
+#include "cli/sensitivity_command.hpp"
 #include "cli/table4.hpp"
 #include "common/shell_word.hpp"
 #include "store/store.hpp"
@@ -30,6 +32,7 @@ int main(int argc, char** argv) {
   ks::cli::QueryArgs& query = ks::cli::add_query_command(app);
   ks::cli::SchemaArgs& schema = ks::cli::add_schema_command(app);
   ks::cli::RobotArgs& robot = ks::cli::add_robot_command(app);
+  ks::cli::SensitivityArgs& sensitivity = ks::cli::add_sensitivity_command(app);
   auto* table4 = app.add_subcommand("table4", "Print seed 000's Table 4 beside kinesweep's figures (no file)");
   try {
     app.parse(argc, argv);
@@ -47,5 +50,6 @@ int main(int argc, char** argv) {
   if (app.got_subcommand("query")) return ks::cli::query_command(query);
   if (app.got_subcommand("schema")) return ks::cli::schema_command(schema);
   if (app.got_subcommand("robot")) return ks::cli::robot_command(robot, std::cout, std::cerr);
+  if (app.got_subcommand("sensitivity")) return ks::cli::sensitivity_command(sensitivity);
   return 0;
 }

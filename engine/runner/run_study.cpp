@@ -54,10 +54,38 @@ std::vector<store::KindMeta> kind_meta(const Study& study) {
   return out;
 }
 
+/// The study's blocks whose design dimension is a Saltelli design (its axes written { saltelli = ... }).
+std::vector<store::DesignMeta> design_meta(const Study& study) {
+  std::vector<store::DesignMeta> out;
+  for (std::size_t b = 0; b < study.blocks.size(); ++b) {
+    const Block& block = study.blocks[b];
+    store::DesignMeta d;
+    for (std::size_t k = 0; k < block.dims().size(); ++k) {
+      const Dim& dim = block.dims()[k];
+      std::string name;
+      for (std::size_t a : dim.axes) name += (name.empty() ? "" : "+") + block.axes()[a].name;
+      d.dims.push_back(name);
+      d.sizes.push_back(static_cast<std::int64_t>(dim.size));
+      if (block.axes()[dim.axes.front()].form != "saltelli") continue;
+      d.dim = static_cast<std::int64_t>(k);
+      for (std::size_t a : dim.axes) d.factors.push_back(block.axes()[a].name);
+    }
+    if (d.factors.empty()) continue;
+    d.block = block.name();
+    d.kind = std::string(to_string(block.kind()));
+    d.design = "saltelli";
+    d.base_samples = d.sizes[static_cast<std::size_t>(d.dim)] / static_cast<std::int64_t>(d.factors.size() + 2);
+    d.first_run = static_cast<std::int64_t>(study.first_run(b));
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
 store::StoreMeta store_meta(const Study& study, const HistoryPolicy& histories) {
   store::StoreMeta meta;
   meta.histories = histories.str();
   meta.kinds = kind_meta(study);
+  meta.designs = design_meta(study);
   meta.study_name = study.name;
   meta.study_path = study.file;
   meta.study_text = study.text;

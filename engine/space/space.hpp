@@ -136,6 +136,14 @@ std::vector<double> uniform_draws(std::uint64_t seed, std::uint64_t count, doubl
 /// d, in stratum perm_d[i] of [from, to) cut in `count` equal strata (each stratum hit exactly once).
 std::vector<std::vector<double>> lhs_draws(std::uint64_t seed, std::uint64_t count,
                                            std::span<const std::pair<double, double>> ranges);
+/// Saltelli's design for first-order and total Sobol' indices of d = ranges.size() factors from
+/// `count` base samples (saltelli.cpp): count (d + 2) points, result[i][r] is point r's factor i in
+/// [from, to): rows 0..count-1 are matrix A, count..2 count-1 matrix B, and rows (2 + m) count ..
+/// (3 + m) count - 1 matrix AB_m (A with column m taken from B). A and B are the first and last d
+/// coordinates of the 2d-dimensional Sobol' sequence (origin skipped), shifted modulo 1 by uniform
+/// draws of `seed`.
+std::vector<std::vector<double>> saltelli_draws(std::uint64_t seed, std::uint64_t count,
+                                                std::span<const std::pair<double, double>> ranges);
 
 /// Values of a range from..to by step, inclusive of `to` within 1e-9 relative (values from + i step;
 /// the last snapped to `to` when within tolerance). Empty when the range is empty or step == 0.

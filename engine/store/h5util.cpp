@@ -136,6 +136,24 @@ void write_i64_attr(hid_t obj, const char* name, std::int64_t value) {
     throw StoreError("", std::string("cannot write attribute ") + name + ": " + h5_error_text());
 }
 
+void write_i64_list_attr(hid_t obj, const char* name, const std::vector<std::int64_t>& values) {
+  if (H5Aexists(obj, name) > 0) H5Adelete(obj, name);
+  hsize_t n = values.size();
+  Hid space(H5Screate_simple(1, &n, nullptr));
+  Hid attr(H5Acreate2(obj, name, H5T_STD_I64LE, space, H5P_DEFAULT, H5P_DEFAULT));
+  if (!attr.ok() || (!values.empty() && H5Awrite(attr, H5T_NATIVE_INT64, values.data()) < 0))
+    throw StoreError("", std::string("cannot write attribute ") + name + ": " + h5_error_text());
+}
+
+std::vector<std::int64_t> read_i64_list_attr(hid_t obj, const char* name) {
+  if (H5Aexists(obj, name) <= 0) return {};
+  Hid attr(H5Aopen(obj, name, H5P_DEFAULT));
+  Hid space(H5Aget_space(attr));
+  std::vector<std::int64_t> v(static_cast<std::size_t>(std::max<hssize_t>(0, H5Sget_simple_extent_npoints(space))));
+  if (!v.empty() && H5Aread(attr, H5T_NATIVE_INT64, v.data()) < 0) v.clear();
+  return v;
+}
+
 void write_str_list_attr(hid_t obj, const char* name, const std::vector<std::string>& values) {
   if (H5Aexists(obj, name) > 0) H5Adelete(obj, name);
   Hid type(utf8_vlen_type());

@@ -101,6 +101,8 @@ hid_t conversion_transfer(std::size_t n, std::size_t element_bytes);
 hid_t string_transfer(std::size_t n);
 void write_str_attr(hid_t obj, const char* name, const std::string& value);
 void write_i64_attr(hid_t obj, const char* name, std::int64_t value);
+void write_i64_list_attr(hid_t obj, const char* name, const std::vector<std::int64_t>& values);
+std::vector<std::int64_t> read_i64_list_attr(hid_t obj, const char* name);  // empty when absent
 void write_str_list_attr(hid_t obj, const char* name, const std::vector<std::string>& values);
 bool has_attr(hid_t obj, const char* name);
 std::string read_str_attr(hid_t obj, const char* name);  // "" when absent
@@ -113,6 +115,8 @@ bool link_exists(hid_t loc, const std::string& path);
 /// column cannot be opened, or (roles_stored) has no valid role attribute or no kinds attribute.
 std::vector<ColumnSpec> read_run_columns(hid_t file, const std::string& path, std::int64_t& n_runs,
                                          bool roles_stored);
+/// Writes /designs/<block> for each of `designs` (none: no /designs) (designs.cpp).
+void write_designs(hid_t file, const std::vector<DesignMeta>& designs, const std::string& path);
 /// Causes of StoreErrors that re-reading cannot cure (the reader gives up at once on them).
 inline constexpr const char* kBadColumnAttribute = "bad column attribute: ";
 

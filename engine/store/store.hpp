@@ -62,6 +62,20 @@ struct KindMeta {
   std::vector<std::pair<std::string, std::vector<std::string>>> lists;  ///< attribute -> values
 };
 
+/// A block whose runs are the points of a Saltelli design (FORMAT.md, /designs/<block>): what a
+/// sensitivity analysis needs to find the design's matrices A, B and AB_m among the block's runs.
+struct DesignMeta {
+  std::string block;                 ///< the block's name
+  std::string kind;                  ///< its run kind ("trajectory" | "ik")
+  std::string design;                ///< "saltelli"
+  std::vector<std::string> factors;  ///< the design's axes, in its column order (AB_m takes factor m from B)
+  std::int64_t base_samples = 0;     ///< N: the design's dimension has N (factors + 2) points, A, B, AB_0, ...
+  std::int64_t first_run = 0;        ///< the block's first run id
+  std::vector<std::string> dims;     ///< the block's dimensions in run order (the last fastest): axis names joined by "+"
+  std::vector<std::int64_t> sizes;   ///< their lengths
+  std::int64_t dim = 0;              ///< the index of the design's dimension in dims
+};
+
 struct StoreMeta {
   std::string study_name;
   std::string study_path;    ///< attribute "path" of /study
@@ -76,6 +90,8 @@ struct StoreMeta {
   std::string histories;
   /// The study's run kinds (/kinds; empty in files from before they were written).
   std::vector<KindMeta> kinds;
+  /// The blocks run as a Saltelli design (/designs; empty when none).
+  std::vector<DesignMeta> designs;
   std::string format = kFormatName;
   std::int64_t format_version = kFormatVersion;
 };
@@ -370,6 +386,8 @@ class ResultsReader {
   /// when the run has none. Format 3 files; older ones are read and encoded at `level`.
   EncodedHistory read_history_chunks(std::int64_t run_id, int level = 1) const;
   std::vector<std::string> landscapes() const;
+  /// The blocks run as a Saltelli design (/designs; empty in files without one) (designs.cpp).
+  std::vector<DesignMeta> designs() const;
   /// A block's landscape: its axes and metrics, with every metric's grid, or (`grids` false) with
   /// their names, units and descriptions only (grid vectors empty).
   LandscapeSpec read_landscape(const std::string& block, bool grids = true) const;

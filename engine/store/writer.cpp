@@ -186,6 +186,7 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
       for (const auto& [attr, values] : k.lists) write_str_list_attr(g, attr.c_str(), values);
     }
   }
+  write_designs(file, meta.designs, path);
   Hid h(check(H5Gcreate2(file, "histories", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /histories"));
   Hid l(check(H5Gcreate2(file, "landscapes", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /landscapes"));
 }

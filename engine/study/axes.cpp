@@ -101,7 +101,7 @@ bool Parser::count_and_interval_ok(const std::string& what, std::int64_t count, 
 
 // ---------------------------------------------------------------------------------------------------
 std::optional<AxisDraft> Parser::parse_axis(const ParamDef& info_ref, const toml::key& key_node, const toml::node& node,
-                                          const toml::node* lhs_node) {
+                                          const toml::node* lhs_node, const std::string& design) {
   const ParamDef* info = &info_ref;
   const toml::node* n = &node;
   const std::string key(key_node.str());
@@ -112,7 +112,7 @@ std::optional<AxisDraft> Parser::parse_axis(const ParamDef& info_ref, const toml
   const std::string forms =
       info->type == CellType::str
           ? "a list of names [\"a\", \"b\"] or { values = [...] }"
-          : "a list [...], { values = [...] }, { from, to, step }, { from, to, count }, { random = { from, to, count, seed } } or { lhs = { from, to } }";
+          : "a list [...], { values = [...] }, { from, to, step }, { from, to, count }, { random = { from, to, count, seed } } or { lhs = { from, to } } / { saltelli = { from, to } }";
   const toml::array* list = n->as_array();
   const toml::table* t = n->as_table();
   if (t && t->get("values")) {
@@ -174,22 +174,23 @@ std::optional<AxisDraft> Parser::parse_axis(const ParamDef& info_ref, const toml
       d.generate = [seed = std::uint64_t(*seed), count = d.count, from = *from, to = *to] {
         return uniform_draws(seed, count, from, to);
       };
-    } else if (const toml::node* ln = t->get("lhs")) {
-      check_keys(*t, {"lhs"}, what + " (lhs)");
-      d.axis.form = "lhs";
+    } else if (const toml::node* ln = t->get("lhs") ? t->get("lhs") : t->get("saltelli")) {
+      const std::string w = t->get("lhs") ? "lhs" : "saltelli";  // the design the axis belongs to
+      check_keys(*t, {w}, what + " (" + w + ")");
+      d.axis.form = w;
       d.lhs = true;
       const auto* lt = ln->as_table();
       if (!lt) {
-        error(*ln, what + " lhs is " + type_name(*ln) + "; expected lhs = { from, to }");
+        error(*ln, what + " " + w + " is " + type_name(*ln) + "; expected " + w + " = { from, to }");
         return std::nullopt;
       }
       if (is_int) {
-        error(*ln, what + ": LHS draws give non-integers; expected a list or an integer range for " + key);
+        error(*ln, what + ": " + w + " draws give non-integers; expected a list or an integer range for " + key);
         return std::nullopt;
       }
-      check_keys(*lt, {"from", "to"}, what + " lhs");
+      check_keys(*lt, {"from", "to"}, what + " " + w);
       auto from = get_number(*lt, "from", "from"), to = get_number(*lt, "to", "to");
-      if (!lt->get("from") || !lt->get("to")) error(*ln, what + " lhs lacks from or to; expected lhs = { from, to }");
+      if (!lt->get("from") || !lt->get("to")) error(*ln, what + " " + w + " lacks from or to; expected " + w + " = { from, to }");
       if (!from || !to) return std::nullopt;
       if (*from > *to) {
         error(*ln, what + " has from = " + fmt(*from) + " > to = " + fmt(*to) + "; expected from <= to");
@@ -200,8 +201,9 @@ std::optional<AxisDraft> Parser::parse_axis(const ParamDef& info_ref, const toml
           error(*ln, p);
           return std::nullopt;
         }
-      if (!lhs_node) {
-        error(*ln, what + " uses lhs but the block has no lhs settings; expected lhs = { count = N, seed = S } in the block");
+      if (!lhs_node || design != w) {
+        error(*ln, what + " uses " + w + " but the block has no " + w + " settings; expected " + w +
+                       " = { count = N, seed = S } in the block" + (lhs_node ? " (it has " + design + ")" : ""));
         return std::nullopt;
       }
       d.lhs_range = {*from, *to};
@@ -252,7 +254,7 @@ std::optional<AxisDraft> Parser::parse_axis(const ParamDef& info_ref, const toml
         d.generate = [from = *from, to = *to, count = d.count] { return linspace_values(from, to, count); };
       }
     } else {
-      const std::vector<std::string> axis_keys{"values", "from", "to", "step", "count", "random", "lhs"};
+      const std::vector<std::string> axis_keys{"values", "from", "to", "step", "count", "random", "lhs", "saltelli"};
       for (auto&& [k, v] : ordered(*t))
         if (std::find(axis_keys.begin(), axis_keys.end(), k->str()) == axis_keys.end()) {
           error(*k, what + " has the unknown key '" + std::string(k->str()) + "' and so gives no values; expected " +

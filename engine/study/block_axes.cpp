@@ -10,28 +10,43 @@
 namespace ks::study_parse {
 
 void Parser::read_block_lhs(BlockDraft& d) {
-  d.lhs_node = d.table.get("lhs");
+  const toml::node* lhs = d.table.get("lhs");
+  const toml::node* saltelli = d.table.get("saltelli");
+  if (lhs && saltelli)
+    error(*saltelli, "the block has both lhs and saltelli; expected one sampled design per block");
+  d.lhs_node = lhs ? lhs : saltelli;
+  d.design = lhs || !saltelli ? "lhs" : "saltelli";
   const toml::node* lhs_node = d.lhs_node;
   if (!lhs_node) return;
+  const std::string& w = d.design;
+  const std::string form = w + " = { count = N, seed = S }";
   if (const auto* lt = lhs_node->as_table()) {
-    check_keys(*lt, {"count", "seed"}, "lhs");
+    if (w == "saltelli") {
+      check_keys(*lt, {"count", "seed", "second_order"}, w);
+      if (const toml::node* so = lt->get("second_order"))
+        if (auto v = so->value<bool>(); !v || *v)
+          error(*so, "saltelli second_order = " + (v ? std::string("true") : type_name(*so)) +
+                         "; expected false (the design gives first-order and total indices only)");
+    } else {
+      check_keys(*lt, {"count", "seed"}, w);
+    }
     if (const toml::node* c = lt->get("count")) {
-      if (auto v = get_integer(*c, "lhs count")) {
-        if (*v < 1) error(*c, "lhs count = " + std::to_string(*v) + "; expected count >= 1");
+      if (auto v = get_integer(*c, w + " count")) {
+        if (*v < 1) error(*c, w + " count = " + std::to_string(*v) + "; expected count >= 1");
         else if (std::uint64_t(*v) > max_runs_)
-          error(*c, "lhs count = " + std::to_string(*v) + "; expected at most " + std::to_string(max_runs_) + " runs" +
+          error(*c, w + " count = " + std::to_string(*v) + "; expected at most " + std::to_string(max_runs_) + " runs" +
                         limit_hint());
         else d.lhs_count = std::uint64_t(*v);
       }
-    } else error(*lhs_node, "lhs has no count; expected lhs = { count = N, seed = S }");
+    } else error(*lhs_node, w + " has no count; expected " + form);
     if (const toml::node* c = lt->get("seed")) {
-      if (auto v = get_integer(*c, "lhs seed")) {
-        if (*v < 0) error(*c, "lhs seed = " + std::to_string(*v) + "; expected seed >= 0");
+      if (auto v = get_integer(*c, w + " seed")) {
+        if (*v < 0) error(*c, w + " seed = " + std::to_string(*v) + "; expected seed >= 0");
         else d.lhs_seed = std::uint64_t(*v);
       }
-    } else error(*lhs_node, "lhs has no seed; expected lhs = { count = N, seed = S }");
+    } else error(*lhs_node, w + " has no seed; expected " + form);
   } else {
-    error(*lhs_node, "lhs is " + type_name(*lhs_node) + "; expected lhs = { count = N, seed = S }");
+    error(*lhs_node, w + " is " + type_name(*lhs_node) + "; expected " + form);
   }
 }
 
@@ -52,7 +67,7 @@ void Parser::read_axes(BlockDraft& d) {
                       " parameter: " + join(d.param_names) + suggest_either(key, d.param_names, d.other, d.other_kname));
       continue;
     }
-    if (auto a = parse_axis(*info, *k, *n, d.lhs_node)) d.drafts.push_back(std::move(*a));
+    if (auto a = parse_axis(*info, *k, *n, d.lhs_node, d.design)) d.drafts.push_back(std::move(*a));
   }
 }
 
@@ -73,13 +88,15 @@ bool Parser::check_block_runs(BlockDraft& d) {
     if (it != d.drafts.end() && runs) runs = times(*runs, it->count);
     counted.insert(g.begin(), g.end());
   }
-  bool lhs = false;
+  std::uint64_t sampled = 0;  // axes of the sampled design
   for (const auto& a : d.drafts) {
     if (counted.count(a.axis.name) || !runs) continue;
-    if (a.lhs) lhs = true;
+    if (a.lhs) ++sampled;
     else runs = times(*runs, a.count);
   }
-  if (lhs && d.lhs_count && runs) runs = times(*runs, *d.lhs_count);
+  // the design's points: count (lhs), count (d + 2) (saltelli: A, B and one AB per factor)
+  if (sampled && d.lhs_count && runs) runs = times(*runs, *d.lhs_count);
+  if (sampled && d.lhs_count && runs && d.design == "saltelli") runs = times(*runs, sampled + 2);
   const std::uint64_t before = d.optimize ? 0 : sweep_runs_;
   const bool over = !runs || *runs > max_runs_ - std::min(before, max_runs_);
   if (!over) {
@@ -127,9 +144,11 @@ void Parser::generate_axes(BlockDraft& d) {
       lhs_axes.push_back(&a);
     }
   if (d.lhs_node && lhs_axes.empty() && d.lhs_node->as_table())
-    error(*d.lhs_node, "lhs settings given but no axis uses them; expected axes written { lhs = { from, to } }");
+    error(*d.lhs_node, d.design + " settings given but no axis uses them; expected axes written { " + d.design +
+                           " = { from, to } }");
   if (!lhs_axes.empty() && d.lhs_count && d.lhs_seed) {
-    const auto draws = lhs_draws(*d.lhs_seed, *d.lhs_count, ranges);
+    const auto draws = d.design == "saltelli" ? saltelli_draws(*d.lhs_seed, *d.lhs_count, ranges)
+                                              : lhs_draws(*d.lhs_seed, *d.lhs_count, ranges);
     for (std::size_t i = 0; i < lhs_axes.size(); ++i) {
       const ParamDef* info = d.info_of(lhs_axes[i]->axis.name);
       for (double v : draws[i]) lhs_axes[i]->axis.values.push_back(info->from_file(v));

@@ -132,7 +132,7 @@ bool Parser::read_block_kind(BlockDraft& d) {
 }
 
 void Parser::check_block_keys(const BlockDraft& d) {
-  std::vector<std::string> block_keys{"name", "kind", "axes", "zip", "lhs"};
+  std::vector<std::string> block_keys{"name", "kind", "axes", "zip", "lhs", "saltelli"};
   if (d.optimize)
     for (const char* k : {"variables", "objective", "global", "local", "polish_from", "seed", "constraint", "penalty"})
       block_keys.push_back(k);
@@ -146,7 +146,7 @@ void Parser::check_block_keys(const BlockDraft& d) {
                     " parameter); expected " + d.a_kind + " parameter: " + join(d.param_names));
     else
       error(*k, "unknown key '" + key + "' in " + d.kname + " block '" + d.spec.name +
-                    "'; expected name, kind, axes, zip, lhs" +
+                    "'; expected name, kind, axes, zip, lhs, saltelli" +
                     (d.kind == BlockKind::trajectory ? ", vertex_alpha" : "") + " or " + d.a_kind +
                     " parameter: " + join(d.param_names) + suggest_either(key, block_keys, d.other, d.other_kname));
   }

@@ -71,7 +71,8 @@ struct BlockDraft {
   std::set<std::string> axis_names;
   std::map<std::string, Pos> axis_keys;  // where each axis is written
   bool scara = true;                     // the IK problem family
-  const toml::node* lhs_node = nullptr;  // lhs = { count, seed }
+  const toml::node* lhs_node = nullptr;  // the sampled design's settings: lhs or saltelli = { count, seed }
+  std::string design = "lhs";            // which: "lhs" or "saltelli" (the key of lhs_node)
   std::optional<std::uint64_t> lhs_count, lhs_seed;
   std::vector<AxisDraft> drafts;         // the axes read so far
   std::vector<std::string> lhs_group;    // the LHS axes, once drawn
@@ -141,7 +142,8 @@ class Parser : public ParserCore {
   void check_block_dt(const BlockDraft& d, const Study& s);
 
   // block_axes.cpp: parse_block's steps for the axes, in order.
-  /// Reads lhs = { count, seed }; reports a bad or missing count or seed.
+  /// Reads the block's sampled design, lhs = { count, seed } or saltelli = { count, seed,
+  /// second_order = false }; reports a bad or missing count or seed, or both designs.
   void read_block_lhs(BlockDraft& d);
   /// Reads [block.axes]; reports axes that are not the kind's parameters (and their bad values).
   void read_axes(BlockDraft& d);
@@ -171,7 +173,7 @@ class Parser : public ParserCore {
   // axes.cpp
   /// One axis of [block.axes] (its values in stored units; LHS axes get their values later).
   std::optional<AxisDraft> parse_axis(const ParamDef& info, const toml::key& key, const toml::node& node,
-                                      const toml::node* lhs_node);
+                                      const toml::node* lhs_node, const std::string& design = "lhs");
   /// A parameter value from a node: type + choices + unit conversion + domain. nullopt on error.
   std::optional<Cell> param_value(const ParamDef& info, const toml::node& n);
   /// Check a stored numeric value's domain (expects file units for messages). Empty when fine.

@@ -1,0 +1,109 @@
+"""First-order and total Sobol' indices of the blocks a study ran as a Saltelli design (/designs,
+FORMAT.md), as `kinesweep sensitivity` computes them: Saltelli 2010's first-order estimator (centred
+on the mean over A and B) and Jansen's total one, over the sample rows whose runs all have the
+kind's good status; percentile bootstrap intervals (numpy's resampling: the same method as the
+command, other draws, so intervals agree to their sampling noise and point estimates exactly).
+
+    from kinesweep.read import open_results
+    for r in open_results("results/sensitivity_seed.h5").sensitivity(metric="E"):
+        print(r["at"], [(f["name"], f["first"], f["total"]) for f in r["factors"]])
+
+Run with Debian's /usr/bin/python3.
+"""
+import numpy as np
+
+from kinesweep.kinds import _s, text_values
+
+
+def designs(f):
+    """The /designs groups of an open h5py file: block -> dict of its attributes (FORMAT.md)."""
+    if "designs" not in f:
+        return {}
+    out = {}
+    for block, g in f["designs"].items():
+        a = g.attrs
+        out[block] = {"kind": _s(a["kind"]), "design": _s(a["design"]), "factors": [_s(x) for x in a["factors"]],
+                      "base_samples": int(a["base_samples"]), "first_run": int(a["first_run"]),
+                      "dims": [_s(x) for x in a["dims"]], "sizes": [int(x) for x in a["sizes"]], "dim": int(a["dim"])}
+    return out
+
+
+def indices(a, b, ab, bootstrap=1000, confidence=0.95, seed=1):
+    """The indices of the factors from the outputs of the sample rows (a: f(A), b: f(B), ab: d x N
+    f(AB_i)); rows with a non-finite value are left out. Returns a dict: first, total (arrays of d),
+    first_lo/first_hi/total_lo/total_hi, variance, samples, dropped."""
+    a, b, ab = np.asarray(a, float), np.asarray(b, float), np.atleast_2d(np.asarray(ab, float))
+    keep = np.isfinite(a) & np.isfinite(b) & np.all(np.isfinite(ab), axis=0)
+    a, b, ab = a[keep], b[keep], ab[:, keep]
+    d, n = ab.shape[0], a.size
+    out = {"samples": int(n), "dropped": int(keep.size - n)}
+
+    def estimate(rows):
+        ra, rb, rab = a[rows], b[rows], ab[:, rows]
+        y = np.concatenate([ra, rb])
+        v = y.var(ddof=1)
+        if not v > 0:
+            return np.full(d, np.nan), np.full(d, np.nan), v
+        return np.mean((rb - y.mean()) * (rab - ra), axis=1) / v, np.mean((ra - rab) ** 2, axis=1) / 2 / v, v
+
+    nan = np.full(d, np.nan)
+    if n < 2:
+        out.update(first=nan, total=nan, variance=np.nan, first_lo=nan, first_hi=nan, total_lo=nan, total_hi=nan)
+        return out
+    out["first"], out["total"], out["variance"] = estimate(np.arange(n))
+    q = (1 - confidence) / 2
+    if bootstrap:
+        rng = np.random.default_rng(seed)
+        s1, st = np.empty((bootstrap, d)), np.empty((bootstrap, d))
+        for r in range(bootstrap):
+            s1[r], st[r], _ = estimate(rng.integers(0, n, n))
+        out["first_lo"], out["first_hi"] = np.nanquantile(s1, q, axis=0), np.nanquantile(s1, 1 - q, axis=0)
+        out["total_lo"], out["total_hi"] = np.nanquantile(st, q, axis=0), np.nanquantile(st, 1 - q, axis=0)
+    else:
+        out.update(first_lo=nan, first_hi=nan, total_lo=nan, total_hi=nan)
+    return out
+
+
+def sensitivity(res, block=None, metric=None, bootstrap=1000, confidence=0.95, seed=1):
+    """Indices of every block with a design (or `block`) for `metric` (default: the kind's ranking
+    objective), one dict per combination of the block's other dimensions: block, kind, metric, unit,
+    at ({axis: value} of the other dimensions), base_samples, factors (names), failed_runs ({status:
+    count}), not_done, and indices()'s entries."""
+    f = res.f
+    out = []
+    for name, d in designs(f).items():
+        if block is not None and name != block:
+            continue
+        meaning = res.kind_meaning(d["kind"])
+        m = metric or meaning["ranking"][0]
+        good = meaning["good_statuses"][0]
+        sizes, dim, n, k = d["sizes"], d["dim"], d["base_samples"], len(d["factors"])
+        ids = slice(d["first_run"], d["first_run"] + int(np.prod(sizes)))
+        done = f["runs"]["done"][ids].astype(bool).reshape(sizes)
+        status = text_values(f["runs"]["status"])[ids].reshape(sizes)
+        y = np.array(f["runs"][m][ids], dtype=float).reshape(sizes)
+        others = [j for j in range(len(sizes)) if j != dim]
+        for combo in np.ndindex(*[sizes[j] for j in others]):
+            index = [slice(None)] * len(sizes)
+            for j, c in zip(others, combo):
+                index[j] = c
+            yy, st, dn = y[tuple(index)], status[tuple(index)], done[tuple(index)]
+            failed = dn & (st != good)
+            values = np.where(dn & ~failed, yy, np.nan)
+            at = {}
+            full = [0] * len(sizes)  # the combination's first run: design point 0
+            for j, c in zip(others, combo):
+                full[j] = c
+            first = d["first_run"] + int(np.ravel_multi_index(tuple(full), sizes))
+            for j in others:
+                for axis in d["dims"][j].split("+"):
+                    col = f["runs"][axis]
+                    v = text_values(col)[first] if col.dtype.kind not in "fiu" or "flag_meanings" in col.attrs else col[first]
+                    at[axis] = v.item() if hasattr(v, "item") else v
+            r = {"block": name, "kind": d["kind"], "metric": m, "unit": _s(f["runs"][m].attrs.get("unit", "")), "at": at,
+                 "base_samples": n, "factors": d["factors"], "not_done": int((~dn).sum()),
+                 "failed_runs": {s: int(c) for s, c in zip(*np.unique(st[failed], return_counts=True))}}
+            r.update(indices(values[:n], values[n:2 * n], values[2 * n:].reshape(k, n), bootstrap, confidence, seed))
+            out.append(r)
+    return out
+

@@ -1,0 +1,66 @@
+// /designs (FORMAT.md): the blocks run as a Saltelli design, written with the file and read back.
+#include <hdf5.h>
+
+#include "store/h5util.hpp"
+#include "store/reader_impl.hpp"
+#include "store/store.hpp"
+
+namespace ks::store {
+namespace detail {
+
+void write_designs(hid_t file, const std::vector<DesignMeta>& designs, const std::string& path) {
+  if (designs.empty()) return;
+  Hid root(check(H5Gcreate2(file, "designs", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /designs"));
+  for (const DesignMeta& d : designs) {
+    Hid g(check(H5Gcreate2(root, d.block.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /designs/" + d.block));
+    write_str_attr(g, "kind", d.kind);
+    write_str_attr(g, "design", d.design);
+    write_str_list_attr(g, "factors", d.factors);
+    write_i64_attr(g, "base_samples", d.base_samples);
+    write_i64_attr(g, "first_run", d.first_run);
+    write_str_list_attr(g, "dims", d.dims);
+    write_i64_list_attr(g, "sizes", d.sizes);
+    write_i64_attr(g, "dim", d.dim);
+  }
+}
+
+}  // namespace detail
+
+using namespace detail;
+
+namespace {
+herr_t collect(hid_t, const char* name, const H5L_info_t*, void* out) {
+  static_cast<std::vector<std::string>*>(out)->emplace_back(name);
+  return 0;
+}
+}  // namespace
+
+std::vector<DesignMeta> ResultsReader::designs() const {
+  QuietHdf5 quiet;
+  std::vector<DesignMeta> out;
+  if (!link_exists(impl_->file, "designs")) return out;
+  Hid root(check(H5Gopen2(impl_->file, "designs", H5P_DEFAULT), impl_->path, "open /designs"));
+  std::vector<std::string> names;
+  H5Literate(root, H5_INDEX_NAME, H5_ITER_INC, nullptr, collect, &names);
+  for (const std::string& name : names) {
+    Hid g(check(H5Gopen2(root, name.c_str(), H5P_DEFAULT), impl_->path, "open /designs/" + name));
+    DesignMeta d;
+    d.block = name;
+    d.kind = read_str_attr(g, "kind");
+    d.design = read_str_attr(g, "design");
+    d.factors = read_str_list_attr(g, "factors");
+    d.base_samples = read_i64_attr(g, "base_samples", 0);
+    d.first_run = read_i64_attr(g, "first_run", 0);
+    d.dims = read_str_list_attr(g, "dims");
+    d.sizes = read_i64_list_attr(g, "sizes");
+    d.dim = read_i64_attr(g, "dim", 0);
+    if (d.dims.size() != d.sizes.size() || d.dim < 0 || static_cast<std::size_t>(d.dim) >= d.dims.size() ||
+        d.base_samples < 1 || d.sizes[static_cast<std::size_t>(d.dim)] !=
+                                  d.base_samples * static_cast<std::int64_t>(d.factors.size() + 2))
+      throw StoreError(impl_->path, "/designs/" + name + " is inconsistent (dims, sizes, dim, base_samples, factors)");
+    out.push_back(std::move(d));
+  }
+  return out;
+}
+
+}  // namespace ks::store
