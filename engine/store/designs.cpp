@@ -1,5 +1,7 @@
-// /designs (FORMAT.md): the blocks run as a Saltelli design, written with the file and read back.
+// /designs (FORMAT.md): the blocks run as a Saltelli design, written with the file and read back; and
+// the dimension scale of /runs.
 #include <hdf5.h>
+#include <hdf5_hl.h>  // H5DS: dimension scales
 
 #include "store/h5util.hpp"
 #include "store/reader_impl.hpp"
@@ -7,6 +9,19 @@
 
 namespace ks::store {
 namespace detail {
+
+void attach_run_scale(hid_t runs, const std::string& path) {
+  if (!link_exists(runs, "run_id")) return;  // (a table without run ids: tests of the store)
+  Hid id(check(H5Dopen2(runs, "run_id", H5P_DEFAULT), path, "open /runs/run_id"));
+  if (H5DSset_scale(id, "run_id") < 0) throw StoreError(path, "cannot make /runs/run_id a dimension scale");
+  for (const std::string& name : read_str_list_attr(runs, "columns")) {
+    if (name == "run_id") continue;
+    Hid d(check(H5Dopen2(runs, name.c_str(), H5P_DEFAULT), path, "open /runs/" + name));
+    if (H5DSattach_scale(d, id, 0) < 0) throw StoreError(path, "cannot attach run_id to /runs/" + name);
+  }
+  Hid done(check(H5Dopen2(runs, "done", H5P_DEFAULT), path, "open /runs/done"));
+  if (H5DSattach_scale(done, id, 0) < 0) throw StoreError(path, "cannot attach run_id to /runs/done");
+}
 
 void write_designs(hid_t file, const std::vector<DesignMeta>& designs, const std::string& path) {
   if (designs.empty()) return;

@@ -115,6 +115,10 @@ bool link_exists(hid_t loc, const std::string& path);
 /// column cannot be opened, or (roles_stored) has no valid role attribute or no kinds attribute.
 std::vector<ColumnSpec> read_run_columns(hid_t file, const std::string& path, std::int64_t& n_runs,
                                          bool roles_stored);
+/// Makes /runs/run_id the dimension scale of every other /runs dataset (netCDF readers such as
+/// xarray then see one dimension, run_id, with the run ids as its coordinate); nothing when /runs
+/// has no run_id column (designs.cpp).
+void attach_run_scale(hid_t runs, const std::string& path);
 /// Writes /designs/<block> for each of `designs` (none: no /designs) (designs.cpp).
 void write_designs(hid_t file, const std::vector<DesignMeta>& designs, const std::string& path);
 /// Causes of StoreErrors that re-reading cannot cure (the reader gives up at once on them).

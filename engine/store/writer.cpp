@@ -177,6 +177,7 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
                         "values whose done flag was not committed before a crash; resume rewrites it)",
                         Role::bookkeeping, ""};
   make(done, H5T_STD_U8LE, H5T_NATIVE_UINT8, &zero, "u8");
+  attach_run_scale(runs, path);
 
   if (!meta.kinds.empty()) {
     Hid kinds(check(H5Gcreate2(file, "kinds", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /kinds"));
