@@ -109,6 +109,17 @@ class Axis:
     def categorical(self):
         return self.labels is not None
 
+    @property
+    def sampled(self):
+        """The points of a design, which no grid or heatmap can draw: a dimension of several axes
+        advancing together ("a+b", an LHS group or a zip) whose values are not monotonic, or numeric
+        values that repeat (a Saltelli design). A single random axis is a grid axis (sorted)."""
+        if self.categorical or len(self.values) < 2:
+            return False
+        v = np.asarray(self.values, dtype=float)
+        d = np.diff(v)
+        return len(np.unique(v)) < len(v) or ("+" in self.name and not (np.all(d > 0) or np.all(d < 0)))
+
     def __repr__(self):
         return f"Axis({self.name!r}, {self.unit!r}, {len(self.values)} values)"
 

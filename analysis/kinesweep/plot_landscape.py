@@ -103,7 +103,8 @@ def usage_exit(msg):
 
 
 def numeric_axes(ls):
-    return [a.name for a in ls.axes if not a.categorical and len(a.values) > 1]
+    """The axes a grid can be drawn over: numeric, swept, monotonic (not a design's sampled points)."""
+    return [a.name for a in ls.axes if not a.categorical and len(a.values) > 1 and not a.sampled]
 
 
 def choose_block(res, block):
@@ -119,7 +120,9 @@ def choose_block(res, block):
         if len(numeric_axes(res.landscape(b))) >= 2:
             return b
     axes = "; ".join(f"{b}: {', '.join(a.name for a in res.landscape(b).axes) or 'no axis'}" for b in names)
-    raise SystemExit(f"plot_landscape: {res.path}: no landscape has two swept numeric axes to plot ({axes})")
+    raise SystemExit(f"plot_landscape: {res.path}: no landscape has two swept numeric axes to plot ({axes}); "
+                     "a dimension of sampled points (LHS, zipped random draws, Saltelli) is not a grid axis: "
+                     "analysis/plot_runs.py draws such runs as points")
 
 
 def reduce_grid(ls, args):

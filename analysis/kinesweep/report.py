@@ -100,6 +100,8 @@ def grid_sections(res, cap_total):
     land = "".join(_landscape_html(i, ls, cap) for i, ls in enumerate(lss))
     basins = []
     for i, ls in enumerate(ik):
+        if _sampled_note(ls):
+            continue
         out = basins_figure(res, ls, cap)
         if out is not None:
             fig, caption, _ = out
@@ -107,7 +109,22 @@ def grid_sections(res, cap_total):
     return land, "".join(basins)
 
 
+def _sampled_note(ls):
+    """For a landscape with a dimension of sampled points (not grid lines): why none is drawn."""
+    sampled = [a.name for a in ls.axes if a.sampled]
+    if not sampled:
+        return ""
+    return (f"<h3>Block {esc(ls.block)} ({esc(ls.kind)})</h3><p class=\"caption\">No landscape: its dimension "
+            f"{esc(', '.join(sampled))} holds sampled points (a Latin hypercube, zipped random draws or a Saltelli "
+            "design), "
+            "not grid lines. analysis/plot_runs.py draws such runs as points; a Saltelli design's indices are in "
+            "the sensitivity section.</p>")
+
+
 def _landscape_html(i, ls, cap):
+    note = _sampled_note(ls)
+    if note:
+        return note
     out = landscape_figure(ls, cap)
     if out is None:  # a block without swept axes: one run, in the tables
         return ""

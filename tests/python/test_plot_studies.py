@@ -106,13 +106,23 @@ def file_blocks(f):
 
 
 def landscape_axes(g):
-    """[(name, categorical, n values)] of a /landscapes group."""
-    return [(h5str(a), h5str(g[h5str(a)].attrs.get("unit", "")).startswith("labels:"), len(g[h5str(a)]))
-            for a in g.attrs["axes"]]
+    """[(name, categorical, n values, sampled)] of a /landscapes group; sampled: the points of a design,
+    which no plot draws a grid over: a group of axes ("a+b") whose values are not monotonic, or
+    repeated values (a Saltelli design)."""
+    out = []
+    for a in g.attrs["axes"]:
+        d = g[h5str(a)]
+        cat = h5str(d.attrs.get("unit", "")).startswith("labels:")
+        v = d[()].astype(float)
+        steps = np.diff(v)
+        sampled = not cat and len(v) > 1 and (len(np.unique(v)) < len(v) or (
+            "+" in h5str(a) and not (np.all(steps > 0) or np.all(steps < 0))))
+        out.append((h5str(a), cat, len(d), sampled))
+    return out
 
 
 def numeric(axes):
-    return [n for n, cat, size in axes if not cat and size > 1]
+    return [n for n, cat, size, sampled in axes if not cat and size > 1 and not sampled]
 
 
 def ordered_landscapes(f):
@@ -214,7 +224,7 @@ class PlotStudiesTest(unittest.TestCase):
             g = f["landscapes"][first]
             ik = "converged" in g
             x, y = numeric(axes[first])[:2]
-            rest = [(n, cat, size) for n, cat, size in axes[first] if n not in (x, y) and size > 1]
+            rest = [(n, cat, size) for n, cat, size, _ in axes[first] if n not in (x, y) and size > 1]
             facet = len(rest) == 1 and rest[0][1] and rest[0][2] <= 6
             rc, d, err = self.plot("plot_landscape.py", h5, expect_ok=ik or facet or not rest)
             if rc == 2:

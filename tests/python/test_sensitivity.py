@@ -3,7 +3,8 @@ order, centred) and Jansen (total) estimators computed here with numpy from the 
 reads (the design's matrices found from /designs); runs with a failed status counted by status;
 its errors (no design, an unknown metric) and the study parser's (two designs in a block, second
 order asked for, an axis of a design the block lacks). kinesweep.read's sensitivity() gives the
-command's point estimates. And the shipped studies/sensitivity_seed.toml:
+command's point estimates. The report and plot_landscape draw no grid over a design's sampled
+points (examples_lhs and the Saltelli study). And the shipped studies/sensitivity_seed.toml:
 its indices of E and tau_inf contain those of a brute-force variance decomposition of the same
 function on a 40^3 grid of cell midpoints over the same ranges.
 
@@ -202,6 +203,34 @@ class Sensitivity(TempDirTest):
             for i, fac in enumerate(e["factors"]):
                 self.assertAlmostEqual(bar["y"][i], fac[key], delta=1e-5)
                 self.assertAlmostEqual(bar["y"][i] + bar["error_y"]["array"][i], fac[key + "_hi"], delta=0.05)
+
+
+    def test_no_grid_is_drawn_over_sampled_points(self):
+        """examples_lhs (a Latin hypercube, random initial guesses) and the Saltelli study: the report
+        draws no heatmap over a dimension of sampled points (every heatmap's x and y are monotonic)
+        and says why; plot_landscape refuses with the reason."""
+        for study in ("examples_lhs.toml", "sensitivity_seed.toml"):
+            out = os.path.join(self.dir, study.replace(".toml", ".h5"))
+            self.assertEqual(run("run", os.path.join(SOURCE, "studies", study), "-o", out, "-q").returncode, 0)
+            page = os.path.join(self.dir, "page.html")
+            r = subprocess.run(["/usr/bin/python3", os.path.join(SOURCE, "analysis", "report.py"), out, "-o", page],
+                               capture_output=True, text=True, timeout=300)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            html = open(page, encoding="utf-8").read()
+            self.assertIn("holds sampled points", html)
+            for fid, data in re.findall(r'<script type="application/gzip" id="([^"]+-data)">([^<]*)</script>', html):
+                fig = json.loads(gzip.decompress(base64.b64decode(data)))
+                for trace in fig.get("data", []) if isinstance(fig, dict) else []:
+                    if trace.get("type") != "heatmap":
+                        continue
+                    for key in ("x", "y"):
+                        v = [x for x in trace.get(key, []) if isinstance(x, (int, float))]
+                        d = np.diff(v)
+                        self.assertTrue(len(v) < 2 or np.all(d > 0) or np.all(d < 0), f"{study} {fid} {key}")
+            r = subprocess.run(["/usr/bin/python3", os.path.join(SOURCE, "analysis", "plot_landscape.py"), out, "-o",
+                                os.path.join(self.dir, "p.png")], capture_output=True, text=True, timeout=300)
+            self.assertEqual(r.returncode, 1)
+            self.assertIn("is not a grid axis", r.stderr)
 
 
 if __name__ == "__main__":
