@@ -2,7 +2,8 @@
 //
 // Each block's runs are sampled along a golden-ratio sequence of its run indices (any prefix is spread
 // over the block), executed and encoded as the sweep does (compute time and history bytes per run),
-// then all samples are written through the store into a temporary results file: its size beyond a
+// then all samples are written through the store into a temporary results file (its landscapes, one
+// f64 per cell and metric, are added from the blocks' grids): its size beyond a
 // file of one empty row gives the bytes per run on disk (rows, history objects, index), and the
 // writer's time the serial cost per run. The sweep overlaps computing (all threads) with the single
 // writer, so its time is about max((compute + write) / threads, write).
@@ -23,6 +24,7 @@
 
 #include "methods/trajectory_lanes.hpp"
 #include "runner/execute.hpp"
+#include "runner/landscape.hpp"
 #include "runner/run_study.hpp"
 #include "store/store.hpp"
 
@@ -197,6 +199,10 @@ int dry_run(const Study& study, const StudySchema& schema, const DryRunOptions& 
   const double overhead_per_run = std::max(0.0, full.bytes - empty.bytes - full.history_bytes) / n_rows;
   double bytes = empty.bytes;
   for (std::size_t b = 0; b < est.size(); ++b) bytes += static_cast<double>(est[b].runs) * (est[b].history_bytes + overhead_per_run);
+  // The landscapes (not in the sample files): one f64 per cell and gridded metric, allocated whole.
+  for (const Block& block : study.blocks)
+    if (const LandscapeGrid grid(block); grid.enabled())
+      bytes += static_cast<double>(block.run_count()) * static_cast<double>(grid.spec().metrics.size()) * sizeof(double);
   // The writer's time per run: the slope between the half and the full file (a new file's first
   // rows cost more: its index and chunks are being allocated).
   const double write_per_run = rows >= 2 ? std::max(0.0, full.seconds - half.seconds) / (n_rows - rows / 2)
