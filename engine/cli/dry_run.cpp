@@ -65,6 +65,32 @@ std::vector<std::uint64_t> spread_indices(std::uint64_t n, std::size_t max) {
 
 /// Seconds since this process started (Linux: /proc; 0 elsewhere): what a run spends before its sweep
 /// (loading, MPI probing, parsing the study), which the dry run spent too.
+/// `picks` as batches of up to `lanes` runs that can share SIMD lanes, as the sweep's consecutive
+/// runs mostly can: each batch opens with the next pick not taken, in the spread order, and takes the
+/// later picks lane-compatible with it (same inertia form and lane options; other runs: one a batch
+/// slot as in the sweep, which runs them one at a time).
+std::vector<std::vector<std::uint64_t>> lane_batches(const Block& block, const std::vector<std::uint64_t>& picks,
+                                                     int lanes) {
+  std::vector<RunSpec> runs;
+  for (std::uint64_t p : picks) runs.push_back(block.run(p));
+  std::vector<std::vector<std::uint64_t>> out;
+  std::vector<char> used(picks.size(), 0);
+  const std::size_t width = static_cast<std::size_t>(std::max(1, lanes));
+  for (std::size_t i = 0; i < picks.size(); ++i) {
+    if (used[i]) continue;
+    const auto* a = std::get_if<TrajectoryRun>(&runs[i]);
+    out.emplace_back();
+    for (std::size_t j = i; j < picks.size() && out.back().size() < width; ++j) {
+      const auto* b = std::get_if<TrajectoryRun>(&runs[j]);
+      const bool shares = a && b && b->inertia == a->inertia && lane_compatible(a->options, b->options);
+      if (used[j] || (j != i && a && !shares)) continue;  // (runs without lanes: any, in order)
+      used[j] = 1;
+      out.back().push_back(picks[j]);
+    }
+  }
+  return out;
+}
+
 double seconds_since_process_start() {
   std::ifstream stat("/proc/self/stat"), uptime("/proc/uptime");
   std::string text;
@@ -142,11 +168,10 @@ int dry_run(const Study& study, const StudySchema& schema, const DryRunOptions& 
     // The samples run in batches of `lanes`, as the sweep's workers run them (execute_batch).
     const auto start = Clock::now();
     double compute = 0;
-    const std::vector<std::uint64_t> picks = spread_indices(block.run_count(), 64);
-    for (std::size_t first = 0; first < picks.size(); first += static_cast<std::size_t>(lanes)) {
+    for (const std::vector<std::uint64_t>& picks : lane_batches(block, spread_indices(block.run_count(), 64), lanes)) {
       if (est[b].sampled >= 4 && std::chrono::duration<double>(Clock::now() - start).count() > opt.seconds_per_block)
         break;
-      const std::size_t n = std::min(picks.size() - first, static_cast<std::size_t>(lanes));
+      const std::size_t n = picks.size(), first = 0;
       std::vector<RunSpec> runs;
       for (std::size_t i = 0; i < n; ++i) runs.push_back(block.run(picks[first + i]));
       std::vector<RunOutcome> outcomes(n);
