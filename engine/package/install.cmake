@@ -54,6 +54,8 @@ install(CODE "
        FILES_MATCHING PATTERN \"*.py\" PATTERN \"__pycache__\" EXCLUDE)
 ")
 install(FILES ${PROJECT_SOURCE_DIR}/analysis/README.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/kinesweep RENAME analysis.md)
+install(FILES ${PROJECT_SOURCE_DIR}/engine/store/FORMAT.md ${PROJECT_SOURCE_DIR}/README.md
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/kinesweep)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/studies/ DESTINATION ${CMAKE_INSTALL_DATADIR}/kinesweep/studies)
 
 # Man page from --help of the program and of each subcommand.

@@ -90,7 +90,7 @@ class Install(unittest.TestCase):
                     "lib/cmake/kinesweep/kinesweepConfig.cmake", "lib/cmake/kinesweep/kinesweepTargets.cmake",
                     "share/man/man1/kinesweep.1", "share/bash-completion/completions/kinesweep",
                     "share/kinesweep/studies/thesis_table4.toml", "share/kinesweep/studies/robots/arm7.urdf",
-                    "share/doc/kinesweep/analysis.md",
+                    "share/doc/kinesweep/analysis.md", "share/doc/kinesweep/FORMAT.md", "share/doc/kinesweep/README.md",
                     os.path.join(python_dir(), "kinesweep", "__init__.py"),
                     os.path.join(python_dir(), "kinesweep", "plot_landscape.py")]:
             self.assertTrue(os.path.exists(os.path.join(PREFIX, rel)), rel)
@@ -139,7 +139,8 @@ class Install(unittest.TestCase):
                    PAGER="cat")
         text = run(["man", "kinesweep"], env=env).stdout
         self.assertIn("kinesweep", text)
-        for sub in ("COMMAND RUN", "COMMAND QUERY", "--where", "--group-by", "--dry-run"):
+        for sub in ("COMMAND RUN", "COMMAND QUERY", "COMMAND SENSITIVITY", "--bootstrap", "--where", "--group-by",
+                    "--dry-run", "share/doc/kinesweep/FORMAT.md"):
             self.assertIn(sub, text)
 
     def complete(self, *words):
