@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   ks::cli::RunArgs& run = ks::cli::add_run_command(app);
   run.program = ks::command_name(argc > 0 ? argv[0] : "");
+  for (int i = 0; i < argc; ++i) ks::process_command_line() += (i ? " " : "") + ks::shell_word(argv[i]);
   ks::cli::InfoArgs& info = ks::cli::add_info_command(app);
   ks::cli::QueryArgs& query = ks::cli::add_query_command(app);
   ks::cli::SchemaArgs& schema = ks::cli::add_schema_command(app);

@@ -20,4 +20,11 @@ inline std::string command_name(const std::string& argv0) {
   return argv0.find('/') == std::string::npos ? std::string("kinesweep") : shell_word(argv0);
 }
 
+/// The command line this process was started with, as shell words (set once by main; "" until then):
+/// results files record it (root attribute command_line).
+inline std::string& process_command_line() {
+  static std::string line;
+  return line;
+}
+
 }  // namespace ks

@@ -86,6 +86,7 @@ store::StoreMeta store_meta(const Study& study, const HistoryPolicy& histories) 
   meta.histories = histories.str();
   meta.kinds = kind_meta(study);
   meta.designs = design_meta(study);
+  meta.command_line = process_command_line();
   meta.study_name = study.name;
   meta.study_path = study.file;
   meta.study_text = study.text;

@@ -85,6 +85,8 @@ struct StoreMeta {
   std::string robot_text;    ///< its text verbatim (/study/robot; written only when non-empty)
   std::string engine_version = KINESWEEP_VERSION;
   std::string created;       ///< ISO 8601 UTC; filled at creation when empty
+  std::string command_line;  ///< the command that created the file (root attribute "command_line"; "" when none)
+  std::string host;          ///< the machine it ran on (root attribute "host"); filled at creation when empty
   /// The history policy the runs are written with (root attribute "histories": full, every=N or
   /// none; written when not empty; "" in files from before it was recorded).
   std::string histories;

@@ -102,6 +102,10 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
   write_str_attr(file, "created", meta.created.empty() ? now_iso8601() : meta.created);
   write_str_attr(file, "study_name", meta.study_name);
   if (!meta.histories.empty()) write_str_attr(file, "histories", meta.histories);
+  if (!meta.command_line.empty()) write_str_attr(file, "command_line", meta.command_line);
+  char host[256] = {};
+  if (meta.host.empty() && ::gethostname(host, sizeof host - 1) != 0) host[0] = 0;
+  write_str_attr(file, "host", meta.host.empty() ? std::string(host) : meta.host);
 
   Hid study(check(H5Gcreate2(file, "study", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path, "create /study"));
   write_str_attr(study, "path", meta.study_path);

@@ -8,6 +8,7 @@ import os
 import random
 import re
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -154,6 +155,8 @@ class Reproducibility(Base):
             text = f["study"]["text"][()]
             self.assertEqual(text.decode() if isinstance(text, bytes) else text, SWEEP)
             self.assertIn("engine_version", f.attrs)
+            self.assertEqual(f.attrs["command_line"], " ".join([KS, "run", study, "-o", out, "-q"]))
+            self.assertEqual(f.attrs["host"], socket.gethostname())
             self.assertTrue(all(s in ("ok", "diverged", "singular", "unreachable_start", "off_path") for s in table["status"][:561]))
             E = table["E"][:561]
             ok = table["status"][:561] == "ok"
