@@ -1,5 +1,6 @@
 """IK basins for analysis/report.py: each cell of an IK block's grid of initial guesses coloured by the
-solution its run converged to (the converged final iterates named by kssolutions.cluster_solutions),
+solution its run converged to (named as /runs' solution column names them, where the engine names the
+solutions; else the converged final iterates named by kssolutions.cluster_solutions),
 failed runs in their status colours; hover with the iterations and status. Run with /usr/bin/python3."""
 import numpy as np
 
@@ -52,7 +53,16 @@ def basins_figure(res, ls, cap):
     if len(rows) != int(np.prod(shape)) or not qcols:
         return None
     revolute = [u == "rad" for u in units]
-    labels = cluster_solutions(q, revolute, CLUSTER_TOLERANCE)
+    # The solutions as /runs names them (the engine's index of the known solution reached, as
+    # plot_basins shows them); clusters of the final iterates where the engine names none.
+    labels, named_by = None, "named by kssolutions.cluster_solutions"
+    if "solution" in ls.metrics:
+        s = np.asarray(ls.metrics["solution"], dtype=float).ravel()
+        if s.size == len(rows) and np.isfinite(s).any():
+            labels = np.where(np.isfinite(s) & np.all(np.isfinite(q), axis=1), s, -1).astype(int)
+            named_by = "named as the solution column of /runs names them"
+    if labels is None:
+        labels = cluster_solutions(q, revolute, CLUSTER_TOLERANCE)
     n_sol = int(labels.max(initial=-1)) + 1
     continuum, n_all = "", n_sol
     if n_sol > len(SOLUTION_COLOURS):
@@ -70,7 +80,7 @@ def basins_figure(res, ls, cap):
     # The largest clusters get their own colours (in order of first appearance); the rest share one.
     named = sorted(np.argsort(-counts, kind="stable")[:len(SOLUTION_COLOURS)].tolist()) if n_sol else []
     other = n_sol > len(named)
-    classes = [f"solution {k + 1}" for k in range(len(named))] + (["other solutions"] if other else [])
+    classes = [f"solution {s}" for s in named] + (["other solutions"] if other else [])
     colours = SOLUTION_COLOURS[:len(named)] + ([OTHER_COLOUR] if other else [])
     texts = [solution_text(q[labels == s], qcols, units) for s in named]
     code = np.full(len(labels), np.nan)
@@ -135,9 +145,10 @@ def basins_figure(res, ls, cap):
     layout["legend"] = {"orientation": "h", "y": -0.16, "x": 0, "font": {"size": 11}}
     layout["height"] = 520 + 22 * ((len(used) + 1) // 2)
     cap_text = (f"Basins of attraction of block {esc(ls.block)} over the initial guesses {esc(xa.name)} × "
-                f"{esc(ya.name)}: each cell is coloured by the solution its run converged to ({n_all} distinct "
-                f"final iterates within {CLUSTER_TOLERANCE:g} in the max-norm, angles mod 360°, named by "
-                "kssolutions.cluster_solutions)" + (f"; the {len(named)} largest have their own colour, the other "
+                f"{esc(ya.name)}: each cell is coloured by the solution its run converged to ("
+                + (f"{n_all} solutions reached, {named_by}" if "runs" in named_by else
+                   f"{n_all} distinct final iterates within {CLUSTER_TOLERANCE:g} in the max-norm, angles mod 360°, "
+                   f"{named_by}") + ")" + (f"; the {len(named)} largest have their own colour, the other "
                                                     f"{n_sol - len(named)} are grey" if other else "")
                 + "; failed runs in their status colours." + continuum + " Hover a cell for its iterations and status.")
     more = sel.caption().replace("held at the best cell (not reduced)", "held at their first value")

@@ -193,7 +193,8 @@ class Sensitivity(TempDirTest):
         r = subprocess.run(["/usr/bin/python3", os.path.join(SOURCE, "analysis", "report.py"), out, "-o", page],
                            capture_output=True, text=True, timeout=300)
         self.assertEqual(r.returncode, 0, r.stderr)
-        html = open(page, encoding="utf-8").read()
+        with open(page, encoding="utf-8") as fh:
+            html = fh.read()
         island = re.search(r'<script type="application/gzip" id="sensitivity-0-data">([^<]*)</script>', html)
         self.assertIsNotNone(island)
         fig = json.loads(gzip.decompress(base64.b64decode(island.group(1))))
@@ -216,7 +217,8 @@ class Sensitivity(TempDirTest):
             r = subprocess.run(["/usr/bin/python3", os.path.join(SOURCE, "analysis", "report.py"), out, "-o", page],
                                capture_output=True, text=True, timeout=300)
             self.assertEqual(r.returncode, 0, r.stderr)
-            html = open(page, encoding="utf-8").read()
+            with open(page, encoding="utf-8") as fh:
+                html = fh.read()
             self.assertIn("holds sampled points", html)
             for fid, data in re.findall(r'<script type="application/gzip" id="([^"]+-data)">([^<]*)</script>', html):
                 fig = json.loads(gzip.decompress(base64.b64decode(data)))
