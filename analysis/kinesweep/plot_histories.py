@@ -16,6 +16,7 @@ from kinesweep import plotting as ksplot  # noqa: E402
 from kinesweep import read as ksread  # noqa: E402
 
 NAMES = {"tau": "τ", "q": "q", "qd": "q̇", "qdd": "q̈"}
+MAX_COLS = 4  # panels per row of one array's components
 
 
 def parse_args(argv=None):
@@ -82,8 +83,18 @@ def main(argv=None):
         label[r] = f"run {r}" + (f" ({', '.join(what)})" if what else "")
 
     plt, size = ksplot.figure(args)
-    ncols = max(hist[ids[0]][w].shape[1] for w in whats)
-    fig, axes = plt.subplots(len(whats), ncols, figsize=size, squeeze=False, sharex=True, constrained_layout=True)
+    # Each array's components in rows of at most MAX_COLS panels (a 7-joint arm: 4 + 3); the legend
+    # in an empty panel slot when there is one.
+    comps = [max(hist[r][w].shape[1] for r in ids) for w in whats]
+    ncols = min(MAX_COLS, max(comps))
+    first_row = np.cumsum([0] + [-(-c // ncols) for c in comps])
+    fig, grid = plt.subplots(int(first_row[-1]), ncols, figsize=size, squeeze=False, sharex=True, constrained_layout=True)
+    axes = [[grid[first_row[wi] + j // ncols][j % ncols] for j in range(c)] for wi, c in enumerate(comps)]
+    used = {id(ax) for row in axes for ax in row}
+    for row in grid:
+        for ax in row:
+            if id(ax) not in used:
+                ax.set_visible(False)
     data = {}
     for r in ids:
         h = hist[r]
@@ -96,18 +107,29 @@ def main(argv=None):
                 ax.plot(t, h[w][:, j], lw=1.1, label=label[r])
                 ax.set_title(f"{NAMES.get(w, w)}{j + 1}", fontsize=9)
                 u = units[j] if len(units) == h[w].shape[1] else units[0]
-                if j == 0:
+                if j % ncols == 0:
                     ax.set_ylabel(f"{NAMES.get(w, w)} [{u}]")
                 ax.grid(alpha=0.3)
             data[r][w] = h[w]
-    for ax in axes[-1]:
-        ax.set_xlabel("t [s]")
-    axes[0][0].legend(fontsize=7)
+    for c in range(ncols):  # the lowest panel of each column shows the time axis
+        column = [grid[r][c] for r in range(grid.shape[0]) if id(grid[r][c]) in used]
+        if column:
+            column[-1].set_xlabel("t [s]")
+            column[-1].xaxis.set_tick_params(labelbottom=True)
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    spare = [ax for row in grid for ax in row if id(ax) not in used]
+    if spare:  # an empty panel slot holds the legend, clear of the data
+        spare[-1].set_visible(True)
+        spare[-1].axis("off")
+        spare[-1].legend(handles, labels, loc="center", fontsize=7)
+    else:
+        axes[0][0].legend(fontsize=7, loc="best")
     title = args.title or (f"{', '.join(NAMES.get(w, w) for w in whats)} against time, "
                            f"{'runs ' + ', '.join(map(str, ids)) if differ else '; '.join(label[r] for r in ids)}"
                            f"\n{os.path.basename(args.file)}")
     fig.suptitle(title, fontsize=10)
-    return ksplot.finish(fig, args, "histories", {"file": args.file, "runs": data})
+    return ksplot.finish(fig, args, "histories", {"file": args.file, "runs": data, "panels": {
+        "rows": int(first_row[-1]), "cols": ncols, "legend_apart": bool(spare)}})
 
 
 if __name__ == "__main__":

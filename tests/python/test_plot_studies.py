@@ -257,6 +257,12 @@ class PlotStudiesTest(unittest.TestCase):
         rc, d, err = self.plot("plot_histories.py", h5, expect_ok=bool(traj))
         if traj:
             self.assertEqual(sorted(int(r) for r in d["runs"]), sorted(traj)[:3])
+            # at most 4 panels a row (the 7-DOF arm: 4 + 3), the legend in a panel of its own when one is free
+            joints = int(f["runs"]["tau_inf"].attrs.get("joints", 0)) or max(
+                len(d["runs"][r]["tau"][0]) for r in d["runs"])
+            self.assertEqual(d["panels"]["cols"], min(4, joints))
+            self.assertEqual(d["panels"]["rows"], -(-joints // 4))
+            self.assertEqual(d["panels"]["legend_apart"], joints % 4 != 0 and joints > 4)
             drawn.append("plot_histories.py")
         else:
             self.assertNotEqual(rc, 0)
