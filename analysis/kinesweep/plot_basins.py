@@ -233,7 +233,7 @@ def main(argv=None):
         plt, size = ksplot.figure(args)
     fig, axes = plt.subplots(nrows, ncols, figsize=size, squeeze=False, sharex=True, sharey=True)
     h_in = size[1]
-    fig.subplots_adjust(left=0.08 if nrows > 1 else 0.06, right=0.9, bottom=min(0.3, 1.2 / h_in),
+    fig.subplots_adjust(left=0.08 if nrows > 1 else 0.06, right=0.85, bottom=min(0.3, 1.2 / h_in),
                         top=1 - min(0.2, 0.8 / h_in), wspace=0.06, hspace=0.25 if nrows > 1 else 0.2)
     xlog = not xa.categorical and ksplot.is_log_spaced(xa.values)
     ylog = not ya.categorical and ksplot.is_log_spaced(ya.values)
@@ -288,11 +288,16 @@ def main(argv=None):
                for (k, s) in sorted(k for k in used if k[0] == "sol")]
     handles += [Patch(color=FAIL_COLOURS.get(s, "#ffffff"), label=f"{s} ({used[(k, s)]} cells)", ec="0.4")
                 for (k, s) in sorted(k for k in used if k[0] == "fail")]
-    fig.legend(handles=handles, loc="lower center", ncol=min(3, len(handles)), fontsize=8, frameon=False)
+    # long entries (a solution's joint values) one a line, so that none runs off the figure; the
+    # panels' bottom leaves the legend's lines free
+    ncol = 1 if max((len(h.get_label()) for h in handles), default=0) > 40 else min(3, max(1, len(handles)))
+    lines = -(-len(handles) // ncol)
+    fig.subplots_adjust(bottom=min(0.45, (0.75 + 0.17 * lines) / h_in))
+    fig.legend(handles=handles, loc="lower center", ncol=ncol, fontsize=8, frameon=False)
     sm = plt.cm.ScalarMappable(norm=shade_norm, cmap=mcolors.LinearSegmentedColormap.from_list(
         "shade", [(0.25, 0.25, 0.25), (0.8125, 0.8125, 0.8125)]))
     pos0, pos1 = axes[0][-1].get_position(), axes[-1][-1].get_position()
-    cb = fig.colorbar(sm, cax=fig.add_axes([0.915, pos1.y0, 0.015, pos0.y1 - pos1.y0]))
+    cb = fig.colorbar(sm, cax=fig.add_axes([0.87, pos1.y0, 0.015, pos0.y1 - pos1.y0]))
     cb.set_label("iterations to converge (shade: pale = many)")
     ksplot.log_colorbar_ticks(cb, shade_norm.vmin, shade_norm.vmax)
     title = args.title or (f"IK basins of attraction over ({xa.name}, {ya.name}) — block {ls.block}"
