@@ -163,6 +163,23 @@ def run_study_text(ks, directory, name, text, *args):
     return out
 
 
+def report_page(test, results, directory):
+    """analysis/report.py on `results` (the test fails unless it exits 0): the page's html and its
+    figures' data islands, id -> the JSON text (gzip and base64 undone)."""
+    import base64
+    import gzip
+    import re
+    page = os.path.join(directory, "report.html")
+    script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis", "report.py")
+    r = subprocess.run(["/usr/bin/python3", script, results, "-o", page], capture_output=True, text=True, timeout=300)
+    test.assertEqual(r.returncode, 0, r.stderr)
+    with open(page, encoding="utf-8") as fh:
+        html = fh.read()
+    islands = {fid: gzip.decompress(base64.b64decode(data)).decode()
+               for fid, data in re.findall(r'<script type="application/gzip" id="([^"]+-data)">([^<]*)</script>', html)}
+    return html, islands
+
+
 class TempDirTest(unittest.TestCase):
     """A test case with a temporary directory and a helper to write study files into it."""
 

@@ -10,11 +10,8 @@ function on a 40^3 grid of cell midpoints over the same ranges.
 
 usage: /usr/bin/python3 test_sensitivity.py KINESWEEP_BINARY SOURCE_DIR
 """
-import base64
-import gzip
 import json
 import os
-import re
 import tomllib
 import subprocess
 import sys
@@ -23,7 +20,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import TempDirTest, runs_column
+from e2e_common import TempDirTest, report_page, runs_column
 
 KS = None
 SOURCE = None
@@ -189,15 +186,9 @@ class Sensitivity(TempDirTest):
                     self.assertTrue(fac["first_lo"] <= first <= fac["first_hi"], f"{what} S1 {first} {fac}")
                     self.assertTrue(fac["total_lo"] <= total <= fac["total_hi"], f"{what} ST {total} {fac}")
         # the report's bar chart: the command's indices of the kind's objective (E)
-        page = os.path.join(self.dir, "report.html")
-        r = subprocess.run(["/usr/bin/python3", os.path.join(SOURCE, "analysis", "report.py"), out, "-o", page],
-                           capture_output=True, text=True, timeout=300)
-        self.assertEqual(r.returncode, 0, r.stderr)
-        with open(page, encoding="utf-8") as fh:
-            html = fh.read()
-        island = re.search(r'<script type="application/gzip" id="sensitivity-0-data">([^<]*)</script>', html)
-        self.assertIsNotNone(island)
-        fig = json.loads(gzip.decompress(base64.b64decode(island.group(1))))
+        _, islands = report_page(self, out, self.dir)
+        self.assertIn("sensitivity-0-data", islands)
+        fig = json.loads(islands["sensitivity-0-data"])
         e = [x for x in results if x["metric"] == "E"][0]
         self.assertEqual(fig["data"][0]["x"], ["alpha1A", "k", "K_N"])
         for bar, key in zip(fig["data"], ("first", "total")):
@@ -213,15 +204,10 @@ class Sensitivity(TempDirTest):
         for study in ("examples_lhs.toml", "sensitivity_seed.toml"):
             out = os.path.join(self.dir, study.replace(".toml", ".h5"))
             self.assertEqual(run("run", os.path.join(SOURCE, "studies", study), "-o", out, "-q").returncode, 0)
-            page = os.path.join(self.dir, "page.html")
-            r = subprocess.run(["/usr/bin/python3", os.path.join(SOURCE, "analysis", "report.py"), out, "-o", page],
-                               capture_output=True, text=True, timeout=300)
-            self.assertEqual(r.returncode, 0, r.stderr)
-            with open(page, encoding="utf-8") as fh:
-                html = fh.read()
+            html, islands = report_page(self, out, self.dir)
             self.assertIn("holds sampled points", html)
-            for fid, data in re.findall(r'<script type="application/gzip" id="([^"]+-data)">([^<]*)</script>', html):
-                fig = json.loads(gzip.decompress(base64.b64decode(data)))
+            for fid, text in islands.items():
+                fig = json.loads(text)
                 for trace in fig.get("data", []) if isinstance(fig, dict) else []:
                     if trace.get("type") != "heatmap":
                         continue

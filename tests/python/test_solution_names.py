@@ -4,8 +4,6 @@ joint values of the runs /runs counts as reaching s, read here with h5py).
 
 usage: /usr/bin/python3 test_solution_names.py KINESWEEP_BINARY SOURCE_DIR
 """
-import base64
-import gzip
 import json
 import os
 import re
@@ -16,7 +14,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import TempDirTest, runs_column
+from e2e_common import TempDirTest, report_page, runs_column
 
 KS = SOURCE = None
 
@@ -34,16 +32,10 @@ class SolutionNames(TempDirTest):
             q1 = np.degrees(f["runs"]["q_final_1"][()])
         want = {int(s): float(np.median(q1[ok & (sol == s)])) for s in np.unique(sol[ok]) if s >= 0}
         self.assertEqual(sorted(want), [0, 1])
-        page = os.path.join(self.dir, "ik.html")
-        r = subprocess.run(["/usr/bin/python3", os.path.join(SOURCE, "analysis", "report.py"), out, "-o", page],
-                           capture_output=True, text=True, timeout=300)
-        self.assertEqual(r.returncode, 0, r.stderr)
-        with open(page, encoding="utf-8") as fh:
-            html = fh.read()
-        islands = dict(re.findall(r'<script type="application/gzip" id="(basins-\d+-data)">([^<]*)</script>', html))
+        _, islands = report_page(self, out, self.dir)
+        islands = {k: v for k, v in islands.items() if k.startswith("basins-")}
         self.assertTrue(islands)
-        for fid, data in islands.items():
-            text = gzip.decompress(base64.b64decode(data)).decode()
+        for fid, text in islands.items():
             names = {int(s): float(t) for s, t in re.findall(r"solution (\d+): \\u03b81 = (-?[\d.]+)", text)}
             self.assertTrue(names, fid)
             for s, theta in names.items():
