@@ -67,9 +67,9 @@ void analyse(store::ResultsReader& reader, const store::DesignMeta& d, const std
       r.design = &d;
       r.metric = metric;
       r.unit = it->unit;
+      const Record row = nd > 1 ? reader.read_record(d.first_run + base) : Record{};  // the other axes' values
       for (std::size_t k = 0; k < nd; ++k) {
         if (k == dim) continue;
-        const Record row = reader.read_record(d.first_run + base);
         std::istringstream names(d.dims[k]);
         for (std::string a; std::getline(names, a, '+');) {
           const auto col = std::find_if(cols.begin(), cols.end(), [&](const ColumnSpec& s) { return s.name == a; });
