@@ -117,6 +117,11 @@ Hid select_rows(hid_t dset, const std::vector<hsize_t>& ids);
 /// Opens an existing results file for writing through the journal driver (which recovers it first
 /// after a crash). Only path, opt and file are set. Throws StoreError.
 std::unique_ptr<ResultsWriter::Impl> open_writer_impl(const std::string& path, const StoreOptions& opt);
+/// Writes a new results file's skeleton into the open `file`: root attributes, /study, the /runs
+/// columns (n_runs rows, every row missing), /kinds, /designs, /histories, /landscapes
+/// (writer_skeleton.cpp).
+void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta, const std::vector<ColumnSpec>& columns,
+                    std::int64_t n_runs);
 }  // namespace detail
 
 }  // namespace ks::store

@@ -163,6 +163,15 @@ def run_study_text(ks, directory, name, text, *args):
     return out
 
 
+def shipped_results(test, directory):
+    """The results files the regression test wrote into its work dir `directory` (one per shipped
+    study); the test fails when there are too few (the fixture did not run)."""
+    import glob
+    found = sorted(glob.glob(os.path.join(directory, "*.h5")))
+    test.assertGreater(len(found), 5, f"no results files in {directory}")
+    return found
+
+
 def report_page(test, results, directory):
     """analysis/report.py on `results` (the test fails unless it exits 0): the page's html and its
     figures' data islands, id -> the JSON text (gzip and base64 undone)."""

@@ -8,7 +8,6 @@ position (isel).
 
 usage: /usr/bin/python3 test_netcdf_groups.py RESULTS_DIR
 """
-import glob
 import os
 import sys
 import unittest
@@ -17,7 +16,7 @@ import h5py
 import numpy as np
 import xarray as xr
 
-from e2e_common import runs_column
+from e2e_common import runs_column, shipped_results
 
 RESULTS = None
 
@@ -31,9 +30,7 @@ def same(a, b):
 
 class NetcdfGroups(unittest.TestCase):
     def files(self):
-        found = sorted(glob.glob(os.path.join(RESULTS, "*.h5")))
-        self.assertGreater(len(found), 5, f"no results files in {RESULTS}")
-        return found
+        return shipped_results(self, RESULTS)
 
     def test_runs_open_with_run_id_as_their_dimension(self):
         for path in self.files():

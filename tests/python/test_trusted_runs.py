@@ -6,7 +6,6 @@ with closed-loop gains the 5R study keeps >= 90 % of its runs `ok` within 1 mm o
 
 usage: /usr/bin/python3 test_trusted_runs.py RESULTS_DIR
 """
-import glob
 import os
 import sys
 import unittest
@@ -14,7 +13,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import runs_column
+from e2e_common import runs_column, shipped_results
 
 RESULTS = None
 
@@ -32,9 +31,7 @@ def trajectory_runs(path):
 
 class TrustedRuns(unittest.TestCase):
     def files(self):
-        found = sorted(glob.glob(os.path.join(RESULTS, "*.h5")))
-        self.assertGreater(len(found), 5, f"no results files in {RESULTS}")
-        return found
+        return shipped_results(self, RESULTS)
 
     def test_every_ok_run_is_on_its_path_and_within_its_limits(self):
         checked = 0
