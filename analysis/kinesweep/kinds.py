@@ -6,7 +6,7 @@ Run with Debian's interpreter: /usr/bin/python3.
 import numpy as np
 
 TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged", "undersampled", "off_path",
-                       "out_of_limits"]
+                       "out_of_limits", "max_evaluations", "not_converged", "infeasible", "singular_extension"]
 IK_STATUSES = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution",
                "out_of_limits"]
 # What each run kind means, for files written before the engine recorded it under /kinds (the engine's
@@ -33,7 +33,9 @@ METRIC_LABELS = {"E": "E (mean ‖τ‖)", "E_M": "E_M (mean ‖τ‖ in M⁻¹ 
 STATUS_COLOURS = {"unreachable_start": "#b0b0b0", "singular": "#7b3294", "diverged": "#202020",
                   "undersampled": "#8c6d31", "off_path": "#c51b7d",
                   "stalled": "#e08214", "max_iter": "#d7191c", "cycle": "#f4a582", "unsupported": "#6a6a6a",
-                  "no_solution": "#8f8f8f", "out_of_limits": "#fdae61"}
+                  "no_solution": "#8f8f8f", "out_of_limits": "#fdae61",
+                  "max_evaluations": "#b35806", "not_converged": "#fee090", "infeasible": "#4d4d4d",
+                  "singular_extension": "#542788"}
 # A converged run that reached none of the solutions a basin plot names.
 OTHER_SOLUTION_COLOUR = "#c7c7c7"
 

@@ -60,7 +60,9 @@ std::vector<Listed> listed() {
   spatial7.robot.joints = 7;
   spatial7.robot.planar = false;
   spatial7.first_vertex = {0.5, 0.0, 0.5};
-  return {{BlockKind::trajectory, "", {}},
+  KindContext seed;  // the seed's 3R, with the columns of global_spline (present in blocks that run it)
+  seed.path_global = true;
+  return {{BlockKind::trajectory, "", seed},
           {BlockKind::ik, "scara", {}},
           {BlockKind::ik, "planar3r", planar},
           {BlockKind::trajectory, "chain_planar", planar4},

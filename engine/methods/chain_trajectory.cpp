@@ -327,9 +327,10 @@ TrajectoryMetrics run_method(const Chain& chain, const ChainTask& task, const Ve
     case TrajectoryMethod::local_unweighted: return run<S, Resolution::unweighted>(chain, task, q, o, alpha, h);
     case TrajectoryMethod::vertex_alpha:
       if constexpr (S == TaskSpace::planar_pose) return run<S, Resolution::nonredundant>(chain, task, q, o, alpha, h);
-      break;
+      throw std::invalid_argument("simulate: vertex_alpha needs the planar_pose task");
+    case TrajectoryMethod::global_spline: break;
   }
-  throw std::invalid_argument("simulate: vertex_alpha needs the planar_pose task");
+  throw std::invalid_argument("simulate: global_spline is built for the closed-form 3R arm, not for chains");
 }
 
 }  // namespace

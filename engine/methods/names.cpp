@@ -7,18 +7,35 @@
 
 namespace ks {
 namespace {
-constexpr NameTable<TrajectoryMethod, 3> kMethods{{{TrajectoryMethod::local_weighted, "local_weighted"},
+constexpr NameTable<TrajectoryMethod, 4> kMethods{{{TrajectoryMethod::local_weighted, "local_weighted"},
                                                {TrajectoryMethod::local_unweighted, "local_unweighted"},
-                                               {TrajectoryMethod::vertex_alpha, "vertex_alpha"}}};
+                                               {TrajectoryMethod::vertex_alpha, "vertex_alpha"},
+                                               {TrajectoryMethod::global_spline, "global_spline"}}};
 constexpr NameTable<Integrator, 2> kIntegrators{
     {{Integrator::semi_implicit_euler, "semi_implicit_euler"}, {Integrator::rk4, "rk4"}}};
-constexpr NameTable<RunStatus, 7> kStatuses{{{RunStatus::ok, "ok"},
+constexpr NameTable<RunStatus, 11> kStatuses{{{RunStatus::ok, "ok"},
                                          {RunStatus::unreachable_start, "unreachable_start"},
                                          {RunStatus::singular, "singular"},
                                          {RunStatus::diverged, "diverged"},
                                          {RunStatus::undersampled, "undersampled"},
                                          {RunStatus::off_path, "off_path"},
-                                         {RunStatus::out_of_limits, "out_of_limits"}}};
+                                         {RunStatus::out_of_limits, "out_of_limits"},
+                                         {RunStatus::max_evaluations, "max_evaluations"},
+                                         {RunStatus::not_converged, "not_converged"},
+                                         {RunStatus::infeasible, "infeasible"},
+                                         {RunStatus::singular_extension, "singular_extension"}}};
+constexpr NameTable<GlobalObjective, 4> kObjectives{{{GlobalObjective::E, "E"},
+                                                     {GlobalObjective::E_M, "E_M"},
+                                                     {GlobalObjective::torque_sq_integral, "torque_sq_integral"},
+                                                     {GlobalObjective::kinetic_energy, "kinetic_energy"}}};
+constexpr NameTable<AlphaSpline, 2> kSplines{
+    {{AlphaSpline::cubic, "cubic"}, {AlphaSpline::vertex_quintic, "vertex_quintic"}}};
+constexpr NameTable<GlobalStart, 3> kStarts{
+    {{GlobalStart::local, "local"}, {GlobalStart::vertex, "vertex"}, {GlobalStart::random, "random"}}};
+constexpr NameTable<StartMethod, 2> kStartMethods{
+    {{StartMethod::local_unweighted, "local_unweighted"}, {StartMethod::local_weighted, "local_weighted"}}};
+constexpr NameTable<Extension, 2> kExtensions{{{Extension::alpha, "alpha"}, {Extension::self_motion, "self_motion"}}};
+constexpr NameTable<StartPosture, 2> kPostures{{{StartPosture::fixed, "fixed"}, {StartPosture::free, "free"}}};
 constexpr NameTable<OnViolation, 3> kOnViolation{
     {{OnViolation::mark, "mark"}, {OnViolation::stop, "stop"}, {OnViolation::ignore, "ignore"}}};
 
@@ -32,6 +49,18 @@ bool parse(std::string_view n, Integrator& out) { return value_of(kIntegrators, 
 bool parse(std::string_view n, RunStatus& out) { return value_of(kStatuses, n, out); }
 std::string_view to_string(OnViolation v) { return name_of(kOnViolation, v); }
 bool parse(std::string_view n, OnViolation& out) { return value_of(kOnViolation, n, out); }
+std::string_view to_string(GlobalObjective v) { return name_of(kObjectives, v); }
+std::string_view to_string(AlphaSpline v) { return name_of(kSplines, v); }
+std::string_view to_string(GlobalStart v) { return name_of(kStarts, v); }
+std::string_view to_string(StartPosture v) { return name_of(kPostures, v); }
+bool parse(std::string_view n, GlobalObjective& out) { return value_of(kObjectives, n, out); }
+bool parse(std::string_view n, AlphaSpline& out) { return value_of(kSplines, n, out); }
+bool parse(std::string_view n, GlobalStart& out) { return value_of(kStarts, n, out); }
+bool parse(std::string_view n, StartPosture& out) { return value_of(kPostures, n, out); }
+std::string_view to_string(Extension v) { return name_of(kExtensions, v); }
+bool parse(std::string_view n, Extension& out) { return value_of(kExtensions, n, out); }
+std::string_view to_string(StartMethod v) { return name_of(kStartMethods, v); }
+bool parse(std::string_view n, StartMethod& out) { return value_of(kStartMethods, n, out); }
 
 }  // namespace ks
 
@@ -51,6 +80,7 @@ bool TrajectoryOptions::IsValid(std::string* why) const {
                      {"orientation_bound", orientation_bound, bound_rule}},
                     why))
     return false;
+  if (method == TrajectoryMethod::global_spline && !global.IsValid(why)) return false;
   for (double a : vertex_alpha)
     if (!std::isfinite(a)) {
       if (why) *why = "vertex_alpha has a value that is not finite; expected finite angles [rad]";

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "methods/global_spline.hpp"
 #include "methods/run_sums.hpp"
 #include "methods/sample_sums.hpp"
 #include "methods/trajectory_batch.hpp"
@@ -189,6 +190,7 @@ TrajectoryMetrics simulate(const PlanarArm3& arm, const Path2& path, const Traje
 
 TrajectoryMetrics simulate(const PlanarArm3& arm, const SampledPath& sampled, const TrajectoryOptions& o,
                            TrajectoryHistory* history) {
+  if (o.method == TrajectoryMethod::global_spline) return solve_global_spline(arm, sampled, o, history);
   kernel::Batch b;
   kernel::prepare(b, 1, arm, sampled, &o, 1, &history);
   kernel::Sums sums;

@@ -12,6 +12,7 @@
 #include "model/arm.hpp"
 #include "model/chain.hpp"
 #include "model/kinematics.hpp"
+#include "methods/path_global_options.hpp"
 #include "task/quintic_path.hpp"
 #include "task/sampled_path.hpp"
 
@@ -22,6 +23,9 @@ enum class TrajectoryMethod {
   local_weighted,    ///< case 1, Eq. 51: inertia-weighted pseudo-inverse, minimises tau^T M^-1 tau
   local_unweighted,  ///< case 2, Eq. 56: M^-2-weighted pseudo-inverse, minimises tau^T tau
   vertex_alpha,      ///< cases 3-5: alpha prescribed at every vertex, quintic alpha(t), non-redundant
+  /// path-global: alpha(t) over the whole path minimising an objective (methods/global_spline.hpp),
+  /// the joint path by exact IK at every sample (the seed's closed-form 3R arm)
+  global_spline,
 };
 
 enum class Integrator {
@@ -38,6 +42,11 @@ enum class RunStatus {
   undersampled,       ///< dt leaves fewer than kMinSamplesPerSegment samples on a segment: nothing simulated
   off_path,           ///< the tip left the path by more than tracking_bound (or orientation_bound)
   out_of_limits,      ///< a joint position, velocity or effort went beyond the robot's limits
+  // global_spline: the optimiser's outcome (ok: converged, on the path, within the limits)
+  max_evaluations,     ///< the optimiser used its evaluation budget; the metrics are at its best point
+  not_converged,       ///< the optimiser stopped without meeting its tolerance (NLopt failure)
+  infeasible,          ///< alpha(t) puts the wrist out of reach at a sample: the run ends there
+  singular_extension,  ///< the extended task [tip; alpha] is singular at a sample: the run ends there
 };
 
 /// What a run does when a sample crosses its tracking bound or its robot's joint limits.
@@ -83,6 +92,7 @@ struct TrajectoryOptions {
   double tracking_bound = 0.05;       ///< |tip - path| above this [m] is off the path
   double orientation_bound = 0.05;    ///< pose tasks: an orientation error above this [rad] is off the path
   OnViolation on_violation = OnViolation::mark;
+  PathGlobalOptions global;           ///< global_spline only
 
   /// The rules on the fields (checked by IsValid; the study schema reports them at the key).
   static constexpr Domain null_damping_rule = Domain::nonnegative();
@@ -128,6 +138,13 @@ struct TrajectoryMetrics {
   double E_force = std::numeric_limits<double>::quiet_NaN();
   double final_alpha = 0.0;           ///< alpha at the last sample [rad]
   double stop_time = 0.0;             ///< time of the last sample computed [s]
+  /// global_spline (NaN for the other methods): the objective at the start and at the end (its
+  /// units: see GlobalObjective), objective evaluations made, and the infinity norm of the objective's
+  /// projected gradient at the end [objective units per rad]
+  double opt_start_objective = std::numeric_limits<double>::quiet_NaN();
+  double opt_objective = std::numeric_limits<double>::quiet_NaN();
+  double opt_evaluations = std::numeric_limits<double>::quiet_NaN();
+  double opt_gradient_norm = std::numeric_limits<double>::quiet_NaN();
   /// the metrics of methods/sample_metrics.hpp's table, in its order (NaN: no sample, or not a metric)
   std::array<double, kMaxSampleMetrics> sampled = nan_array();
 

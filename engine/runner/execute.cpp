@@ -173,7 +173,10 @@ RunOutcome trajectory_outcome(const TrajectoryMetrics& metrics, const Trajectory
 /// Whether a run may share SIMD lanes: a closed-form 3R trajectory run that samples its path.
 const TrajectoryRun* lane_run(const Scenario& sc, const RunSpec& run) {
   const auto* t = std::get_if<TrajectoryRun>(&run);
-  return t && !sc.chain && samples_path(sc.task->durations, t->options.dt) ? t : nullptr;
+  return t && !sc.chain && t->options.method != TrajectoryMethod::global_spline &&
+                 samples_path(sc.task->durations, t->options.dt)
+             ? t
+             : nullptr;
 }
 
 RunOutcome run_trajectory(const Scenario& sc, const TrajectoryRun& run, int stride, RunWorkspace::Impl& ws) {

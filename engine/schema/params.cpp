@@ -102,10 +102,11 @@ RankKey rank_key(double objective, double tie, std::uint64_t run) {
 }
 std::span<const std::string_view> statuses(BlockKind kind) {
   using ik::Status;
-  static const std::array<std::string_view, 7> trajectory{
+  static const std::array<std::string_view, 11> trajectory{
       to_string(RunStatus::ok),           to_string(RunStatus::unreachable_start), to_string(RunStatus::singular),
       to_string(RunStatus::diverged),     to_string(RunStatus::undersampled),      to_string(RunStatus::off_path),
-      to_string(RunStatus::out_of_limits)};
+      to_string(RunStatus::out_of_limits), to_string(RunStatus::max_evaluations),  to_string(RunStatus::not_converged),
+      to_string(RunStatus::infeasible),   to_string(RunStatus::singular_extension)};
   static const std::array<std::string_view, 9> ik{
       ik::to_string(Status::converged), ik::to_string(Status::stalled),  ik::to_string(Status::singular),
       ik::to_string(Status::max_iter),  ik::to_string(Status::cycle),    ik::to_string(Status::diverged),

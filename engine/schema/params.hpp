@@ -44,6 +44,7 @@ struct KindContext {
   bool scara = true;                                   ///< ik: the block's problem family (units, defaults)
   RobotShape robot;                                    ///< [robot]
   Eigen::Vector3d first_vertex{1.5, 1.5, 0.0};         ///< the path's first vertex [m] (chain IK's default target)
+  bool path_global = false;  ///< the block runs global_spline: its parameters and metrics are columns
 };
 
 /// When a parameter has an effect: always (no controller), or only while another text parameter

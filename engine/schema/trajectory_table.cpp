@@ -13,8 +13,51 @@ using namespace schema_detail;
 using Run = TrajectoryRun;
 
 namespace {
-const EffectRule kLocalOnly{"method", {"local_weighted", "local_unweighted"}};
+// global_spline starts from a local run (k, K_N) or a vertex_alpha one (vertex_alpha_i)
+const EffectRule kLocalOnly{"method", {"local_weighted", "local_unweighted", "global_spline"}};
+const EffectRule kLocalSpring{"method", {"local_weighted", "local_unweighted"}};
 const EffectRule kVertexOnly{"method", {"vertex_alpha"}};
+const EffectRule kVertexAngles{"method", {"vertex_alpha", "global_spline"}};
+const EffectRule kGlobalOnly{"method", {"global_spline"}};
+
+/// global_spline's own parameters (methods/path_global_options.hpp).
+void global_params(std::vector<ParamDef>& t) {
+  t.push_back(named<Run>("spline", names_of<AlphaSpline>(AlphaSpline::cubic, AlphaSpline::vertex_quintic),
+                         "global_spline: alpha(t) as a clamped cubic B-spline (knots) or a quintic per path "
+                         "segment through vertex values (seed cases 3-5's family)",
+                         [](auto& r) -> auto& { return r.options.global.spline; }, kGlobalOnly));
+  t.push_back(integer<Run>("knots", "", PathGlobalOptions::knots_rule,
+                           "global_spline, cubic: breakpoints evenly spaced in time (= coefficients)",
+                           [](auto& r) -> auto& { return r.options.global.knots; }, kGlobalOnly));
+  t.push_back(named<Run>("extension", names_of<Extension>(Extension::self_motion, Extension::alpha),
+                         "global_spline, cubic: the coordinate the spline describes: the angle along the arm's "
+                         "self-motion circle (crosses elbow branches) or the tip angle alpha (one elbow branch)",
+                         [](auto& r) -> auto& { return r.options.global.extension; }, kGlobalOnly));
+  t.push_back(named<Run>("global_objective",
+                         names_of<GlobalObjective>(GlobalObjective::E, GlobalObjective::E_M,
+                                                   GlobalObjective::torque_sq_integral, GlobalObjective::kinetic_energy),
+                         "global_spline: what alpha(t) minimises (E, E_M, torque_sq_integral, or the integral "
+                         "of the kinetic energy)",
+                         [](auto& r) -> auto& { return r.options.global.objective; }, kGlobalOnly));
+  t.push_back(named<Run>("global_start", names_of<GlobalStart>(GlobalStart::local, GlobalStart::vertex, GlobalStart::random),
+                         "global_spline: the optimiser's start: the local run (start_method, alpha1A, k, K_N), "
+                         "vertex_alpha's alpha(t) (alpha1A, vertex_alpha_i), or random (start_seed)",
+                         [](auto& r) -> auto& { return r.options.global.start; }, kGlobalOnly));
+  t.push_back(named<Run>("start_method", names_of<StartMethod>(StartMethod::local_unweighted, StartMethod::local_weighted),
+                         "global_spline, global_start = local: the local method of the start",
+                         [](auto& r) -> auto& { return r.options.global.start_method; }, kGlobalOnly));
+  t.push_back(named<Run>("start_posture", names_of<StartPosture>(StartPosture::fixed, StartPosture::free),
+                         "global_spline: alpha at the start fixed at alpha1A, or free",
+                         [](auto& r) -> auto& { return r.options.global.posture; }, kGlobalOnly));
+  t.push_back(integer<Run>("start_seed", "", Domain::nonnegative(), "global_spline, global_start = random: the draw's seed",
+                           [](auto& r) -> auto& { return r.options.global.start_seed; }, kGlobalOnly));
+  t.push_back(real<Run>("opt_tolerance", FileUnit::none, "1", PathGlobalOptions::tolerance_rule,
+                        "global_spline: relative change of the objective that stops the optimiser",
+                        [](auto& r) -> auto& { return r.options.global.tolerance; }, kGlobalOnly));
+  t.push_back(integer<Run>("max_evaluations", "", PathGlobalOptions::max_evaluations_rule,
+                           "global_spline: objective evaluations allowed (each with its gradient)",
+                           [](auto& r) -> auto& { return r.options.global.max_evaluations; }, kGlobalOnly));
+}
 
 /// The preset: sets the row's method, k, alpha1A and vertex orientations (explicit keys override).
 ParamDef preset_param() {
@@ -43,10 +86,11 @@ ParamDef preset_param() {
 std::vector<ParamDef> trajectory_params(const KindContext& ctx) {
   std::vector<ParamDef> t;
   t.push_back(preset_param());
-  t.push_back(named<Run>("method", names_of<TrajectoryMethod>(TrajectoryMethod::local_weighted,
-                                                               TrajectoryMethod::local_unweighted,
-                                                               TrajectoryMethod::vertex_alpha),
-                         "redundancy resolution method", [](auto& r) -> auto& { return r.options.method; }));
+  std::vector<std::string> methods = names_of<TrajectoryMethod>(
+      TrajectoryMethod::local_weighted, TrajectoryMethod::local_unweighted, TrajectoryMethod::vertex_alpha);
+  if (!ctx.robot.chain) methods.emplace_back(to_string(TrajectoryMethod::global_spline));  // the closed-form 3R
+  t.push_back(named<Run>("method", std::move(methods), "redundancy resolution method",
+                         [](auto& r) -> auto& { return r.options.method; }));
   t.push_back(real<Run>("k", FileUnit::none, "", Domain::any(), "gravity weight in the resolution",
                         [](auto& r) -> auto& { return r.options.k; }, kLocalOnly));
   const RobotShape& robot = ctx.robot;
@@ -58,13 +102,14 @@ std::vector<ParamDef> trajectory_params(const KindContext& ctx) {
   t.push_back(real<Run>("K_L", FileUnit::none, "1/s^2", TrajectoryOptions::limit_centring_rule,
                         "null-space spring towards the middle of each joint's position limits (joints with "
                         "both limits; 0 = none)",
-                        [](auto& r) -> auto& { return r.options.limit_centring; }, kLocalOnly));
+                        [](auto& r) -> auto& { return r.options.limit_centring; }, kLocalSpring));
   for (std::size_t v = 2; robot.vertex_alpha() && v <= ctx.path_vertices; ++v) {
     const std::size_t i = v - 2;
     t.push_back(real<Run>("vertex_alpha_" + std::to_string(v), FileUnit::deg, "rad", Domain::any(),
-                          "orientation at vertex " + std::to_string(v) + " (vertex_alpha method)",
-                          [i](auto& r) -> auto& { return r.options.vertex_alpha[i]; }, kVertexOnly));
+                          "orientation at vertex " + std::to_string(v) + " (vertex_alpha; global_spline: its vertex start)",
+                          [i](auto& r) -> auto& { return r.options.vertex_alpha[i]; }, kVertexAngles));
   }
+  if (ctx.path_global && !robot.chain) global_params(t);
   t.push_back(named<Run>("integrator", names_of<Integrator>(Integrator::semi_implicit_euler, Integrator::rk4),
                          "time integrator", [](auto& r) -> auto& { return r.options.integrator; }));
   t.push_back(real<Run>("dt", FileUnit::none, "s", TrajectoryOptions::dt_rule, "sample / integration step",
@@ -177,6 +222,20 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
                           e.gridded, [k](const M& r) { return r.sampled[k]; })
                     .labelled(std::string(e.label)));
   });
+  if (ctx.path_global && !robot.chain) {
+    m.push_back(metric<M>("opt_start_objective", CellType::f64, "",
+                          "global_spline: the objective at the optimiser's start (units of global_objective)", false,
+                          [](const M& r) { return r.opt_start_objective; }));
+    m.push_back(metric<M>("opt_objective", CellType::f64, "",
+                          "global_spline: the objective at the optimum (units of global_objective)", true,
+                          [](const M& r) { return r.opt_objective; }));
+    m.push_back(metric<M>("opt_evaluations", CellType::f64, "", "global_spline: objective evaluations made", true,
+                          [](const M& r) { return r.opt_evaluations; }));
+    m.push_back(metric<M>("opt_gradient_norm", CellType::f64, "",
+                          "global_spline: infinity norm of the projected gradient at the optimum (objective units "
+                          "per rad)",
+                          false, [](const M& r) { return r.opt_gradient_norm; }));
+  }
   if (robot.chain) {
     m.push_back(metric<M>("max_q_limit_ratio", CellType::f64, "",
                           "max over samples and joints of |q - mid| / half range (1 = at a position limit; NaN: none)",

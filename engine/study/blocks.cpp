@@ -24,6 +24,21 @@ KindContext block_context(const Study& s, bool scara) {
   return ctx;
 }
 
+/// Whether the block's method (fixed, or one value of its axis) is global_spline.
+bool names_global_spline(const toml::table& b) {
+  const auto is_global = [](const toml::node* n) {
+    if (!n) return false;
+    if (const auto* v = n->as_string()) return v->get() == "global_spline";
+    if (const auto* a = n->as_array())
+      for (const toml::node& e : *a)
+        if (const auto* v = e.as_string(); v && v->get() == "global_spline") return true;
+    return false;
+  };
+  if (is_global(b.get("method"))) return true;
+  const toml::table* axes = b.get("axes") ? b.get("axes")->as_table() : nullptr;
+  return axes && is_global(axes->get("method"));
+}
+
 /// Why `name` cannot name an HDF5 group (/landscapes/<block>, /optimizations/<name>); "" when it can.
 std::string hdf5_name_problem(const std::string& name) {
   if (name == "." || name == "..") return "is '" + name + "', which HDF5 paths reserve";
@@ -55,6 +70,7 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
   d.nverts = s.task.vertices.size();
   d.scara = !s.chain;  // an IK block without a problem: the SCARA, or the study's chain's position problem
   d.ctx = block_context(s, d.scara);
+  d.ctx.path_global = names_global_spline(b);
 
   read_block_name(d, names);
   if (!read_block_kind(d)) return std::nullopt;
@@ -70,6 +86,7 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
   generate_axes(d);
   if (!d.lhs_group.empty()) d.spec.groups.push_back(d.lhs_group);  // after the zip groups
   d.ctx = block_context(s, d.scara);
+  d.ctx.path_global = names_global_spline(d.table);
   check_robot_supports(d, s);
   reject_ineffective_axes(d);
   return finish_block(d, errors_before);

@@ -1,0 +1,91 @@
+#pragma once
+// The evaluator of the path-global method on the seed's planar 3R arm: given alpha(t) (any
+// AlphaBasis and its coefficients), the joint path is the exact inverse kinematics of (path, alpha)
+// at every sample (methods/alpha_basis.hpp's families share it), qd and qdd solve the square extended
+// task [tip; alpha] (J3 qd = [xd; alpha_d], J3 qdd = [xdd - Jd qd; alpha_dd]), and tau is the inverse
+// dynamics M qdd + c + g. The objective is a sum of per-sample terms, each a function of (alpha,
+// alpha_d, alpha_dd) at its sample, so its gradient is the chain rule through the basis' weights with
+// the three partials per sample by central differences: seven sample evaluations per sample for the
+// whole gradient, whatever the number of coefficients.
+#include <cstddef>
+#include <vector>
+
+#include "methods/alpha_basis.hpp"
+#include "methods/path_global_options.hpp"
+#include "methods/trajectory.hpp"
+#include "model/dynamics.hpp"
+
+namespace ks {
+
+/// The self-motion chart at one sample (Extension::self_motion): alpha = phi + beta sin psi with phi
+/// the tip's direction from the base and beta half the arc of tip angles the wrist can reach, and
+/// their first two time derivatives [rad, rad/s, rad/s^2].
+struct ChartSample {
+  double phi[3], beta[3];
+};
+
+/// One sample of the joint path for (alpha, alpha_d, alpha_dd).
+struct GlobalSample {
+  bool reachable = false;  ///< the wrist is within reach of links 1 and 2 (|cos theta2| <= 1)
+  double reach_excess = 0; ///< |cos theta2| - 1 when not reachable
+  double det = 0;          ///< det J3 [m^2] (l1 l2 sin theta2)
+  Vec3 q, qd, qdd, tau;    ///< [rad], [rad/s], [rad/s^2], [Nm]
+  Sym3 M;                  ///< M(q) [kg m^2]
+  Mat23 J;                 ///< position Jacobian [m/rad]
+};
+
+class PathGlobalProblem {
+ public:
+  /// arm: its constants (inertia form included); path: sampled at the run's dt; elbow: the IK branch
+  /// (alpha: every sample's; self_motion: the start's); singular_tolerance: |det J3| [m^2] below which
+  /// a sample is singular (alpha only: the self-motion chart is regular where it is defined).
+  PathGlobalProblem(const PlanarArm3& arm, const SampledPath& path, Elbow elbow, double singular_tolerance,
+                    Extension extension = Extension::alpha);
+
+  Extension extension() const { return extension_; }
+  /// self_motion: whether the chart is defined at every sample (the wrist's reachable tip angles form
+  /// an arc shorter than a full turn, 0 < beta < pi); always true for alpha.
+  bool chart_defined() const { return chart_defined_; }
+  /// The coordinate (alpha, or psi on branch `elbow`) of tip angle `alpha` at sample i.
+  double coordinate(std::size_t i, double alpha, Elbow elbow) const;
+
+  std::size_t samples() const { return path_.size(); }
+  const SampledPath& path() const { return path_; }
+
+  /// Sample i of the joint path for the coordinate x (alpha or psi) and its rate and acceleration.
+  /// Fills `s` (q .. tau only when reachable).
+  void sample(std::size_t i, double x, double xd, double xdd, GlobalSample& s) const;
+
+  /// The objective at coefficients c of `basis`; `grad` (size basis.coefficients) its gradient when
+  /// not null. Past the reach boundary the samples are taken at the boundary (cos theta2 = +-kReachClamp),
+  /// so that the objective stays finite and continuous for the optimiser's trial points.
+  double objective(const AlphaBasis& basis, const double* c, GlobalObjective objective, double* grad) const;
+
+  /// The run's metrics at coefficients c (the trajectory kind's, through the per-sample accumulator),
+  /// its history when `history` is given. Unreachable or singular samples end the run there with
+  /// status infeasible or singular_extension.
+  TrajectoryMetrics measure(const AlphaBasis& basis, const double* c, const TrajectoryOptions& o,
+                            TrajectoryHistory* history) const;
+
+  /// Extension::alpha: the reach constraints con[i] = cos(theta2_i)^2 - 1 <= 0, one per sample, and
+  /// (when `jac` is not null) their gradients, row-major (samples x basis.coefficients).
+  void reach(const AlphaBasis& basis, const double* c, double* con, double* jac) const;
+
+  static constexpr double kReachClamp = 1.0 - 1e-12;
+
+ private:
+  double cost(std::size_t i, double a, double ad, double add, GlobalObjective objective) const;
+  void sample_alpha(std::size_t i, double a, double ad, double add, Elbow elbow, GlobalSample& s) const;
+
+  PlanarArm3 arm_;
+  DynamicsCoefficients dyn_;
+  const SampledPath& path_;
+  std::vector<Vec2> velocity_;  // the path's velocity at each sample [m/s]
+  Elbow elbow_;
+  double tolerance_;
+  Extension extension_;
+  std::vector<ChartSample> chart_;  // self_motion
+  bool chart_defined_ = true;
+};
+
+}  // namespace ks

@@ -1,0 +1,85 @@
+#pragma once
+// Options of the path-global method (global_spline): the tip angle alpha(t) over the whole path chosen
+// by a gradient-based optimiser (NLopt SLSQP), the joint path by exact inverse kinematics at every
+// sample, the torques by inverse dynamics (methods/path_global.hpp).
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "common/domain.hpp"
+
+namespace ks {
+
+/// What the path-global method minimises over alpha(t).
+enum class GlobalObjective {
+  E,                   ///< mean over samples of sqrt(tau^T tau) [Nm] (seed Eq. 60; case 4's objective)
+  E_M,                 ///< mean over samples of sqrt(tau^T M^-1 tau) (case 3's objective)
+  torque_sq_integral,  ///< trapezoidal integral of tau^T tau [N^2 m^2 s]
+  kinetic_energy,      ///< trapezoidal integral of the kinetic energy qd^T M qd / 2 [J s]
+};
+
+/// How alpha(t) is represented (methods/alpha_basis.hpp).
+enum class AlphaSpline {
+  cubic,           ///< clamped uniform cubic B-spline with `knots` breakpoints, at rest at both ends (C2)
+  vertex_quintic,  ///< alpha at the path's vertices, a quintic per segment (seed cases 3-5's family)
+};
+
+/// The redundant coordinate the spline describes (cubic splines; vertex_quintic is always alpha).
+enum class Extension {
+  alpha,        ///< the tip angle alpha on the start's elbow branch; singular where theta2 = 0 (stretched)
+  self_motion,  ///< the angle psi along the arm's self-motion circle at the tip: alpha = phi + beta sin psi,
+                ///< elbow branch = sign(cos psi) (phi: the tip's direction, beta: half the reachable alpha
+                ///< arc), so a path may cross elbow branches through the stretched arm
+};
+
+/// Where the optimiser starts.
+enum class GlobalStart {
+  local,   ///< alpha(t) of the run's local method (start_method, alpha1A, k, K_N) fitted by the spline
+  vertex,  ///< alpha(t) of vertex_alpha at the run's alpha1A and vertex_alpha_i, fitted by the spline
+  random,  ///< alpha1A plus independent uniform draws in [-0.5, 0.5] rad per coefficient (start_seed)
+};
+
+/// The local method whose run is the start when start = local.
+enum class StartMethod { local_unweighted, local_weighted };
+
+/// Whether alpha at the start is the run's alpha1A or a free variable.
+enum class StartPosture { fixed, free };
+
+std::string_view to_string(GlobalObjective v);
+std::string_view to_string(AlphaSpline v);
+std::string_view to_string(GlobalStart v);
+std::string_view to_string(StartPosture v);
+std::string_view to_string(StartMethod v);
+std::string_view to_string(Extension v);
+bool parse(std::string_view name, GlobalObjective& out);
+bool parse(std::string_view name, AlphaSpline& out);
+bool parse(std::string_view name, GlobalStart& out);
+bool parse(std::string_view name, StartPosture& out);
+bool parse(std::string_view name, StartMethod& out);
+bool parse(std::string_view name, Extension& out);
+
+struct PathGlobalOptions {
+  AlphaSpline spline = AlphaSpline::cubic;
+  std::int64_t knots = 20;               ///< cubic: breakpoints, evenly spaced in time (= coefficients)
+  Extension extension = Extension::self_motion;  ///< cubic: the coordinate the spline describes
+  GlobalObjective objective = GlobalObjective::E;
+  GlobalStart start = GlobalStart::local;
+  StartMethod start_method = StartMethod::local_unweighted;  ///< start = local
+  StartPosture posture = StartPosture::fixed;
+  std::int64_t start_seed = 0;           ///< start = random
+  double tolerance = 1e-10;              ///< relative change of the objective that stops the optimiser
+  std::int64_t max_evaluations = 3000;   ///< objective evaluations (each with its gradient)
+
+  static constexpr Domain knots_rule = Domain::within(2, 2000);
+  static constexpr Domain tolerance_rule = Domain::positive();
+  static constexpr Domain max_evaluations_rule = Domain::within(1, 1e7);
+
+  bool IsValid(std::string* why = nullptr) const {
+    return fields_valid({{"knots", static_cast<double>(knots), knots_rule},
+                         {"opt_tolerance", tolerance, tolerance_rule},
+                         {"max_evaluations", static_cast<double>(max_evaluations), max_evaluations_rule}},
+                        why);
+  }
+};
+
+}  // namespace ks
