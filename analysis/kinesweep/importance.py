@@ -157,6 +157,21 @@ def swept_parameters(res, runs, rows, kind):
     return out
 
 
+def _block_rows(res, block):
+    """The run kind of `block` and which done rows are its."""
+    inblock = res.runs(columns=["block"])["block"] == block
+    return (res.row_kinds()[np.flatnonzero(inblock)[0]] if inblock.any() else ""), inblock
+
+
+def block_parameters(res, block):
+    """The parameters `block` sweeps (file order), angles as in runs(); [] for a block without done runs."""
+    kind, inblock = _block_rows(res, block)
+    if not inblock.any():
+        return []
+    runs = res.runs(columns=res.parameters(kind))
+    return swept_parameters(res, runs, inblock, kind)
+
+
 def permutation_importance(results, block=None, metric=None, **kw):
     """Permutation importance of the swept parameters of `block` (default: the file's first) for
     `metric` (default: the block's run kind's ranking objective: E, IK iterations) over its runs
@@ -182,10 +197,7 @@ def permutation_importance(results, block=None, metric=None, **kw):
                        + f"; blocks: {', '.join(blocks)}")
     all_done = res.runs(columns=["block"], done_only=False)
     not_done = int(np.sum((all_done["block"] == block) & ~all_done["done"]))
-    kinds = res.row_kinds()
-    bcol = res.runs(columns=["block"])["block"]
-    inblock = bcol == block
-    kind = kinds[np.flatnonzero(inblock)[0]] if inblock.any() else ""
+    kind, inblock = _block_rows(res, block)
     meaning = res.kind_meaning(kind)
     metrics = res.metrics(kind)
     metric = metric or next(iter(meaning.get("ranking", [])), None)

@@ -5,8 +5,8 @@ failed status are counted, not dropped silently; the package imports without sci
 what to install when a fit is asked for. End to end on studies/examples_lhs.toml (the engine's
 runs): alpha1A ranks above k and every swept parameter is listed, the ranking agrees with Optuna's
 fANOVA (the figures the issue recorded, 0.67 / 0.30 / 0.03, and recomputed when python3-optuna is
-installed), the command's table and JSON, and the report's importance section (its figure's data
-island) equal the module's numbers.
+installed), the command's table and JSON, and the report's importance section (its figures' data
+islands: one bar chart per block, bars and whiskers the module's numbers, the caption's R²).
 
 usage: /usr/bin/python3 test_importance.py KINESWEEP_BINARY SOURCE_DIR
 """
@@ -189,6 +189,22 @@ class ExamplesLhs(TempDirTest):
         r = self.command("--metric", "Ee")
         self.assertEqual(r.returncode, 2)
         self.assertIn("did you mean 'E'", r.stderr)
+
+    def test_report_has_the_importance_section(self):
+        html, islands = report_page(self, self.h5, self.dir)
+        self.assertIn('<section id="importance">', html)
+        self.assertIn("permutation importance of a random-forest fit (R² = "
+                      f"{self.lhs['r2']:.3f}", html)
+        self.assertIn("not a variance decomposition", html)
+        for i, want in enumerate((self.lhs, self.lm)):
+            fig = json.loads(islands[f"importance-{i}-data"])
+            bar = fig["data"][0]
+            self.assertEqual(bar["type"], "bar")
+            self.assertEqual(bar["x"], [p["name"] for p in want["parameters"]])
+            for j, p in enumerate(want["parameters"]):
+                self.assertAlmostEqual(bar["y"][j], p["mean"], delta=1e-6 * max(1, abs(p["mean"])))
+                self.assertAlmostEqual(bar["error_y"]["array"][j], p["std"], delta=1e-6 * max(1, p["std"]))
+        self.assertNotIn("importance-2-data", islands)
 
 
 if __name__ == "__main__":
