@@ -145,38 +145,37 @@ def fit_importance(table, params, metric, status=None, good=("ok", "converged"),
     return out
 
 
-def swept_parameters(res, runs, rows, kind):
-    """The parameters of `kind` that take more than one value among `rows` of `runs`, in file order."""
-    out = []
-    for c in res.parameters(kind):
-        if c not in runs:
-            continue
-        v = runs[c][rows]
-        if len(set(v.tolist()) if v.dtype == object else np.unique(v[~np.isnan(v)] if v.dtype.kind == "f" else v)) > 1:
-            out.append(c)
-    return out
+def _varies(v):
+    """Whether a column takes more than one value (NaN, a parameter not applying, is no value)."""
+    if v.dtype == object:
+        return len(set(v.tolist())) > 1
+    if v.dtype.kind == "f":
+        v = v[~np.isnan(v)]
+    return len(np.unique(v)) > 1
 
 
 def _block_rows(res, block):
-    """The run kind of `block` and which done rows are its."""
-    inblock = res.runs(columns=["block"])["block"] == block
-    return (res.row_kinds()[np.flatnonzero(inblock)[0]] if inblock.any() else ""), inblock
+    """The run kind of `block`, which done rows are its (a bool array over runs()' rows) and how many
+    of its rows are not done."""
+    t = res.runs(columns=["block"], done_only=False)
+    mine = t["block"] == block
+    return res._block_kind(block), mine[t["done"]], int(np.sum(mine & ~t["done"]))
 
 
-def block_parameters(res, block):
-    """The parameters `block` sweeps (file order), angles as in runs(); [] for a block without done runs."""
-    kind, inblock = _block_rows(res, block)
+def block_parameters(res, block, rows=None):
+    """The parameters `block` sweeps: those of its run kind taking more than one value among its done
+    runs, in file order ([] for a block without done runs). Read one column at a time."""
+    kind, inblock, _ = _block_rows(res, block) if rows is None else (res._block_kind(block), rows, 0)
     if not inblock.any():
         return []
-    runs = res.runs(columns=res.parameters(kind))
-    return swept_parameters(res, runs, inblock, kind)
+    return [c for c in res.parameters(kind) if _varies(res.runs(columns=[c])[c][inblock])]
 
 
-def permutation_importance(results, block=None, metric=None, **kw):
-    """Permutation importance of the swept parameters of `block` (default: the file's first) for
-    `metric` (default: the block's run kind's ranking objective: E, IK iterations) over its runs
-    with a good status. `results`: a kinesweep.read.Results or a path. Keyword arguments go to
-    fit_importance (n_estimators, n_repeats, test_fraction, max_rows, random_state, min_runs).
+def permutation_importance(results, block=None, metric=None, params=None, **kw):
+    """Permutation importance of the swept parameters of `block` (default: the file's first; or of
+    `params`) for `metric` (default: the block's run kind's ranking objective: E, IK iterations) over
+    its runs with a good status. `results`: a kinesweep.read.Results or a path. Keyword arguments go
+    to fit_importance (n_estimators, n_repeats, test_fraction, max_rows, random_state, min_runs).
     Returns fit_importance's dict with block, kind, unit (of the metric), units (of the parameters,
     angles in degrees), not_done (the block's rows not run yet) added. ImportanceError when nothing
     can be computed, KeyError for an unknown block or metric."""
@@ -184,7 +183,7 @@ def permutation_importance(results, block=None, metric=None, **kw):
     from kinesweep import where as kswhere
     if isinstance(results, str):
         with ksread.open_results(results) as res:
-            return permutation_importance(res, block, metric, **kw)
+            return permutation_importance(res, block, metric, params, **kw)
     res = results
     blocks = res.blocks()
     if block is None:
@@ -195,9 +194,7 @@ def permutation_importance(results, block=None, metric=None, **kw):
         close = kswhere.did_you_mean(block, blocks)
         raise KeyError(f"no block {block!r}" + (f"; did you mean '{close}'?" if close else "")
                        + f"; blocks: {', '.join(blocks)}")
-    all_done = res.runs(columns=["block"], done_only=False)
-    not_done = int(np.sum((all_done["block"] == block) & ~all_done["done"]))
-    kind, inblock = _block_rows(res, block)
+    kind, inblock, not_done = _block_rows(res, block)
     meaning = res.kind_meaning(kind)
     metrics = res.metrics(kind)
     metric = metric or next(iter(meaning.get("ranking", [])), None)
@@ -205,11 +202,11 @@ def permutation_importance(results, block=None, metric=None, **kw):
         close = kswhere.did_you_mean(str(metric), metrics)
         raise KeyError(f"{metric!r} is not a metric of {kind} runs" + (f"; did you mean '{close}'?" if close else "")
                        + f"; metrics: {', '.join(metrics)}")
-    names = list(dict.fromkeys(["status", metric] + res.parameters(kind)))
+    params = block_parameters(res, block, inblock) if params is None else list(params)
+    names = list(dict.fromkeys(["status", metric] + params))
     runs = res.runs(columns=names, degrees=True)
     if runs[metric].dtype == object:
         raise KeyError(f"{metric!r} is a text column: no importance of it")
-    params = swept_parameters(res, runs, inblock, kind)
     sub = {c: runs[c][inblock] for c in names}
     out = fit_importance(sub, params, metric, status="status", good=tuple(meaning.get("good_statuses", ["ok"])), **kw)
     out.update(block=block, kind=kind, unit=runs.units[metric], units={p: runs.units[p] for p in params},

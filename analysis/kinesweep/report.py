@@ -199,7 +199,8 @@ def importance_section(res, limit=MAX_IMPORTANCE_FIGURES):
     from kinesweep import importance as ksimp
     from kinesweep.sensitivity import designs
     saltelli = set(designs(res.f))
-    blocks = [b for b in res.blocks() if b not in saltelli and len(ksimp.block_parameters(res, b)) >= 2]
+    swept = {b: ksimp.block_parameters(res, b) for b in res.blocks() if b not in saltelli}
+    blocks = [b for b, ps in swept.items() if len(ps) >= 2]
     if not blocks:
         return ""
     try:
@@ -213,7 +214,7 @@ def importance_section(res, limit=MAX_IMPORTANCE_FIGURES):
             notes.append(f"{len(blocks) - limit} more blocks not fitted (kinesweep.importance FILE fits them all).")
             break
         try:
-            r = ksimp.permutation_importance(res, b)
+            r = ksimp.permutation_importance(res, b, params=swept[b])
         except ksimp.ImportanceError as e:
             notes.append(f"Block {esc(b)}: no importance ({esc(e)}).")
             continue
