@@ -302,8 +302,8 @@ def main(argv=None):
         for s in skipped:
             print(f"block {s['block']}: no importance: {s['reason']}")
     if not results:
-        print(f"importance: {args.file}: no block with an importance" + (f" ({skipped[0]['reason']})" if skipped else ""),
-              file=sys.stderr)
+        why = f" ({skipped[0]['reason']})" if skipped else ""
+        print(f"importance: {args.file}: no block with an importance{why}", file=sys.stderr)
         return 1
     return 0
 

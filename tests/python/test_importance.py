@@ -119,8 +119,10 @@ class ExamplesLhs(TempDirTest):
             cls.lhs = res.importance(block="local_lhs")
             cls.lm = res.importance(block="lm_lambda")
             runs = res.runs()
-        cls.status = {b: {s: int(np.sum((runs["block"] == b) & (runs["status"] == s)))
-                          for s in set(runs["status"][runs["block"] == b].tolist())} for b in ("local_lhs", "lm_lambda")}
+        cls.status = {}
+        for b in ("local_lhs", "lm_lambda"):
+            st = runs["status"][runs["block"] == b]
+            cls.status[b] = {s: int(np.sum(st == s)) for s in set(st.tolist())}
 
     @classmethod
     def tearDownClass(cls):
@@ -162,9 +164,8 @@ class ExamplesLhs(TempDirTest):
                  "method": CategoricalDistribution(["local_weighted", "local_unweighted"])}
         study = optuna.create_study()
         for i in rows:
-            study.add_trial(optuna.trial.create_trial(
-                params={"alpha1A": float(runs["alpha1A"][i]), "k": float(runs["k"][i]), "method": str(runs["method"][i])},
-                distributions=dists, value=float(runs["E"][i])))
+            params = {"alpha1A": float(runs["alpha1A"][i]), "k": float(runs["k"][i]), "method": str(runs["method"][i])}
+            study.add_trial(optuna.trial.create_trial(params=params, distributions=dists, value=float(runs["E"][i])))
         fanova = get_param_importances(study, evaluator=FanovaImportanceEvaluator(seed=0))
         self.assertEqual(names, list(fanova))
         for name, share in FANOVA.items():
