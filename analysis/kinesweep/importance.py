@@ -298,7 +298,8 @@ def main(argv=None):
                   ensure_ascii=False, allow_nan=False)
         print()
     else:
-        print("\n\n".join(format_table(r) for r in results))
+        if results:
+            print("\n\n".join(format_table(r) for r in results))
         for s in skipped:
             print(f"block {s['block']}: no importance: {s['reason']}")
     if not results:
