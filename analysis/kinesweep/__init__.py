@@ -14,12 +14,12 @@ Submodules (each importable alone):
     plotting    shared matplotlib helpers of the plot commands
 Commands (`/usr/bin/python3 -m kinesweep.NAME --help`; from a source tree, analysis/NAME.py is the same):
     plot_landscape, plot_histories, plot_cases, plot_basins, plot_convergence, plot_runs,
-    compare_landscapes, report, make_examples
+    compare_landscapes, importance, report, make_examples
 `python3 -m kinesweep` lists them. The former module names (ksread, kswhere, kshistory, kslive,
 kstypes, kssolutions, ksplot) remain importable from analysis/ as aliases of these modules.
 """
 COMMANDS = ("plot_landscape", "plot_histories", "plot_cases", "plot_basins", "plot_convergence", "plot_runs",
-            "compare_landscapes", "report", "make_examples")
+            "compare_landscapes", "importance", "report", "make_examples")
 _READ_API = ("open_results", "read_runs", "read_history", "read_landscape", "read_optimization", "Results",
              "FormatVersionError", "THESIS_TABLE4")
 

@@ -193,6 +193,12 @@ class Results:
         from kinesweep.sensitivity import sensitivity
         return sensitivity(self, **kw)
 
+    def importance(self, **kw):
+        """Permutation importance of a block's swept parameters from a random-forest fit
+        (kinesweep.importance.permutation_importance; needs python3-sklearn)."""
+        from kinesweep.importance import permutation_importance
+        return permutation_importance(self, **kw)
+
     @kslive.consistent
     def kind_meaning(self, kind):
         """What runs of `kind` mean, as the file records it (/kinds/<kind>): {"statuses": in code

@@ -3,8 +3,9 @@
 
 Sections (those that do not apply are left out; the contents list what is there): the study text
 and file metadata, status counts per block, the best runs of each block, interactive landscapes,
-IK basins, Sobol' indices of the blocks run as a Saltelli design, the histories of the best runs, and
-the optimisation traces. Plotly's JavaScript is
+IK basins, Sobol' indices of the blocks run as a Saltelli design, the permutation importance of the
+other blocks' swept parameters (a random-forest fit; needs python3-sklearn), the histories of the best
+runs, and the optimisation traces. Plotly's JavaScript is
 embedded (Debian's python3-plotly, minified by esbuild when installed) and, with the figures' data,
 gzip-compressed (inflated by the browser), so the page works offline and can be mailed as one file.
 Reads files a sweep is still writing (done rows only). Big grids and long traces are subsampled so
@@ -13,7 +14,7 @@ that the page stays small (the captions say where).
     /usr/bin/python3 analysis/report.py results/examples_landscape.h5 -o report.html
 
 Open a single section with report.html#only=SECTION (study, status, best, landscapes, basins,
-sensitivity, histories, optimizations).
+sensitivity, importance, histories, optimizations).
 """
 import argparse
 import datetime
@@ -30,6 +31,7 @@ from kinesweep.report_traces import best_with_history, history_figure, history_i
 CELL_BUDGET = 40000   # heatmap cells over all landscape and basin figures (about 40 bytes each, compressed)
 MAX_HISTORY_FIGURES = 12
 MAX_SENSITIVITY_FIGURES = 12
+MAX_IMPORTANCE_FIGURES = 12
 
 
 def parse_args(argv=None):
@@ -118,7 +120,7 @@ def _sampled_note(ls):
             f"{esc(', '.join(sampled))} holds sampled points (a Latin hypercube, zipped random draws or a Saltelli "
             "design), "
             "not grid lines. analysis/plot_runs.py draws such runs as points; a Saltelli design's indices are in "
-            "the sensitivity section.</p>")
+            "the sensitivity section, the other blocks' parameters are ranked in the importance section.</p>")
 
 
 def _landscape_html(i, ls, cap):
@@ -189,6 +191,63 @@ def sensitivity_section(res, limit=MAX_SENSITIVITY_FIGURES):
     return "".join(parts)
 
 
+def importance_section(res, limit=MAX_IMPORTANCE_FIGURES):
+    """One bar chart per block that sweeps two or more parameters and is not a Saltelli design (those
+    have Sobol' indices): each swept parameter's permutation importance in a random-forest fit of the
+    kind's objective (kinesweep.importance), whiskers ± one std over the permutation repeats. Blocks
+    with too few good runs are named with the reason. Needs python3-sklearn: without it, a note."""
+    from kinesweep import importance as ksimp
+    from kinesweep.sensitivity import designs
+    saltelli = set(designs(res.f))
+    swept = {b: ksimp.block_parameters(res, b) for b in res.blocks() if b not in saltelli}
+    blocks = [b for b, ps in swept.items() if len(ps) >= 2]
+    if not blocks:
+        return ""
+    try:
+        ksimp._sklearn()
+    except ImportError as e:
+        print(f"report: no importance section: {e}", file=sys.stderr)
+        return ""
+    parts, notes, n = [], [], 0
+    for b in blocks:
+        if n >= limit:
+            notes.append(f"{len(blocks) - limit} more blocks not fitted (kinesweep.importance FILE fits them all).")
+            break
+        try:
+            r = ksimp.permutation_importance(res, b, params=swept[b])
+        except ksimp.ImportanceError as e:
+            notes.append(f"Block {esc(b)}: no importance ({esc(e)}).")
+            continue
+        ps = r["parameters"]
+        good = r["trustworthy"]
+        bar = {"type": "bar", "name": "permutation importance", "x": [p["name"] for p in ps],
+               "y": [p["mean"] for p in ps], "marker": {"color": "#1f77b4" if good else "#9a9a9a"},
+               "customdata": [100 * p["fraction"] for p in ps],
+               "hovertemplate": "%{x}: %{y:.4g} (share %{customdata:.1f} %)<extra></extra>",
+               "error_y": {"type": "data", "symmetric": True, "array": [p["std"] for p in ps]}}
+        fig = {"data": [bar], "layout": {"height": 340, "margin": {"t": 20}, "showlegend": False,
+                                         "yaxis": {"title": {"text": f"drop of held-out R² of {r['metric']}"}}}}
+        excl = ", ".join(f"{esc(s)} {c}" for s, c in r["excluded"].items())
+        shares = ", ".join(f"{esc(p['name'])} {100 * p['fraction']:.0f} %" for p in ps)
+        ordinal = [p for p, e in r["encoding"].items() if e != "numeric"]
+        caption = (f"{esc(r['metric'])}: permutation importance of a random-forest fit (R² = {r['r2']:.3f} on "
+                   f"{r['test']} held-out runs), not a variance decomposition. Bars: the mean drop of the held-out "
+                   f"R² when a parameter's values are shuffled ({r['model']['n_repeats']} repeats); whiskers: ± one "
+                   f"std over the repeats; shares of the positive drops: {shares}. "
+                   f"{r['model']['n_estimators']} trees fitted on {r['train']} of the {r['used']} runs with a good "
+                   "status" + (f" (a random {r['subsampled']} used)" if r["subsampled"] else "")
+                   + (f"; left out by status: {excl}" if excl else "; none left out")
+                   + (f"; {esc(', '.join(ordinal))} ordinal-encoded" if ordinal else "") + ".")
+        if not good:
+            caption += (f" <span class=\"capped\">A poor fit (R² below {ksimp.POOR_R2}): these numbers are not "
+                        "trustworthy.</span>")
+        parts.append(figure(f"importance-{n}", fig, caption, title=f"Block {b} ({r['kind']})"))
+        n += 1
+    if not parts:
+        return ""
+    return "".join(parts) + "".join(f'<p class="caption">{x}</p>' for x in notes)
+
+
 def build(path, best=5, max_cells=CELL_BUDGET, title=None):
     """The page's html for one results file."""
     with ksread.open_results(path) as res:
@@ -206,6 +265,9 @@ def build(path, best=5, max_cells=CELL_BUDGET, title=None):
         sens = sensitivity_section(res)
         if sens:
             sections.append(("sensitivity", "Which parameter matters: Sobol' indices", sens))
+        imp = importance_section(res)
+        if imp:
+            sections.append(("importance", "Which parameter matters: permutation importance", imp))
         hist = histories_section(view)
         if hist:
             sections.append(("histories", "Histories of the best runs", hist))

@@ -403,6 +403,33 @@ class PlotStudiesTest(unittest.TestCase):
             m = t / 10 ** math.floor(math.log10(t) + 1e-12)
             self.assertAlmostEqual(m, round(m), places=9)
 
+    def test_convergence_identical_histories_drawn_once(self):
+        """ik_scara's default convergence plot: lm_adaptive ignores lambda, so its first run at each
+        lambda (the same start) has the same history: one line for them, labelled with every run, a
+        note on stderr; no two drawn lines hold the same data, and runs drawn on separate lines have
+        histories that differ (read with h5py)."""
+        h5 = self.files["ik_scara"]
+        _, d, err = self.plot("plot_convergence.py", h5)
+        lines = d["lines"]
+        drawn = [(tuple(ln["x"]), tuple(ln["y"])) for ln in lines]
+        self.assertEqual(len(drawn), len(set(drawn)), "two drawn lines hold identical data")
+        self.assertEqual(sorted(r for ln in lines for r in ln["runs"]), sorted(int(r) for r in d["runs"]))
+        grouped = [ln for ln in lines if len(ln["runs"]) > 1]
+        self.assertTrue(grouped, "ik_scara's lm_adaptive runs from one start should be drawn as one line")
+        with h5py.File(h5, "r") as f:
+            method = runs_column(f["runs"]["method"])
+            hist = Histories(f)
+            norm_f = {r: {a: v for a, v, _ in hist.read(r)}["norm_F"][:, 0] for ln in lines for r in ln["runs"]}
+        for ln in grouped:
+            self.assertIn("runs " + ",".join(map(str, ln["runs"])) + " (identical)", ln["label"])
+            self.assertIn(f"plot_convergence.py: note: runs {','.join(map(str, ln['runs']))} have identical", err)
+            self.assertTrue(all(method[r] == "lm_adaptive" for r in ln["runs"]), ln["runs"])
+            for r in ln["runs"]:
+                self.assertEqual(norm_f[r].tobytes(), norm_f[ln["runs"][0]].tobytes())
+                self.assertEqual(d["runs"][str(r)]["label"], ln["label"])
+        firsts = [norm_f[ln["runs"][0]].tobytes() for ln in lines]
+        self.assertEqual(len(firsts), len(set(firsts)))
+
     def test_convergence_runs_own_colours(self):
         h5 = self.files["ik_scara"]
         _, d, _ = self.plot("plot_convergence.py", h5, "--runs", "0,1,2")

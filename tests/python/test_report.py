@@ -68,7 +68,7 @@ q0_2 = { from = -180, to = 180, count = 9 }
 """
 
 SECTIONS = {"trajectory": ["study", "status", "best", "landscapes", "histories"],
-            "basins": ["study", "status", "best", "landscapes", "basins", "histories"],
+            "basins": ["study", "status", "best", "landscapes", "basins", "importance", "histories"],
             "optimize": ["study", "status", "best", "landscapes", "optimizations"]}
 GOOD = {"trajectory": ("ok", ["E"]), "ik": ("converged", ["iterations", "error"])}
 

@@ -188,6 +188,7 @@ class Sensitivity(TempDirTest):
         # the report's bar chart: the command's indices of the kind's objective (E)
         _, islands = report_page(self, out, self.dir)
         self.assertIn("sensitivity-0-data", islands)
+        self.assertNotIn("importance-0-data", islands)  # a Saltelli design has indices, no forest fit
         fig = json.loads(islands["sensitivity-0-data"])
         e = [x for x in results if x["metric"] == "E"][0]
         self.assertEqual(fig["data"][0]["x"], ["alpha1A", "k", "K_N"])
