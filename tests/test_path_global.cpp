@@ -89,6 +89,23 @@ TEST(AlphaBasis, CubicIsAPartitionOfUnityAtRestAtBothEnds) {
   EXPECT_NEAR(ad, 0.0, 1e-10);
 }
 
+TEST(AlphaBasis, CubicWithAFreeEndHasOneMoreCoefficientAndMovesThere) {
+  const SampledPath path(seed_square(), 1e-3);
+  const AlphaBasis b = cubic_spline_basis(path, 9, false);
+  ASSERT_EQ(b.coefficients, 10);
+  const std::vector<double> ones(10, 1.0), c = random_coefficients(10, 0.0, 1.0, 3);
+  double a, ad, add;
+  for (std::size_t i = 0; i < path.size(); i += 101) {
+    b.at(i, ones.data(), a, ad, add);
+    EXPECT_NEAR(a, 1.0, 1e-14);
+  }
+  b.at(0, c.data(), a, ad, add);
+  EXPECT_NEAR(ad, 0.0, 1e-12);  // still at rest at the start
+  b.at(path.size() - 1, c.data(), a, ad, add);
+  EXPECT_NEAR(a, c.back(), 1e-12);
+  EXPECT_GT(std::abs(ad), 1e-3);  // 3 (c[9] - c[8]) / knot spacing
+}
+
 TEST(AlphaBasis, CubicDerivativesMatchFiniteDifferences) {
   const SampledPath path(seed_square(), 1e-3);
   const AlphaBasis b = cubic_spline_basis(path, 12);

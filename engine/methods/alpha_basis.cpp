@@ -83,17 +83,19 @@ AlphaBasis vertex_quintic_basis(const SampledPath& path) {
   return b;
 }
 
-AlphaBasis cubic_spline_basis(const SampledPath& path, int knots) {
+AlphaBasis cubic_spline_basis(const SampledPath& path, int knots, bool rest_at_end) {
   if (knots < 2) throw std::invalid_argument("cubic_spline_basis: knots = " + std::to_string(knots) + "; expected >= 2");
   const double T = path.path().duration();
   const int m = knots + 2;  // control points
   std::vector<double> U(4, 0.0);
   for (int j = 1; j + 1 < knots; ++j) U.push_back(T * j / (knots - 1));
   U.insert(U.end(), 4, T);
-  // control point j -> coefficient: the first two and the last two tied (zero rate at both ends)
-  const auto coefficient = [knots](int j) { return std::clamp(j - 1, 0, knots - 1); };
+  // control point j -> coefficient: the first two tied (zero rate at the start), and the last two
+  // when the end is at rest
+  const int count = rest_at_end ? knots : knots + 1;
+  const auto coefficient = [count](int j) { return std::clamp(j - 1, 0, count - 1); };
   AlphaBasis b;
-  b.coefficients = knots;
+  b.coefficients = count;
   b.rows.resize(path.size());
   for (std::size_t i = 0; i < path.size(); ++i) {
     const double t = std::clamp(path.time(i), 0.0, T);

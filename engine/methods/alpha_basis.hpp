@@ -6,8 +6,9 @@
 // - vertex_quintic: the coefficients are alpha at the path's vertices, each segment a quintic between
 //   them with zero rate and acceleration at the vertices (seed 000's cases 3-5, QuinticPath<1>);
 // - cubic: a clamped uniform cubic B-spline over the whole path (C2), `knots` breakpoints evenly spaced
-//   in time, at rest at both ends (zero rate); its coefficients are the B-spline's control points with
-//   the first two and the last two tied, so there are exactly `knots` of them.
+//   in time, at rest at the start (zero rate) and, unless asked otherwise, at the end; its coefficients
+//   are the B-spline's control points with the first two (and the last two) tied, so there are exactly
+//   `knots` of them (knots + 1 with a free end).
 #include <cstddef>
 #include <vector>
 
@@ -43,9 +44,10 @@ struct AlphaBasis {
 
 /// The vertex-quintic family on `path`'s samples: coefficients = alpha at vertices 1..n (n = vertices).
 AlphaBasis vertex_quintic_basis(const SampledPath& path);
-/// The clamped cubic B-spline with `knots` >= 2 breakpoints over [0, duration] at rest at both ends,
-/// on `path`'s samples (std::invalid_argument for knots < 2).
-AlphaBasis cubic_spline_basis(const SampledPath& path, int knots);
+/// The clamped cubic B-spline with `knots` >= 2 breakpoints over [0, duration] at rest at the start
+/// and, when `rest_at_end`, at the end (then `knots` coefficients, else knots + 1), on `path`'s
+/// samples (std::invalid_argument for knots < 2).
+AlphaBasis cubic_spline_basis(const SampledPath& path, int knots, bool rest_at_end = true);
 
 /// Least-squares coefficients of `basis` for the samples alpha[0 .. count) [rad] (count <= rows);
 /// coefficients with no weight on those samples keep the last fitted value before them.

@@ -157,7 +157,8 @@ TrajectoryMetrics solve_global_spline(const PlanarArm3& arm, const SampledPath& 
   if (path.dt() != o.dt) throw std::invalid_argument("global_spline: path sampled at another dt");
   const PathGlobalOptions& g = o.global;
   const AlphaBasis basis =
-      g.spline == AlphaSpline::cubic ? cubic_spline_basis(path, static_cast<int>(g.knots)) : vertex_quintic_basis(path);
+      g.spline == AlphaSpline::cubic ? cubic_spline_basis(path, static_cast<int>(g.knots), g.end == EndState::rest)
+                                      : vertex_quintic_basis(path);
   const Extension extension = g.spline == AlphaSpline::cubic ? g.extension : Extension::alpha;
   const PathGlobalProblem problem(arm, path, o.elbow, o.singular_tolerance, extension);
   if (!problem.chart_defined()) return not_simulated(RunStatus::singular_extension, 3);

@@ -35,6 +35,7 @@ constexpr NameTable<GlobalStart, 3> kStarts{
 constexpr NameTable<StartMethod, 2> kStartMethods{
     {{StartMethod::local_unweighted, "local_unweighted"}, {StartMethod::local_weighted, "local_weighted"}}};
 constexpr NameTable<Extension, 2> kExtensions{{{Extension::alpha, "alpha"}, {Extension::self_motion, "self_motion"}}};
+constexpr NameTable<EndState, 2> kEnds{{{EndState::rest, "rest"}, {EndState::free, "free"}}};
 constexpr NameTable<StartPosture, 2> kPostures{{{StartPosture::fixed, "fixed"}, {StartPosture::free, "free"}}};
 constexpr NameTable<OnViolation, 3> kOnViolation{
     {{OnViolation::mark, "mark"}, {OnViolation::stop, "stop"}, {OnViolation::ignore, "ignore"}}};
@@ -57,6 +58,8 @@ bool parse(std::string_view n, GlobalObjective& out) { return value_of(kObjectiv
 bool parse(std::string_view n, AlphaSpline& out) { return value_of(kSplines, n, out); }
 bool parse(std::string_view n, GlobalStart& out) { return value_of(kStarts, n, out); }
 bool parse(std::string_view n, StartPosture& out) { return value_of(kPostures, n, out); }
+std::string_view to_string(EndState v) { return name_of(kEnds, v); }
+bool parse(std::string_view n, EndState& out) { return value_of(kEnds, n, out); }
 std::string_view to_string(Extension v) { return name_of(kExtensions, v); }
 bool parse(std::string_view n, Extension& out) { return value_of(kExtensions, n, out); }
 std::string_view to_string(StartMethod v) { return name_of(kStartMethods, v); }

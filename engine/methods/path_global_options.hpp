@@ -45,18 +45,24 @@ enum class StartMethod { local_unweighted, local_weighted };
 /// Whether alpha at the start is the run's alpha1A or a free variable.
 enum class StartPosture { fixed, free };
 
+/// Whether the arm ends at rest (zero self-motion rate at the last vertex, as it starts) or may still
+/// move in its self-motion there, as a local method's run may.
+enum class EndState { rest, free };
+
 std::string_view to_string(GlobalObjective v);
 std::string_view to_string(AlphaSpline v);
 std::string_view to_string(GlobalStart v);
 std::string_view to_string(StartPosture v);
 std::string_view to_string(StartMethod v);
 std::string_view to_string(Extension v);
+std::string_view to_string(EndState v);
 bool parse(std::string_view name, GlobalObjective& out);
 bool parse(std::string_view name, AlphaSpline& out);
 bool parse(std::string_view name, GlobalStart& out);
 bool parse(std::string_view name, StartPosture& out);
 bool parse(std::string_view name, StartMethod& out);
 bool parse(std::string_view name, Extension& out);
+bool parse(std::string_view name, EndState& out);
 
 struct PathGlobalOptions {
   AlphaSpline spline = AlphaSpline::cubic;
@@ -66,6 +72,7 @@ struct PathGlobalOptions {
   GlobalStart start = GlobalStart::local;
   StartMethod start_method = StartMethod::local_unweighted;  ///< start = local
   StartPosture posture = StartPosture::fixed;
+  EndState end = EndState::rest;         ///< cubic: the self-motion rate at the end
   std::int64_t start_seed = 0;           ///< start = random
   double tolerance = 1e-10;              ///< relative change of the objective that stops the optimiser
   std::int64_t max_evaluations = 3000;   ///< objective evaluations (each with its gradient)

@@ -49,6 +49,10 @@ void global_params(std::vector<ParamDef>& t) {
   t.push_back(named<Run>("start_posture", names_of<StartPosture>(StartPosture::fixed, StartPosture::free),
                          "global_spline: alpha at the start fixed at alpha1A, or free",
                          [](auto& r) -> auto& { return r.options.global.posture; }, kGlobalOnly));
+  t.push_back(named<Run>("end_state", names_of<EndState>(EndState::rest, EndState::free),
+                         "global_spline, cubic: the arm at rest at the end (as at the start), or free to move in "
+                         "its self-motion there (as a local method's run may)",
+                         [](auto& r) -> auto& { return r.options.global.end; }, kGlobalOnly));
   t.push_back(integer<Run>("start_seed", "", Domain::nonnegative(), "global_spline, global_start = random: the draw's seed",
                            [](auto& r) -> auto& { return r.options.global.start_seed; }, kGlobalOnly));
   t.push_back(real<Run>("opt_tolerance", FileUnit::none, "1", PathGlobalOptions::tolerance_rule,
