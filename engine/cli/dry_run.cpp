@@ -157,6 +157,7 @@ int dry_run(const Study& study, const StudySchema& schema, const DryRunOptions& 
   const int lanes = opt.lanes > 0 ? std::min(opt.lanes, max_lanes()) : max_lanes();
   std::vector<Sample> samples;
   std::vector<BlockEstimate> est(study.blocks.size());
+  double longest = 0;  // the longest sample run: no thread count finishes before it
   for (std::size_t b = 0; b < study.blocks.size(); ++b) {
     const Block& block = study.blocks[b];
     out << "  block " << block.name() << " (" << to_string(block.kind()) << "): " << block.run_count() << " runs =";
@@ -167,9 +168,15 @@ int dry_run(const Study& study, const StudySchema& schema, const DryRunOptions& 
     est[b].runs = block.run_count();
     // The samples run in batches of `lanes`, as the sweep's workers run them (execute_batch).
     const auto start = Clock::now();
-    double compute = 0;
+    double compute = 0, sq = 0;
     for (const std::vector<std::uint64_t>& picks : lane_batches(block, spread_indices(block.run_count(), 64), lanes)) {
-      if (est[b].sampled >= 4 && std::chrono::duration<double>(Clock::now() - start).count() > opt.seconds_per_block)
+      // past the budget, sampling goes on (up to 10 budgets) while the mean run time is uncertain by
+      // more than 10 % (runs of very different cost in one block: global_spline's knot counts)
+      const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+      const double n_s = static_cast<double>(est[b].sampled);
+      const double mean = n_s > 0 ? compute / n_s : 0, var = n_s > 1 ? (sq - n_s * mean * mean) / (n_s - 1) : 0;
+      const bool settled = n_s > 1 && std::sqrt(std::max(var, 0.0) / n_s) <= 0.1 * mean;
+      if (est[b].sampled >= 4 && elapsed > opt.seconds_per_block && (settled || elapsed > 10 * opt.seconds_per_block))
         break;
       const std::size_t n = picks.size(), first = 0;
       std::vector<RunSpec> runs;
@@ -183,6 +190,8 @@ int dry_run(const Study& study, const StudySchema& schema, const DryRunOptions& 
         if (!outcomes[i].history.arrays.empty()) hist = store::encode_history(outcomes[i].history, opt.compression);
         wall[i] += std::chrono::duration<double>(Clock::now() - t0).count();
         compute += wall[i];
+        sq += wall[i] * wall[i];
+        longest = std::max(longest, wall[i]);
         est[b].history_bytes += history_bytes(hist);
         samples.push_back({b, picks[first + i],
                            schema.row(study.first_run(b) + picks[first + i], b, block, runs[i], outcomes[i], wall[i]),
@@ -234,7 +243,8 @@ int dry_run(const Study& study, const StudySchema& schema, const DryRunOptions& 
                                          : std::max(0.0, full.seconds - empty.seconds) / n_rows;
   const int n = opt.threads > 0 ? opt.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const double write_total = total_runs * write_per_run;
-  const double seconds = startup + std::max((compute_total + write_total) / n, write_total) + 2 * empty.seconds;
+  const double seconds =
+      startup + std::max({(compute_total + write_total) / n, write_total, longest}) + 2 * empty.seconds;
   out << "  total: " << static_cast<std::uint64_t>(total_runs) << " runs; histories " << h.str()
       << "\n  estimated size: " << human_bytes(bytes) << " (" << human_bytes((bytes - empty.bytes) / std::max(total_runs, 1.0))
       << " per run); estimated time: " << human_time(seconds) << " on " << n

@@ -315,11 +315,14 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
   // Lanes: runs per SIMD batch (results do not depend on it); a pipeline token holds enough runs to
   // fill two batches of the widest lanes.
   const int lanes = options.lanes > 0 ? std::min(options.lanes, max_lanes()) : max_lanes();
-  const std::size_t batch = std::max<std::size_t>(options.batch, 2 * static_cast<std::size_t>(lanes));
   const auto start = Clock::now();
   auto last_progress = start;
   std::uint64_t next = 0, written = 0;
   const std::uint64_t todo = options.source ? options.source_runs : total - skipped;
+  // A small sweep is cut into at least four batches per thread, so that a few long runs (global_spline)
+  // spread over the threads; a large one fills two batches of the widest lanes per token.
+  const std::size_t full_batch = std::max<std::size_t>(options.batch, 2 * static_cast<std::size_t>(lanes));
+  const std::size_t batch = std::clamp<std::size_t>((todo + 4 * threads - 1) / (4 * threads), 1, full_batch);
   bool interrupted = false;
   auto is_done = [&](std::uint64_t id) { return previous && id < previous->done.size() && previous->done[id]; };
 
