@@ -90,10 +90,11 @@ ParamDef preset_param() {
 std::vector<ParamDef> trajectory_params(const KindContext& ctx) {
   std::vector<ParamDef> t;
   t.push_back(preset_param());
-  std::vector<std::string> methods = names_of<TrajectoryMethod>(
-      TrajectoryMethod::local_weighted, TrajectoryMethod::local_unweighted, TrajectoryMethod::vertex_alpha);
-  if (!ctx.robot.chain) methods.emplace_back(to_string(TrajectoryMethod::global_spline));  // the closed-form 3R
-  t.push_back(named<Run>("method", std::move(methods), "redundancy resolution method",
+  // (global_spline: the closed-form 3R arm only; a chain study naming it is refused at the key)
+  t.push_back(named<Run>("method",
+                         names_of<TrajectoryMethod>(TrajectoryMethod::local_weighted, TrajectoryMethod::local_unweighted,
+                                                    TrajectoryMethod::vertex_alpha, TrajectoryMethod::global_spline),
+                         "redundancy resolution method",
                          [](auto& r) -> auto& { return r.options.method; }));
   t.push_back(real<Run>("k", FileUnit::none, "", Domain::any(), "gravity weight in the resolution",
                         [](auto& r) -> auto& { return r.options.k; }, kLocalOnly));

@@ -308,6 +308,21 @@ void Parser::check_robot_supports(const BlockDraft& d, const Study& s) {
                      "); expected a robot with more joints than task equations, or a position task");
     return;
   }
+  // global_spline: the closed-form 3R arm only (its extension and IK are the 3R's closed forms)
+  const std::string global_reason =
+      "global_spline is built for the seed's closed-form 3R arm (a [robot] table without l, m or urdf), not yet "
+      "for chain robots";
+  for (const auto& [name, v] : d.spec.fixed)
+    if (const std::string* t = std::get_if<std::string>(&v); name == "method" && t && *t == "global_spline") {
+      error(d.table.get(name)->source(), global_reason + "; expected local_weighted, local_unweighted or vertex_alpha");
+      return;
+    }
+  for (const AxisDraft& a : d.drafts)
+    for (const auto& v : a.axis.values)
+      if (const std::string* t = std::get_if<std::string>(&v); a.axis.name == "method" && t && *t == "global_spline") {
+        error(a.pos, global_reason + " (the method axis includes it); expected the other methods");
+        return;
+      }
   if (r.vertex_alpha()) return;
   // vertex_alpha: named by method (fixed or axis) or by a preset of cases 3-5
   auto uses = [&](const std::string& name, const Cell& v) {
