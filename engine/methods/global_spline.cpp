@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "methods/alpha_basis.hpp"
+#include "methods/global_solve.hpp"
 #include "methods/path_global.hpp"
 
 namespace ks {
@@ -93,10 +94,10 @@ struct Solve {
     std::copy(x, x + (c.size() - first), c.begin() + first);
     return c.data();
   }
-  double objective_at(const std::vector<double>& x, std::vector<double>& g) {
+  double objective_at(const double* x, double* g) {
     ++evaluations;
-    const double f = problem->objective(*basis, coefficients(x.data()), objective, g.empty() ? nullptr : grad.data());
-    if (!g.empty()) std::copy(grad.begin() + first, grad.end(), g.begin());
+    const double f = problem->objective(*basis, coefficients(x), objective, g ? grad.data() : nullptr);
+    if (g) std::copy(grad.begin() + first, grad.end(), g);
     return f;
   }
   void reach_at(unsigned m, double* con, unsigned n, const double* x, double* g) {
@@ -189,43 +190,18 @@ TrajectoryMetrics solve_global_spline(const PlanarArm3& arm, const SampledPath& 
       }
     }
   }
-  if (extension == Extension::alpha) {  // a start with every sample within reach, with a margin where the fixed start allows one
-    std::vector<double> con(problem.samples());
-    s.reach_at(static_cast<unsigned>(con.size()), con.data(), static_cast<unsigned>(x.size()), x.data(), nullptr);
-    if (*std::max_element(con.begin(), con.end()) > 0.0) {
-      const double bound = std::max(1.0 - 1e-3, con[0] + 1.0);
-      if (!restore_reach(s, x, bound)) {
-        TrajectoryMetrics m = problem.measure(basis, s.coefficients(x.data()), o, history);
-        m.status = RunStatus::infeasible;
-        m.opt_start_objective = start_f;
-        m.opt_evaluations = static_cast<double>(s.evaluations);
-        return m;
-      }
-    }
+  SlsqpSpec spec;
+  spec.bound = bound;
+  spec.tolerance = g.tolerance;
+  spec.max_evaluations = g.max_evaluations;
+  spec.f = [&s](const double* x, double* grad) { return s.objective_at(x, grad); };
+  if (extension == Extension::alpha) {  // the self-motion chart reaches by construction
+    spec.constraints = static_cast<unsigned>(problem.samples());
+    spec.con = [&s, n = static_cast<unsigned>(x.size())](const double* x, double* con, double* jac) {
+      s.reach_at(static_cast<unsigned>(s.problem->samples()), con, n, x, jac);
+    };
   }
-  nlopt::opt opt(nlopt::LD_SLSQP, static_cast<unsigned>(x.size()));
-  opt.set_lower_bounds(-bound);
-  opt.set_upper_bounds(bound);
-  opt.set_ftol_rel(g.tolerance);
-  opt.set_maxeval(static_cast<int>(g.max_evaluations));
-  opt.set_min_objective([](const std::vector<double>& x, std::vector<double>& grad, void* data) {
-    return static_cast<Solve*>(data)->objective_at(x, grad);
-  }, &s);
-  if (extension == Extension::alpha)  // the self-motion chart reaches by construction
-    opt.add_inequality_mconstraint(
-        [](unsigned m, double* con, unsigned n, const double* x, double* grad, void* data) {
-          static_cast<Solve*>(data)->reach_at(m, con, n, x, grad);
-        },
-        &s, std::vector<double>(problem.samples(), 0.0));
-  RunStatus outcome = RunStatus::ok;
-  try {
-    double f = 0.0;
-    if (opt.optimize(x, f) == nlopt::MAXEVAL_REACHED) outcome = RunStatus::max_evaluations;
-  } catch (const nlopt::roundoff_limited&) {
-    // NLopt: "the optimization still typically returns a useful result"; the gradient norm says how useful
-  } catch (const std::exception&) {
-    outcome = RunStatus::not_converged;
-  }
+  const RunStatus outcome = minimise_slsqp(spec, x);
   const std::vector<double> best(s.coefficients(x.data()), s.coefficients(x.data()) + basis.coefficients);
   if (coefficients) *coefficients = best;
   TrajectoryMetrics m = problem.measure(basis, best.data(), o, history);

@@ -1,0 +1,29 @@
+#pragma once
+// The optimiser of the path-global method: NLopt's SLSQP (gradient-based, local) on box-bounded
+// coefficients, with optional inequality constraints, and its outcome as a run status.
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "methods/trajectory.hpp"
+
+namespace ks {
+
+struct SlsqpSpec {
+  /// f(x, grad): the objective at x; its gradient into grad (size of x) when grad is not null.
+  std::function<double(const double* x, double* grad)> f;
+  /// con(x, con, jac): `constraints` values con(x) <= 0 and, when jac is not null, their gradients
+  /// (row-major, constraints x size of x). None when constraints = 0.
+  unsigned constraints = 0;
+  std::function<void(const double* x, double* con, double* jac)> con;
+  double bound = 0;                   ///< every coefficient within [-bound, bound]
+  double tolerance = 1e-10;           ///< relative change of the objective that stops SLSQP
+  std::int64_t max_evaluations = 1;   ///< objective evaluations allowed
+};
+
+/// Minimise from x (updated in place to the last point SLSQP returns). Status: ok (a tolerance was
+/// met, or SLSQP stopped on roundoff: NLopt's "typically useful result"), max_evaluations, or
+/// not_converged (any other NLopt failure).
+RunStatus minimise_slsqp(const SlsqpSpec& spec, std::vector<double>& x);
+
+}  // namespace ks
