@@ -12,13 +12,7 @@
 
 namespace ks {
 
-namespace {
-
-/// The self-motion chart at a tip position p, velocity v and acceleration acc of a 3R arm whose first
-/// two links reach L = l1 + l2 and whose last is l3: phi = atan2(y, x) and beta = acos(gamma) with
-/// gamma = (r^2 + l3^2 - L^2) / (2 r l3) (the law of cosines in the triangle base, tip, wrist), with
-/// their time derivatives. False when beta is not within (0, pi).
-bool chart_at(const Vec2& p, const Vec2& v, const Vec2& acc, double L, double l3, ChartSample& c) {
+bool self_motion_chart(const Vec2& p, const Vec2& v, const Vec2& acc, double L, double l3, ChartSample& c) {
   const double r2 = p.squaredNorm(), r = std::sqrt(r2);
   if (!(r > 0.0)) return false;
   const double cross = p.x() * v.y() - p.y() * v.x(), dot = p.x() * v.x() + p.y() * v.y();
@@ -38,7 +32,6 @@ bool chart_at(const Vec2& p, const Vec2& v, const Vec2& acc, double L, double l3
   return true;
 }
 
-}  // namespace
 
 PathGlobalProblem::PathGlobalProblem(const PlanarArm3& arm, const SampledPath& path, Elbow elbow,
                                      double singular_tolerance, Extension extension)
@@ -49,7 +42,7 @@ PathGlobalProblem::PathGlobalProblem(const PlanarArm3& arm, const SampledPath& p
   if (extension_ != Extension::self_motion) return;
   chart_.resize(path.size());
   for (std::size_t i = 0; i < path.size(); ++i)
-    chart_defined_ = chart_defined_ && chart_at(path.position(i), velocity_[i], path.acceleration(i),
+    chart_defined_ = chart_defined_ && self_motion_chart(path.position(i), velocity_[i], path.acceleration(i),
                                                 arm.l[0] + arm.l[1], arm.l[2], chart_[i]);
 }
 
@@ -58,7 +51,7 @@ double PathGlobalProblem::coordinate(std::size_t i, double alpha, Elbow elbow) c
   const ChartSample& c = chart_[i];
   const double d = std::remainder(alpha - c.phi[0], 2.0 * std::numbers::pi);
   const double s = std::clamp(d / c.beta[0], -1.0, 1.0);
-  return std::atan2(static_cast<int>(elbow) * std::sqrt(1.0 - s * s), s);
+  return std::atan2(s, static_cast<int>(elbow) * std::sqrt(1.0 - s * s));
 }
 
 void PathGlobalProblem::sample(std::size_t i, double x, double xd, double xdd, GlobalSample& s) const {
@@ -68,11 +61,21 @@ void PathGlobalProblem::sample(std::size_t i, double x, double xd, double xdd, G
   const double a = c.phi[0] + c.beta[0] * sp;
   const double ad = c.phi[1] + c.beta[1] * sp + c.beta[0] * cp * xd;
   const double add = c.phi[2] + c.beta[2] * sp + 2.0 * c.beta[1] * cp * xd - c.beta[0] * sp * xd * xd + c.beta[0] * cp * xdd;
-  sample_alpha(i, a, ad, add, cp >= 0.0 ? Elbow::positive : Elbow::negative, s);
+  sample_alpha(i, a, ad, add, cp >= 0.0 ? Elbow::positive : Elbow::negative, s, self_motion_elbow(x, c.beta[0],
+               path_.position(i).norm(), arm_.l[2], arm_.l[0], arm_.l[1]));
+}
+
+double self_motion_elbow(double psi, double beta, double r, double l3, double l1, double l2) {
+  // 1 - cos(theta2) = r l3 (cos(beta sin psi) - cos beta) / (l1 l2), the difference of cosines as a
+  // product of sines and 1 -+ sin psi as 2 sin^2(pi/4 -+ psi/2): no cancellation near the stretched arm
+  constexpr double q = std::numbers::pi / 4;
+  const double u = 2.0 * std::pow(std::sin(q - 0.5 * psi), 2), v = 2.0 * std::pow(std::sin(q + 0.5 * psi), 2);
+  const double h = std::clamp(r * l3 * std::sin(0.5 * beta * v) * std::sin(0.5 * beta * u) / (l1 * l2), 0.0, 1.0);
+  return (std::cos(psi) >= 0.0 ? 2.0 : -2.0) * std::asin(std::sqrt(h));
 }
 
 void PathGlobalProblem::sample_alpha(std::size_t i, double a, double ad, double add, Elbow elbow,
-                                     GlobalSample& s) const {
+                                     GlobalSample& s, double theta2) const {
   // inverse_kinematics (model/kinematics.hpp) with cos(theta2) kept within reach, so that the joint
   // path and the objective continue past the reach boundary (the optimiser's trial points; the reach
   // constraints bring it back): an unreachable sample is reported, its values are those at the boundary
@@ -88,8 +91,10 @@ void PathGlobalProblem::sample_alpha(std::size_t i, double a, double ad, double 
     s.det = 0.0;
     return;
   }
-  const double c2 = std::clamp(c2_raw, -kReachClamp, kReachClamp);
-  const double s2 = static_cast<int>(elbow) * std::sqrt(1.0 - c2 * c2);
+  const bool given = std::isfinite(theta2);  // the self-motion chart's, within reach by construction
+  if (given) s.reachable = true, s.reach_excess = 0.0;
+  const double c2 = given ? std::cos(theta2) : std::clamp(c2_raw, -kReachClamp, kReachClamp);
+  const double s2 = given ? std::sin(theta2) : static_cast<int>(elbow) * std::sqrt(1.0 - c2 * c2);
   const double c1 = ((arm_.l[0] + arm_.l[1] * c2) * x2 + arm_.l[1] * s2 * y2) / d;
   const double s1 = ((arm_.l[0] + arm_.l[1] * c2) * y2 - arm_.l[1] * s2 * x2) / d;
   const double t1 = std::atan2(s1, c1), t2 = std::atan2(s2, c2);

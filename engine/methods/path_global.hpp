@@ -8,6 +8,7 @@
 // the three partials per sample by central differences: seven sample evaluations per sample for the
 // whole gradient, whatever the number of coefficients.
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "methods/alpha_basis.hpp"
@@ -23,6 +24,18 @@ namespace ks {
 struct ChartSample {
   double phi[3], beta[3];
 };
+
+/// The self-motion chart at a tip position p [m], velocity v [m/s] and acceleration acc [m/s^2] of a
+/// 3R arm whose first two links reach L = l1 + l2 [m] and whose last is l3 [m]: phi = atan2(y, x) and
+/// beta = acos(gamma) with gamma = (r^2 + l3^2 - L^2) / (2 r l3) (the law of cosines in the triangle
+/// base, tip, wrist), with their time derivatives. False when beta is not within (0, pi).
+bool self_motion_chart(const Vec2& p, const Vec2& v, const Vec2& acc, double L, double l3, ChartSample& c);
+
+/// The elbow angle [rad] (theta2 of a 3R arm, the angle between its first two links) at the point
+/// psi [rad] of the self-motion chart with half-arc beta [rad], the tip at distance r [m] from the
+/// base, links l1, l2, l3 [m]: sign(cos psi) times its magnitude from the law of cosines, written so
+/// that it keeps its precision near the stretched arm (theta2 near 0, where the chart changes branch).
+double self_motion_elbow(double psi, double beta, double r, double l3, double l1, double l2);
 
 /// One sample of the joint path for (alpha, alpha_d, alpha_dd).
 struct GlobalSample {
@@ -75,7 +88,9 @@ class PathGlobalProblem {
 
  private:
   double cost(std::size_t i, double a, double ad, double add, GlobalObjective objective) const;
-  void sample_alpha(std::size_t i, double a, double ad, double add, Elbow elbow, GlobalSample& s) const;
+  /// theta2: the elbow angle when known (the self-motion chart's), NaN to solve it from the reach
+  void sample_alpha(std::size_t i, double a, double ad, double add, Elbow elbow, GlobalSample& s,
+                    double theta2 = std::numeric_limits<double>::quiet_NaN()) const;
 
   PlanarArm3 arm_;
   DynamicsCoefficients dyn_;
