@@ -84,8 +84,12 @@ AlphaBasis vertex_quintic_basis(const SampledPath& path) {
 }
 
 AlphaBasis cubic_spline_basis(const SampledPath& path, int knots, bool rest_at_end) {
+  return cubic_spline_basis(path.size(), path.dt(), path.path().duration(), knots, rest_at_end);
+}
+
+AlphaBasis cubic_spline_basis(std::size_t samples, double dt, double duration, int knots, bool rest_at_end) {
   if (knots < 2) throw std::invalid_argument("cubic_spline_basis: knots = " + std::to_string(knots) + "; expected >= 2");
-  const double T = path.path().duration();
+  const double T = duration;
   const int m = knots + 2;  // control points
   std::vector<double> U(4, 0.0);
   for (int j = 1; j + 1 < knots; ++j) U.push_back(T * j / (knots - 1));
@@ -96,9 +100,9 @@ AlphaBasis cubic_spline_basis(const SampledPath& path, int knots, bool rest_at_e
   const auto coefficient = [count](int j) { return std::clamp(j - 1, 0, count - 1); };
   AlphaBasis b;
   b.coefficients = count;
-  b.rows.resize(path.size());
-  for (std::size_t i = 0; i < path.size(); ++i) {
-    const double t = std::clamp(path.time(i), 0.0, T);
+  b.rows.resize(samples);
+  for (std::size_t i = 0; i < samples; ++i) {
+    const double t = std::clamp(static_cast<double>(i) * dt, 0.0, T);  // SampledQuinticPath::time
     int span = 3;
     while (span < m - 1 && t >= U[span + 1]) ++span;
     double ders[3][4];

@@ -48,6 +48,8 @@ AlphaBasis vertex_quintic_basis(const SampledPath& path);
 /// and, when `rest_at_end`, at the end (then `knots` coefficients, else knots + 1), on `path`'s
 /// samples (std::invalid_argument for knots < 2).
 AlphaBasis cubic_spline_basis(const SampledPath& path, int knots, bool rest_at_end = true);
+/// The same on `samples` samples t_i = i dt [s] of a path of `duration` [s] (any sampled path).
+AlphaBasis cubic_spline_basis(std::size_t samples, double dt, double duration, int knots, bool rest_at_end = true);
 
 /// Least-squares coefficients of `basis` for the samples alpha[0 .. count) [rad] (count <= rows);
 /// coefficients with no weight on those samples keep the last fitted value before them.

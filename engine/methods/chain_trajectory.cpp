@@ -4,6 +4,7 @@
 // Fixed-maximum-size types throughout: nothing is allocated per step. Planar tasks on planar chains of
 // revolute joints take the fixed-size run of methods/planar_chain_run.hpp instead.
 #include "methods/chain_trajectory.hpp"
+#include "methods/path_global_chain.hpp"
 #include "methods/run_sums.hpp"
 #include "methods/sample_sums.hpp"
 
@@ -330,13 +331,14 @@ TrajectoryMetrics run_method(const Chain& chain, const ChainTask& task, const Ve
       throw std::invalid_argument("simulate: vertex_alpha needs the planar_pose task");
     case TrajectoryMethod::global_spline: break;
   }
-  throw std::invalid_argument("simulate: global_spline is built for the closed-form 3R arm, not for chains");
+  throw std::invalid_argument("simulate: global_spline runs through solve_global_spline_chain");
 }
 
 }  // namespace
 
 TrajectoryMetrics simulate(const Chain& chain, const ChainTask& task, const VecN& q0, const TrajectoryOptions& o,
                            ChainHistory* history) {
+  if (o.method == TrajectoryMethod::global_spline) return solve_global_spline_chain(chain, task, q0, o, history);
   const SampledPath3& sampled = task.path;
   const int n = chain.dof(), m = task_dimension(task.space);
   if (std::string why; !o.IsValid(&why)) throw std::invalid_argument("simulate: " + why);

@@ -90,7 +90,7 @@ ParamDef preset_param() {
 std::vector<ParamDef> trajectory_params(const KindContext& ctx) {
   std::vector<ParamDef> t;
   t.push_back(preset_param());
-  // (global_spline: the closed-form 3R arm only; a chain study naming it is refused at the key)
+  // (global_spline: planar arms of revolute joints on a position path; other robots are refused at the key)
   t.push_back(named<Run>("method",
                          names_of<TrajectoryMethod>(TrajectoryMethod::local_weighted, TrajectoryMethod::local_unweighted,
                                                     TrajectoryMethod::vertex_alpha, TrajectoryMethod::global_spline),
@@ -114,7 +114,7 @@ std::vector<ParamDef> trajectory_params(const KindContext& ctx) {
                           "orientation at vertex " + std::to_string(v) + " (vertex_alpha; global_spline: its vertex start)",
                           [i](auto& r) -> auto& { return r.options.vertex_alpha[i]; }, kVertexAngles));
   }
-  if (ctx.path_global && !robot.chain) global_params(t);
+  if (ctx.path_global && robot.planar && !robot.pose_task) global_params(t);
   t.push_back(named<Run>("integrator", names_of<Integrator>(Integrator::semi_implicit_euler, Integrator::rk4),
                          "time integrator", [](auto& r) -> auto& { return r.options.integrator; }));
   t.push_back(real<Run>("dt", FileUnit::none, "s", TrajectoryOptions::dt_rule, "sample / integration step",
@@ -227,7 +227,7 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
                           e.gridded, [k](const M& r) { return r.sampled[k]; })
                     .labelled(std::string(e.label)));
   });
-  if (ctx.path_global && !robot.chain) {
+  if (ctx.path_global && robot.planar && !robot.pose_task) {
     m.push_back(metric<M>("opt_start_objective", CellType::f64, "",
                           "global_spline: the objective at the optimiser's start (units of global_objective)", false,
                           [](const M& r) { return r.opt_start_objective; }));

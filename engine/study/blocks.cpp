@@ -308,21 +308,32 @@ void Parser::check_robot_supports(const BlockDraft& d, const Study& s) {
                      "); expected a robot with more joints than task equations, or a position task");
     return;
   }
-  // global_spline: the closed-form 3R arm only (its extension and IK are the 3R's closed forms)
-  const std::string global_reason =
-      "global_spline is built for the seed's closed-form 3R arm (a [robot] table without l, m or urdf), not yet "
-      "for chain robots";
-  for (const auto& [name, v] : d.spec.fixed)
-    if (const std::string* t = std::get_if<std::string>(&v); name == "method" && t && *t == "global_spline") {
-      error(d.table.get(name)->source(), global_reason + "; expected local_weighted, local_unweighted or vertex_alpha");
-      return;
+  // global_spline on a chain: planar, revolute joints, a position path; cubic splines from a local
+  // or random start (the vertex family and start are the seed's 3R's)
+  bool prismatic = false;
+  for (int j = 0; j < r.joints; ++j) prismatic = prismatic || r.is_prismatic(j);
+  const char* global_why = !r.planar ? "a spatial robot" : r.pose_task ? "an orientation path" : prismatic ? "prismatic joints" : nullptr;
+  const auto refuse_global = [&](const std::string& key, const std::string& value, const std::string& why,
+                                 const auto& at, bool axis) {
+    error(at, key + " = \"" + value + "\" " + why + (axis ? " (the " + key + " axis includes it)" : "") + "; expected " +
+                  (key == "method" ? "local_weighted or local_unweighted" : key == "spline" ? "cubic" : "local or random"));
+  };
+  const auto check_global = [&](const std::string& key, const std::string& value, const auto& at, bool axis) {
+    if (key == "method" && value == "global_spline" && global_why) {
+      refuse_global(key, value, std::string("is the path-global method of planar arms of revolute joints on a position path, not of ") + global_why, at, axis);
+      return true;
     }
+    if ((key == "spline" && value == "vertex_quintic") || (key == "global_start" && value == "vertex")) {
+      refuse_global(key, value, "is the seed's vertex family, defined for its closed-form 3R arm, not for a chain robot", at, axis);
+      return true;
+    }
+    return false;
+  };
+  for (const auto& [name, v] : d.spec.fixed)
+    if (const std::string* t = std::get_if<std::string>(&v); t && check_global(name, *t, d.table.get(name)->source(), false)) return;
   for (const AxisDraft& a : d.drafts)
     for (const auto& v : a.axis.values)
-      if (const std::string* t = std::get_if<std::string>(&v); a.axis.name == "method" && t && *t == "global_spline") {
-        error(a.pos, global_reason + " (the method axis includes it); expected the other methods");
-        return;
-      }
+      if (const std::string* t = std::get_if<std::string>(&v); t && check_global(a.axis.name, *t, a.pos, true)) return;
   if (r.vertex_alpha()) return;
   // vertex_alpha: named by method (fixed or axis) or by a preset of cases 3-5
   auto uses = [&](const std::string& name, const Cell& v) {

@@ -1,0 +1,106 @@
+// solve_global_spline_chain (methods/path_global_chain.hpp): the start from the chain's local run,
+// the SLSQP solve over every coordinate's spline, and the final measure.
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+
+#include "methods/global_solve.hpp"
+#include "methods/path_global_chain.hpp"
+
+namespace ks {
+
+TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask& task, const VecN& q0,
+                                            const TrajectoryOptions& o, ChainHistory* history,
+                                            std::vector<double>* coefficients) {
+  if (std::string why; !o.IsValid(&why)) throw std::invalid_argument("global_spline: " + why);
+  const PathGlobalOptions& g = o.global;
+  if (g.spline != AlphaSpline::cubic || g.start == GlobalStart::vertex)
+    throw std::invalid_argument("global_spline on a chain: cubic splines from a local or random start only");
+  const int n = chain.dof();
+  // the start: the chain's local run (its first sample is the start solve's configuration)
+  TrajectoryOptions lo = o;
+  lo.method = g.start_method == StartMethod::local_unweighted ? TrajectoryMethod::local_unweighted
+                                                             : TrajectoryMethod::local_weighted;
+  lo.on_violation = OnViolation::ignore;
+  ChainHistory h;
+  h.stride = 1;
+  const TrajectoryMetrics local = simulate(chain, task, q0, lo, &h);
+  if (local.status == RunStatus::unreachable_start || h.size == 0) return not_simulated(RunStatus::unreachable_start, n);
+  const VecN q_start = h.q.col(0);
+  Elbow elbow = Elbow::positive;
+  {
+    double z[kMaxJoints];
+    ChainGlobalProblem probe(chain, task, Extension::alpha, Elbow::positive);
+    probe.coordinates_of(0, q_start, z, elbow);  // the last three joints' branch at the start
+  }
+  const ChainGlobalProblem problem(chain, task, g.extension, elbow);
+  const AlphaBasis basis = cubic_spline_basis(task.path.size(), task.path.dt(), task.path.path().duration(),
+                                                static_cast<int>(g.knots), g.end == EndState::rest);
+  const int K = basis.coefficients, r = problem.coordinates();
+  const std::size_t count = std::min<std::size_t>(static_cast<std::size_t>(h.size), problem.samples());
+  // each coordinate along the local run, unwrapped, fitted by the spline
+  std::vector<std::vector<double>> series(r, std::vector<double>(count));
+  for (std::size_t i = 0; i < count; ++i) {
+    double z[kMaxJoints];
+    Elbow e;
+    problem.coordinates_of(i, h.q.col(static_cast<Eigen::Index>(i)), z, e);
+    for (int k = 0; k < r; ++k)
+      series[k][i] = i == 0 ? z[k] : series[k][i - 1] + std::remainder(z[k] - series[k][i - 1], 2.0 * std::numbers::pi);
+  }
+  std::vector<double> c(static_cast<std::size_t>(K) * r);
+  std::mt19937_64 rng(static_cast<std::uint64_t>(g.start_seed));
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  for (int k = 0; k < r; ++k) {
+    std::vector<double> ck = g.start == GlobalStart::random ? std::vector<double>(K, series[k][0])
+                                                             : fit_basis(basis, series[k].data(), count);
+    if (g.start == GlobalStart::random)
+      for (double& x : ck) x += u(rng);
+    std::copy(ck.begin(), ck.end(), c.begin() + k * K);
+  }
+  const bool fixed = g.posture == StartPosture::fixed;
+  if (fixed)
+    for (int k = 0; k < r; ++k) c[k * K] = series[k][0];
+  // the free coefficients: all, or all but each coordinate's first (its value at the start)
+  std::vector<int> free;
+  for (int k = 0; k < r; ++k)
+    for (int j = fixed ? 1 : 0; j < K; ++j) free.push_back(k * K + j);
+  const double bound = 4.0 * std::numbers::pi + std::ranges::max(c, {}, [](double v) { return std::abs(v); });
+  std::vector<double> x(free.size()), full = c, grad(c.size());
+  for (std::size_t m = 0; m < free.size(); ++m) x[m] = c[free[m]];
+  long evaluations = 0;
+  const auto at = [&](const double* xs) {
+    for (std::size_t m = 0; m < free.size(); ++m) full[free[m]] = xs[m];
+    return full.data();
+  };
+  const double start_f = problem.objective(basis, c.data(), g.objective, nullptr);
+  SlsqpSpec spec;
+  spec.bound = bound;
+  spec.tolerance = g.tolerance;
+  spec.max_evaluations = g.max_evaluations;
+  spec.f = [&](const double* xs, double* gx) {
+    ++evaluations;
+    const double f = problem.objective(basis, at(xs), g.objective, gx ? grad.data() : nullptr);
+    if (gx)
+      for (std::size_t m = 0; m < free.size(); ++m) gx[m] = grad[free[m]];
+    return f;
+  };
+  const RunStatus outcome = minimise_slsqp(spec, x);
+  const std::vector<double> best(at(x.data()), at(x.data()) + c.size());
+  if (coefficients) *coefficients = best;
+  TrajectoryMetrics m = problem.measure(basis, best.data(), q_start, o, history);
+  if (m.status == RunStatus::ok) m.status = outcome;
+  m.opt_objective = problem.objective(basis, best.data(), g.objective, grad.data());
+  double norm = 0.0;
+  for (int idx : free) {
+    const bool at_lower = best[idx] <= -bound && grad[idx] > 0, at_upper = best[idx] >= bound && grad[idx] < 0;
+    if (!at_lower && !at_upper) norm = std::max(norm, std::abs(grad[idx]));
+  }
+  m.opt_gradient_norm = norm;
+  m.opt_start_objective = start_f;
+  m.opt_evaluations = static_cast<double>(evaluations);
+  return m;
+}
+
+}  // namespace ks
