@@ -169,12 +169,13 @@ TEST(StudyRobot, RedundancyAndVertexAlphaAreCheckedAgainstTheRobot) {
                "not for a planar arm of more than 3 joints");
   expect_error("[robot]\nl = [0.8, 0.8, 0.7, 0.5]\nm = [1, 1, 1, 1]\n" + kTraj + "[block.axes]\npreset = [\"1a\", \"3\"]\n",
                8, 1, "the preset axis includes it");
-  // global_spline is the closed-form 3R's, at the key or the axis that names it
-  expect_error("[robot]\nl = [0.8, 0.8, 0.7, 0.5]\nm = [1, 1, 1, 1]\n" + kTraj + "method = \"global_spline\"\n", 7, 10,
-               "global_spline is built for the seed's closed-form 3R arm");
+  // global_spline on a chain: planar revolute arms; the seed's vertex family and start are its 3R's
   expect_error("[robot]\nl = [0.8, 0.8, 0.7, 0.5]\nm = [1, 1, 1, 1]\n" + kTraj +
-                   "[block.axes]\nmethod = [\"local_weighted\", \"global_spline\"]\n",
-               8, 1, "the method axis includes it");
+                   "method = \"global_spline\"\nglobal_start = \"vertex\"\n",
+               8, 16, "the seed's vertex family");
+  expect_error("[robot]\nl = [0.8, 0.8, 0.7, 0.5]\nm = [1, 1, 1, 1]\n" + kTraj +
+                   "method = \"global_spline\"\n[block.axes]\nspline = [\"cubic\", \"vertex_quintic\"]\n",
+               9, 1, "the spline axis includes it");
 }
 
 TEST(StudyRobot, UrdfRobotLoadsRelativeToTheStudy) {

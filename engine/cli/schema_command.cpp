@@ -56,6 +56,7 @@ std::vector<Listed> listed() {
   planar4.robot.chain = true;
   planar4.robot.joints = 4;
   planar4.scara = false;
+  planar4.path_global = true;  // global_spline's columns (planar revolute chains on a position path)
   KindContext spatial7 = planar4;  // a spatial URDF chain (here 7 revolute joints)
   spatial7.robot.joints = 7;
   spatial7.robot.planar = false;

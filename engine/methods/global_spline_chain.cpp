@@ -19,14 +19,18 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
   if (g.spline != AlphaSpline::cubic || g.start == GlobalStart::vertex)
     throw std::invalid_argument("global_spline on a chain: cubic splines from a local or random start only");
   const int n = chain.dof();
-  // the start: the chain's local run (its first sample is the start solve's configuration)
-  TrajectoryOptions lo = o;
-  lo.method = g.start_method == StartMethod::local_unweighted ? TrajectoryMethod::local_unweighted
-                                                             : TrajectoryMethod::local_weighted;
-  lo.on_violation = OnViolation::ignore;
+  // the start: the chain's local run (its first sample is the start solve's configuration), each
+  // coordinate along it unwrapped and fitted by the spline
   ChainHistory h;
   h.stride = 1;
-  const TrajectoryMetrics local = simulate(chain, task, q0, lo, &h);
+  const auto local_run = [&](StartMethod method) {
+    TrajectoryOptions lo = o;
+    lo.method = method == StartMethod::local_unweighted ? TrajectoryMethod::local_unweighted
+                                                        : TrajectoryMethod::local_weighted;
+    lo.on_violation = OnViolation::ignore;
+    return simulate(chain, task, q0, lo, &h);
+  };
+  const TrajectoryMetrics local = local_run(g.start_method);
   if (local.status == RunStatus::unreachable_start || h.size == 0) return not_simulated(RunStatus::unreachable_start, n);
   const VecN q_start = h.q.col(0);
   Elbow elbow = Elbow::positive;
@@ -37,31 +41,53 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
   }
   const ChainGlobalProblem problem(chain, task, g.extension, elbow);
   const AlphaBasis basis = cubic_spline_basis(task.path.size(), task.path.dt(), task.path.path().duration(),
-                                                static_cast<int>(g.knots), g.end == EndState::rest);
+                                              static_cast<int>(g.knots), g.end == EndState::rest);
   const int K = basis.coefficients, r = problem.coordinates();
-  const std::size_t count = std::min<std::size_t>(static_cast<std::size_t>(h.size), problem.samples());
-  // each coordinate along the local run, unwrapped, fitted by the spline
-  std::vector<std::vector<double>> series(r, std::vector<double>(count));
-  for (std::size_t i = 0; i < count; ++i) {
-    double z[kMaxJoints];
-    Elbow e;
-    problem.coordinates_of(i, h.q.col(static_cast<Eigen::Index>(i)), z, e);
+  std::vector<double> first(r);
+  const auto fitted = [&]() {  // the coefficients of the run in h
+    const std::size_t count = std::min<std::size_t>(static_cast<std::size_t>(h.size), problem.samples());
+    std::vector<std::vector<double>> series(r, std::vector<double>(count));
+    for (std::size_t i = 0; i < count; ++i) {
+      double z[kMaxJoints];
+      Elbow e;
+      problem.coordinates_of(i, h.q.col(static_cast<Eigen::Index>(i)), z, e);
+      for (int k = 0; k < r; ++k)
+        series[k][i] = i == 0 ? z[k] : series[k][i - 1] + std::remainder(z[k] - series[k][i - 1], 2.0 * std::numbers::pi);
+    }
+    std::vector<double> c(static_cast<std::size_t>(K) * r);
+    for (int k = 0; k < r; ++k) {
+      const std::vector<double> ck = fit_basis(basis, series[k].data(), count);
+      std::copy(ck.begin(), ck.end(), c.begin() + k * K);
+      first[k] = series[k][0];
+    }
+    return c;
+  };
+  const auto usable = [&](const std::vector<double>& cs) {
+    for (double v : cs)
+      if (!std::isfinite(v)) return false;
+    return problem.worst_violation(basis, cs.data()) == 0.0;
+  };
+  std::vector<double> c = fitted();
+  if (g.start == GlobalStart::random) {
+    std::mt19937_64 rng(static_cast<std::uint64_t>(g.start_seed));
+    std::uniform_real_distribution<double> u(-0.5, 0.5);
     for (int k = 0; k < r; ++k)
-      series[k][i] = i == 0 ? z[k] : series[k][i - 1] + std::remainder(z[k] - series[k][i - 1], 2.0 * std::numbers::pi);
+      for (int j = 0; j < K; ++j) c[k * K + j] = first[k] + u(rng);
+  } else if (!usable(c)) {
+    // a local run far off its path can leave the chart once put on the path: the other local method's
+    // run, when it stays on it
+    const std::vector<double> keep = c, keep_first = first;
+    const StartMethod other = g.start_method == StartMethod::local_unweighted ? StartMethod::local_weighted
+                                                                              : StartMethod::local_unweighted;
+    local_run(other);
+    c = h.size > 0 ? fitted() : keep;
+    if (h.size == 0 || !usable(c)) c = keep, first = keep_first;
   }
-  std::vector<double> c(static_cast<std::size_t>(K) * r);
-  std::mt19937_64 rng(static_cast<std::uint64_t>(g.start_seed));
-  std::uniform_real_distribution<double> u(-0.5, 0.5);
-  for (int k = 0; k < r; ++k) {
-    std::vector<double> ck = g.start == GlobalStart::random ? std::vector<double>(K, series[k][0])
-                                                             : fit_basis(basis, series[k].data(), count);
-    if (g.start == GlobalStart::random)
-      for (double& x : ck) x += u(rng);
-    std::copy(ck.begin(), ck.end(), c.begin() + k * K);
-  }
+  for (double v : c)  // a local run that diverged at both methods: nothing to start from
+    if (!std::isfinite(v)) return not_simulated(RunStatus::infeasible, n);
   const bool fixed = g.posture == StartPosture::fixed;
   if (fixed)
-    for (int k = 0; k < r; ++k) c[k * K] = series[k][0];
+    for (int k = 0; k < r; ++k) c[k * K] = first[k];
   // the free coefficients: all, or all but each coordinate's first (its value at the start)
   std::vector<int> free;
   for (int k = 0; k < r; ++k)

@@ -17,6 +17,7 @@ namespace {
 
 using V2 = Eigen::Vector2d;
 constexpr double kViolationWeight = 1e6;
+constexpr double kInfeasibleFloor = 1e4;  // per unit of 1 / samples, in the objective's units
 constexpr double kClamp = 1.0 - 1e-12;
 
 V2 dir(double a) { return {std::cos(a), std::sin(a)}; }
@@ -147,8 +148,12 @@ double ChainGlobalProblem::cost(std::size_t i, const double (*z)[3], GlobalObjec
   sample(i, z, s);
   const std::size_t n = samples();
   const double trapezoid = (i == 0 || i + 1 == n) ? 0.5 * task_.path.dt() : task_.path.dt();
-  double f = kViolationWeight * s.violation * s.violation;
-  if (extension_ == Extension::alpha && !(std::abs(s.det) >= 1e-12)) f += 1e6 / static_cast<double>(n);
+  // a sample off the chart or out of reach: its torques (at the clamped boundary, near singular) are
+  // left out, and a floor above any valid sample's cost and a penalty growing with the violation
+  // keep the optimiser away
+  if (s.violation > 0.0) return kInfeasibleFloor / static_cast<double>(n) + kViolationWeight * s.violation * s.violation;
+  double f = 0.0;
+  if (extension_ == Extension::alpha && !(std::abs(s.det) >= 1e-12)) f += kInfeasibleFloor / static_cast<double>(n);
   switch (objective) {
     case GlobalObjective::E: return f + s.tau.norm() / static_cast<double>(n);
     case GlobalObjective::E_M: return f + std::sqrt(s.tau.dot(state_.M.ldlt().solve(s.tau))) / static_cast<double>(n);
@@ -181,6 +186,18 @@ double ChainGlobalProblem::objective(const AlphaBasis& basis, const double* c, G
       }
   }
   return f;
+}
+
+double ChainGlobalProblem::worst_violation(const AlphaBasis& basis, const double* c) const {
+  const int K = basis.coefficients, r = coordinates();
+  double worst = 0.0, z[kMaxJoints][3];
+  for (std::size_t i = 0; i < samples(); ++i) {
+    for (int k = 0; k < r; ++k) basis.at(i, c + k * K, z[k][0], z[k][1], z[k][2]);
+    ChainGlobalSample s;
+    sample(i, z, s);
+    worst = std::max(worst, s.violation);
+  }
+  return worst;
 }
 
 TrajectoryMetrics ChainGlobalProblem::measure(const AlphaBasis& basis, const double* c, const VecN& q_start,

@@ -46,6 +46,9 @@ class ChainGlobalProblem {
   /// plus 1e6 times each sample's squared violation; its gradient into grad when not null.
   double objective(const AlphaBasis& basis, const double* c, GlobalObjective objective, double* grad) const;
 
+  /// The largest violation over the samples at coefficients c (0: every sample on the chart and in reach).
+  double worst_violation(const AlphaBasis& basis, const double* c) const;
+
   /// The run's metrics at c (the trajectory kind's, through the per-sample accumulator, with the
   /// chain's limits), its history when given; q continued across (-pi, pi] from q_start. A sample
   /// off the chart or out of reach ends the run there, infeasible; a singular wrist solve (|det| <
