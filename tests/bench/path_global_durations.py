@@ -7,17 +7,10 @@ statuses, the best local run that stays within 1 mm of its path, and the best gl
 usage: /usr/bin/python3 path_global_durations.py KINESWEEP_BINARY [--durations 1,1.5,2,3,4] [--threads N]
 """
 import argparse
-import os
-import subprocess
-import sys
-import tempfile
 
-import h5py
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "analysis"))
-from kinesweep import read as ksread  # noqa: E402
+from study_runs import run_study
 
 STUDY = """
 [study]
@@ -58,32 +51,24 @@ def main():
     ap.add_argument("--threads", default="2")
     a = ap.parse_args()
     rows = []
-    with tempfile.TemporaryDirectory() as tmp:
-        for T in [float(x) for x in a.durations.split(",")]:
-            study = os.path.join(tmp, f"d{T}.toml")
-            out = os.path.join(tmp, f"d{T}.h5")
-            with open(study, "w") as f:
-                f.write(STUDY.format(d=T / 4))
-            subprocess.run([a.kinesweep, "run", study, "-o", out, "-q", "--threads", a.threads], check=True,
-                           capture_output=True)
-            with ksread.open_results(out) as r:
-                runs = r.runs(degrees=True)
-            block = np.asarray(runs["block"])
-            status = np.asarray(runs["status"])
-            E = np.asarray(runs["E"], dtype=float)
-            track = np.asarray(runs["max_tracking_error"], dtype=float)
-            loc = block == "local"
-            n = int(loc.sum())
-            counts = {s: int(((status == s) & loc).sum()) for s in np.unique(status[loc])}
-            on_path = loc & (status == "ok") & (track <= 1e-3)
-            best_local = float(np.nanmin(E[on_path])) if on_path.any() else float("nan")
-            best_any = float(np.nanmin(np.where(loc & (status == "ok"), E, np.nan)))
-            glo = (block == "global") & (status == "ok")
-            end = np.asarray(runs["end_state"])
-            best_rest = float(np.nanmin(np.where(glo & (end == "rest"), E, np.nan))) if (glo & (end == "rest")).any() else float("nan")
-            best_free = float(np.nanmin(np.where(glo & (end == "free"), E, np.nan))) if (glo & (end == "free")).any() else float("nan")
-            g_status = {s: int(((status == s) & (block == "global")).sum()) for s in np.unique(status[block == "global"])}
-            rows.append((T, n, counts, int(on_path.sum()), best_local, best_any, best_rest, best_free, g_status))
+    for T in [float(x) for x in a.durations.split(",")]:
+        runs = run_study(a.kinesweep, STUDY.format(d=T / 4), a.threads, degrees=True)
+        block = np.asarray(runs["block"])
+        status = np.asarray(runs["status"])
+        E = np.asarray(runs["E"], dtype=float)
+        track = np.asarray(runs["max_tracking_error"], dtype=float)
+        loc = block == "local"
+        n = int(loc.sum())
+        counts = {s: int(((status == s) & loc).sum()) for s in np.unique(status[loc])}
+        on_path = loc & (status == "ok") & (track <= 1e-3)
+        best_local = float(np.nanmin(E[on_path])) if on_path.any() else float("nan")
+        best_any = float(np.nanmin(np.where(loc & (status == "ok"), E, np.nan)))
+        glo = (block == "global") & (status == "ok")
+        end = np.asarray(runs["end_state"])
+        best_rest, best_free = (float(np.nanmin(np.where(glo & (end == e), E, np.nan))) if (glo & (end == e)).any()
+                                else float("nan") for e in ("rest", "free"))
+        g_status = {s: int(((status == s) & (block == "global")).sum()) for s in np.unique(status[block == "global"])}
+        rows.append((T, n, counts, int(on_path.sum()), best_local, best_any, best_rest, best_free, g_status))
     print("| T [s] | local runs: statuses | within 1 mm | best local E (≤ 1 mm / any ok) | global_spline E (end at rest / free) | global statuses |")
     print("|---|---|---|---|---|---|")
     for T, n, counts, k, bl, ba, gr, gf, gs in rows:

@@ -5,16 +5,10 @@ Prints a markdown table with the change between the two finest counts.
 usage: /usr/bin/python3 path_global_knots.py KINESWEEP_BINARY [--knots 5,10,20,40,80,160] [--threads N]
 """
 import argparse
-import os
-import subprocess
-import sys
-import tempfile
 
 import numpy as np
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "analysis"))
-from kinesweep import read as ksread  # noqa: E402
+from study_runs import run_study
 
 STUDY = """
 [study]
@@ -42,14 +36,7 @@ def main():
     ap.add_argument("--knots", default="5,10,20,40,80,160")
     ap.add_argument("--threads", default="2")
     a = ap.parse_args()
-    with tempfile.TemporaryDirectory() as tmp:
-        study, out = os.path.join(tmp, "knots.toml"), os.path.join(tmp, "knots.h5")
-        with open(study, "w") as f:
-            f.write(STUDY.format(knots=a.knots))
-        subprocess.run([a.kinesweep, "run", study, "-o", out, "-q", "--threads", a.threads], check=True,
-                       capture_output=True)
-        with ksread.open_results(out) as r:
-            runs = r.runs()
+    runs = run_study(a.kinesweep, STUDY.format(knots=a.knots), a.threads)
     knots = [int(k) for k in a.knots.split(",")]
     print("| α(0) | inertia | " + " | ".join(f"{k} knots" for k in knots) + " | change between the two finest |")
     print("|---|---|" + "---|" * len(knots) + "---|")
