@@ -145,13 +145,22 @@ def status_section(view):
         f'<p class="caption">Runs per block and status, counted over the done rows. {good}</p>'
 
 
+def held(v):
+    """Which values of a column are values: not NaN, -1 (integers) or "" (the missing values of a
+    column a block does not have, e.g. global_spline's in a block of local runs)."""
+    return np.isfinite(v) if v.dtype.kind == "f" else (v != -1) if v.dtype.kind in "iu" else (v != "")
+
+
 def varying_parameters(view, block, rows):
     """The block's parameters (of its kind) that take more than one value over its done rows, and the
-    fixed ones. (Floats compare rounded to 12 decimals; NaN is no value.)"""
+    fixed ones; parameters without a value in any of the rows are neither. (Floats compare rounded to
+    12 decimals; NaN is no value.)"""
     kind = view.kind(block)
     varying, fixed = [], []
     for c in view.res.parameters(kind or None):
         v = view.values(c, rows)
+        if len(v) and not held(v).any():
+            continue
         if v.dtype.kind == "f":
             f = np.round(v[np.isfinite(v)], 12)
             varies = f.size > 1 and f.min() != f.max()
@@ -166,9 +175,7 @@ def shown_metrics(view, block, rows):
     kind = view.kind(block)
     out = []
     for c in view.res.metrics(kind or None):
-        v = view.values(c, rows)
-        held = np.isfinite(v) if v.dtype.kind == "f" else (v != -1) if v.dtype.kind in "iu" else (v != "")
-        if held.any():
+        if held(view.values(c, rows)).any():
             out.append(c)
     return out
 
@@ -193,7 +200,7 @@ def best_section(view, n_best):
                 for i, r in enumerate(top)]
         first = rows_done[0]
         fixed_values = [(c, fmt(view.value(c, first))) for c in fixed]
-        fixed_text = ", ".join(f"{c} = {v}{(' ' + view.units[c]) if view.units[c] else ''}"
+        fixed_text = ", ".join(f"{c} = {v}{(' ' + view.units[c]) if view.units[c] not in ('', '1') else ''}"
                                for c, v in fixed_values if v not in ("", "–"))
         order = " then ".join(keys) if keys else "run id"
         cap = (f"The {len(top)} best of the block's {len(ranked)} {good} runs ({len(rows_done)} done), "

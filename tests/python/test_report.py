@@ -10,6 +10,7 @@ import base64
 import gzip
 import html
 import json
+import re
 import math
 import os
 import shutil
@@ -198,6 +199,33 @@ class ReportTest(unittest.TestCase):
                 self.assertIn(pid + "-data", p.islands)
                 spec = json.loads(p.islands[pid + "-data"])
                 self.assertTrue(spec["data"], pid)
+
+    def test_fixed_parameters_leave_out_columns_a_block_does_not_have(self):
+        # a block of local runs next to a global_spline block: global_spline's columns hold missing
+        # values (-1, "") in the local block's rows, which are not parameters of that block
+        text = """
+[study]
+name = "mixed"
+histories = "none"
+[[block]]
+name = "local"
+kind = "trajectory"
+[[block]]
+name = "global"
+kind = "trajectory"
+method = "global_spline"
+knots = 5
+max_evaluations = 3
+"""
+        page = open(self.report(run_study_text(KS, self.tmp.name, "mixed", text)), encoding="utf-8").read()
+        captions = re.findall(r"Fixed in this block: ([^<]*)", page)
+        self.assertEqual(len(captions), 2, captions)
+        local = [c for c in captions if "method = local_weighted" in c]
+        self.assertEqual(len(local), 1, captions)
+        for name in ("knots", "max_evaluations", "start_seed", "spline", "global_start"):
+            self.assertNotIn(name + " =", local[0])
+        self.assertTrue(any("knots = 5" in c and "max_evaluations = 3" in c for c in captions), captions)
+        self.assertNotIn("opt_tolerance = 1e-10 1", page)  # a dimensionless unit "1" is not written after a value
 
     def test_no_network_references(self):
         for name, path in self.html.items():
