@@ -36,6 +36,32 @@ STATUS_COLOURS = {"unreachable_start": "#b0b0b0", "singular": "#7b3294", "diverg
                   "no_solution": "#8f8f8f", "out_of_limits": "#fdae61",
                   "max_evaluations": "#b35806", "not_converged": "#fee090", "infeasible": "#4d4d4d",
                   "singular_extension": "#542788"}
+# Seed 000, Table 4 (copied from engine/methods/seed_cases.cpp, checked against it by the tests):
+# case -> (method, k, alpha1A [deg], thesis E [Nm], thesis (|tau1|inf, |tau2|inf, |tau3|inf) [Nm]).
+THESIS_TABLE4 = {
+    "1a": ("local_weighted", 0.0, 0.0, 51.03, (82.63, 32.31, 8.77)),
+    "1b": ("local_weighted", 0.0, 0.0, 51.03, (82.63, 32.31, 8.77)),
+    "1c": ("local_weighted", 0.0, 15.0, 55.77, (79.09, 33.26, 8.41)),
+    "1d": ("local_weighted", 0.57, 15.0, 51.70, (627.76, 111.32, 12.21)),
+    "1e": ("local_weighted", 0.0, 30.0, 62.27, (93.33, 42.30, 7.21)),
+    "1f": ("local_weighted", 0.16, 30.0, 54.32, (215.59, 50.28, 9.52)),
+    "1g": ("local_weighted", 0.0, -23.5, 38.63, (101.39, 45.40, 8.78)),
+    "1h": ("local_weighted", 0.13, -24.1, 37.79, (109.44, 48.33, 8.79)),
+    "2a": ("local_unweighted", 0.0, 0.0, 48.63, (50.33, 30.00, 8.71)),
+    "2b": ("local_unweighted", 0.0, 0.0, 48.63, (50.33, 30.00, 8.71)),
+    "2c": ("local_unweighted", 0.0, 15.0, 54.09, (57.32, 29.14, 8.61)),
+    "2d": ("local_unweighted", 0.75, 15.0, 54.07, (5301.60, 2135.90, 263.50)),
+    "2e": ("local_unweighted", 0.0, 30.0, 61.04, (387.90, 153.58, 22.35)),
+    "2f": ("local_unweighted", 0.18, 30.0, 54.83, (1076.50, 401.30, 49.40)),
+    "2g": ("local_unweighted", 0.0, -20.1, 39.41, (59.77, 51.65, 8.95)),
+    "2h": ("local_unweighted", 0.06, -23.5, 37.41, (90.23, 60.75, 10.30)),
+    "3": ("vertex_alpha", 0.0, -18.9, 53.58, (139.75, 35.49, 8.56)),
+    "4": ("vertex_alpha", 0.0, -18.3, 48.39, (116.40, 30.83, 8.58)),
+    "5a": ("vertex_alpha", 0.0, 0.0, 66.65, (178.82, 28.20, 8.26)),
+    "5b": ("vertex_alpha", 0.0, 15.0, 60.81, (121.11, 28.22, 8.26)),
+    "5c": ("vertex_alpha", 0.0, 30.0, 60.05, (107.88, 28.23, 8.26)),
+}
+
 # A converged run that reached none of the solutions a basin plot names.
 OTHER_SOLUTION_COLOUR = "#c7c7c7"
 
