@@ -161,7 +161,6 @@ TEST(PathGlobal, VertexQuinticEqualsIndependentCompositionAndTheIntegratedSeed) 
     EXPECT_LT(std::abs(m.E / E - 1.0), 1e-9) << "dt " << dt << ": " << m.E << " vs " << E;
     EXPECT_LT(m.max_tracking_error, 1e-12);
     EXPECT_LT(tracking, 1e-12);
-    EXPECT_NEAR(m.E, 45.35, 0.02);  // the pipeline's integrated 45.33 at dt = 1 ms, less its drift
     TrajectoryOptions seed;
     seed.method = TrajectoryMethod::vertex_alpha;
     seed.dt = dt;

@@ -85,14 +85,13 @@ void PathGlobalProblem::sample_alpha(std::size_t i, double a, double ad, double 
   const double d = x2 * x2 + y2 * y2;
   const double c2_raw = (d - arm_.l[0] * arm_.l[0] - arm_.l[1] * arm_.l[1]) / (2.0 * arm_.l[0] * arm_.l[1]);
   s.reachable = std::abs(c2_raw) <= 1.0 && d > 0.0;
-  s.reach_excess = s.reachable ? 0.0 : std::abs(c2_raw) - 1.0;
   if (!(d > 0.0) || !std::isfinite(c2_raw)) {
     s.reachable = false;
     s.det = 0.0;
     return;
   }
   const bool given = std::isfinite(theta2);  // the self-motion chart's, within reach by construction
-  if (given) s.reachable = true, s.reach_excess = 0.0;
+  if (given) s.reachable = true;
   const double c2 = given ? std::cos(theta2) : std::clamp(c2_raw, -kReachClamp, kReachClamp);
   const double s2 = given ? std::sin(theta2) : static_cast<int>(elbow) * std::sqrt(1.0 - c2 * c2);
   const double c1 = ((arm_.l[0] + arm_.l[1] * c2) * x2 + arm_.l[1] * s2 * y2) / d;

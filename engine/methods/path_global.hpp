@@ -40,7 +40,6 @@ double self_motion_elbow(double psi, double beta, double r, double l3, double l1
 /// One sample of the joint path for (alpha, alpha_d, alpha_dd).
 struct GlobalSample {
   bool reachable = false;  ///< the wrist is within reach of links 1 and 2 (|cos theta2| <= 1)
-  double reach_excess = 0; ///< |cos theta2| - 1 when not reachable
   double det = 0;          ///< det J3 [m^2] (l1 l2 sin theta2)
   Vec3 q, qd, qdd, tau;    ///< [rad], [rad/s], [rad/s^2], [Nm]
   Sym3 M;                  ///< M(q) [kg m^2]
