@@ -78,7 +78,9 @@ bool same_cells(const std::vector<Cell>& a, const std::vector<Cell>& b) {
   return true;
 }
 
-Digest digest_of(const Study& s) { return context_digest(run_context(s, s.histories)); }
+std::vector<ContextField> context_of(const Study& s) { return run_context(s, s.histories); }
+/// The digest of every part of the context (the trajectory kind reads them all).
+Digest digest_of(const Study& s) { return context_digest(context_of(s), BlockKind::trajectory); }
 
 Digest sha(const std::string& bytes) {
   Sha256 h;
@@ -89,7 +91,7 @@ Digest sha(const std::string& bytes) {
 /// Identities of the runs of block `name`, by local index.
 std::vector<Digest> identities(const Study& s, const std::string& name) {
   const Block& b = s.blocks[s.block_index(name)];
-  const BlockIdentity ids(digest_of(s), b);
+  const BlockIdentity ids(context_of(s), b);
   std::vector<Digest> out;
   for (std::uint64_t i = 0; i < b.run_count(); ++i) out.push_back(ids.run(i));
   return out;
@@ -122,10 +124,10 @@ TEST(RunIdentity, SameRunsInAnotherTextHaveTheSameIdentity) {
 TEST(RunIdentity, AStoredRowHasTheIdentityOfItsRun) {
   const Study s = parse_study(kStudy);
   const StudySchema schema = make_schema(s);
-  const Digest ctx = digest_of(s);
   for (std::size_t b = 0; b < s.blocks.size(); ++b) {
     const Block& block = s.blocks[b];
-    const BlockIdentity ids(ctx, block);
+    const BlockIdentity ids(context_of(s), block);
+    const Digest ctx = context_digest(context_of(s), block.kind());
     std::vector<std::string> names;
     for (const ColumnSpec& c : block.columns()) names.push_back(c.name);
     for (std::uint64_t i = 0; i < block.run_count(); ++i) {
@@ -217,6 +219,35 @@ TEST(RunIdentity, TheContextNamesWhatChanged) {
   }
   // the defaults written out change nothing
   EXPECT_EQ(context_changes(base, run_context(parse_study(kStudy + "[robot]\ng = 9.81\n[task]\ndt = 1e-3\n"), s.histories)), "");
+}
+
+// Each kind's identities cover the parts of the context its runs read: an edited task changes every
+// trajectory run's identity and no IK run's; an edited robot or histories policy changes both.
+TEST(RunIdentity, AKindsIdentitiesCoverThePartsOfTheContextItReads) {
+  const Study s = parse_study(kStudy);
+  const auto traj = identities(s, "weighted"), ik = identities(s, "basin");
+  auto edited = [&](const std::string& table, bool trajectory_same, bool ik_same) {
+    const Study e = parse_study(kStudy + table);
+    const auto t = identities(e, "weighted"), i = identities(e, "basin");
+    for (std::size_t r = 0; r < t.size(); ++r) EXPECT_EQ(t[r] == traj[r], trajectory_same) << table << " run " << r;
+    for (std::size_t r = 0; r < i.size(); ++r) EXPECT_EQ(i[r] == ik[r], ik_same) << table << " run " << r;
+  };
+  edited("[task]\ndt = 0.002\n", false, true);
+  edited("[task]\nvertices = [[1.4, 1.4], [1.9, 1.4], [1.9, 1.9], [1.4, 1.9], [1.4, 1.4]]\n", false, true);
+  edited("[task]\nintegrator = \"rk4\"\n", false, true);
+  edited("[robot]\nm = [5.0, 2.0, 1.5]\n", false, false);
+  edited("[robot]\nl = [1.0, 1.2, 1.0]\n", false, false);
+  {
+    std::string t = kStudy;
+    t.replace(t.find("every=10"), 8, "every=5");
+    const Study e = parse_study(t);
+    EXPECT_NE(identities(e, "weighted")[0], traj[0]);
+    EXPECT_NE(identities(e, "basin")[0], ik[0]);
+  }
+  // the parts are the kind's declaration, read from the schema
+  const auto parts = context_parts(BlockKind::ik);
+  EXPECT_EQ(std::count(parts.begin(), parts.end(), "task"), 0);
+  EXPECT_EQ(context_parts(BlockKind::trajectory).size(), 3u);
 }
 
 }  // namespace

@@ -14,10 +14,12 @@ IK_STATUSES = ["converged", "stalled", "singular", "max_iter", "cycle", "diverge
 KIND_MEANING = {
     "trajectory": {"statuses": TRAJECTORY_STATUSES, "good_statuses": ["ok"], "ranking": ["E"],
                    "key_metrics": ["E", "E_M", "tau_inf"],
-                   "history_arrays": ["t", "q", "qd", "qdd", "tau", "x", "alpha"]},
+                   "history_arrays": ["t", "q", "qd", "qdd", "tau", "x", "alpha"],
+                   "resume_context": ["robot", "task", "settings"]},
     "ik": {"statuses": IK_STATUSES, "good_statuses": ["converged"], "ranking": ["iterations", "error"],
            "key_metrics": ["iterations", "error", "solution"],
-           "history_arrays": ["k", "q", "F", "norm_F", "step", "lambda"]},
+           "history_arrays": ["k", "q", "F", "norm_F", "step", "lambda"],
+           "resume_context": ["robot", "settings"]},
 }
 GOOD_STATUSES = [s for m in KIND_MEANING.values() for s in m["good_statuses"]]
 # Display labels of metrics for files written before the engine recorded them (the attribute

@@ -60,8 +60,9 @@ std::vector<std::vector<std::size_t>> parameter_columns(const Study& study, cons
 using Entry = std::pair<Digest, std::int64_t>;  // identity, run id in the old file
 
 /// The identities of the done runs of the old file, sorted (the first run id of equal identities).
-std::vector<Entry> done_identities(const store::ResultsReader& file, const Study& before, const Digest& context,
-                                   const std::string& out, std::uint64_t& done) {
+std::vector<Entry> done_identities(const store::ResultsReader& file, const Study& before,
+                                   const std::vector<ContextField>& context, const std::string& out,
+                                   std::uint64_t& done) {
   const auto cols = parameter_columns(before, file.columns(), out);
   std::vector<BlockIdentity> ids;
   for (const Block& b : before.blocks) ids.emplace_back(context, b);
@@ -140,18 +141,31 @@ EditedResume begin_edited_resume(const Study& study, const StudySchema& schema, 
     refuse(out, "the file records an unknown history policy '" + file.meta().histories + "'");
   const auto was = run_context(before, was_histories, file.meta().engine_version);
   const auto now = run_context(study, options.histories);
-  if (const std::string what = context_changes(was, now); !what.empty()) refuse(out, what);
+  EditedResume r;
+  if (const std::string what = context_changes(was, now); !what.empty()) {
+    // the kinds of the edited study whose runs read a changed part of the context are computed
+    // again; when that is every kind, no run could be reused
+    std::string again;
+    bool reusable = false;
+    for (const BlockKind kind : block_kinds()) {
+      const bool used = std::any_of(study.blocks.begin(), study.blocks.end(),
+                                    [&](const Block& b) { return b.kind() == kind; });
+      if (!used) continue;
+      if (context_digest(was, kind) == context_digest(now, kind)) reusable = true;
+      else again += (again.empty() ? "" : " and ") + std::string(to_string(kind));
+    }
+    if (!reusable) refuse(out, what);
+    r.context_changes = what + " (read by the " + again + " runs, which are computed again)";
+  }
   if (file.n_runs() != static_cast<std::int64_t>(before.run_count()))
     refuse(out, "the file has " + std::to_string(file.n_runs()) + " runs, its study " +
                     std::to_string(before.run_count()));
-  const Digest context = context_digest(now);
 
-  EditedResume r;
-  const std::vector<Entry> old = done_identities(file, before, context, out, r.old_done);
+  const std::vector<Entry> old = done_identities(file, before, was, out, r.old_done);
   std::vector<std::pair<std::uint64_t, std::int64_t>> pairs;  // new run id, old run id
   std::uint64_t id = 0;
   for (const Block& b : study.blocks) {
-    const BlockIdentity ids(context, b);
+    const BlockIdentity ids(now, b);
     for (std::uint64_t local = 0; local < b.run_count(); ++local, ++id) {
       const Entry key{ids.run(local), 0};
       const auto it = std::lower_bound(old.begin(), old.end(), key,

@@ -1,8 +1,9 @@
 #pragma once
 // `kinesweep run --resume` of a results file whose study text differs from the study given (the
-// study was edited: comments, block order, axis values, blocks added or removed). When the run
-// context (robot, task, settings: runner/run_identity.hpp) is the stored study's, a new file for the
-// edited study is built beside the old one: every done run of the old file whose identity a run of
+// study was edited: comments, block order, axis values, blocks added or removed, the robot, task or
+// settings). When some kind of the edited study's runs reads no changed part of the run context
+// (robot, task, settings: runner/run_identity.hpp; e.g. IK runs when only the task changed), a new
+// file for the edited study is built beside the old one: every done run of the old file whose identity a run of
 // the edited study has is copied into it (its row, with the edited study's run id and block, and its
 // history, through the store's public reads and writes), the sweep computes the rest, and the new
 // file replaces the old one once complete. The old file is never written: if the process ends
@@ -27,6 +28,8 @@ struct EditedResume {
   std::string staging;                           ///< the new file's path until it replaces the old one
   std::uint64_t reused = 0;                      ///< runs copied
   std::uint64_t old_done = 0;                    ///< done runs of the old file
+  /// What changed in the run context ("" when nothing did) and which kinds' runs are computed again.
+  std::string context_changes;
 };
 
 /// True when `out` is a results file of a study whose text (or URDF robot) differs from `study`'s
@@ -36,7 +39,7 @@ bool holds_edited_study(const std::string& out, const Study& study);
 
 /// Build the new file of `study` beside `out` and copy the reusable runs of `out` into it. Refuses
 /// with store::StoreError, `out` untouched, when the stored study's run context differs from
-/// `study`'s (the message says what changed: "the robot changed: [robot] l: ... -> ...; refusing to
+/// `study`'s in a part that every kind of `study`'s runs reads (the message says what changed: "the robot changed: [robot] l: ... -> ...; refusing to
 /// resume: rerun with --overwrite"), or when the stored study cannot be read again.
 EditedResume begin_edited_resume(const Study& study, const StudySchema& schema, const std::string& out,
                                  const EditedResumeOptions& options);

@@ -133,9 +133,11 @@ std::vector<ContextField> run_context(const Study& study, const HistoryPolicy& h
   return out;
 }
 
-Digest context_digest(const std::vector<ContextField>& context) {
+Digest context_digest(const std::vector<ContextField>& context, BlockKind kind) {
+  const auto parts = context_parts(kind);
   Sha256 h;
   for (const ContextField& f : context) {
+    if (std::find(parts.begin(), parts.end(), f.group) == parts.end()) continue;
     h.update(f.key);
     h.update(std::string_view("\0", 1));
     h.update(f.value);
@@ -181,8 +183,8 @@ std::string run_identity_bytes(const Digest& context, BlockKind kind, const std:
   return out;
 }
 
-BlockIdentity::BlockIdentity(const Digest& context, const Block& block)
-    : block_(block), prefix_(prefix_bytes(context, block.kind())) {
+BlockIdentity::BlockIdentity(const std::vector<ContextField>& context, const Block& block)
+    : block_(block), prefix_(prefix_bytes(context_digest(context, block.kind()), block.kind())) {
   const auto& cols = block.columns();
   order_.resize(cols.size());
   for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = i;

@@ -14,16 +14,20 @@
 //               names and unused links are not part of it);
 //     task      vertices (and heights), durations, dt and integrator (the defaults of the runs'
 //               columns of the same names), orientation;
-//     settings  the histories policy and the kinesweep version.
+//     settings  the histories policy and the kinesweep version;
+//   of these parts, a run's identity covers those its kind reads (schema/params.hpp context_parts:
+//   trajectory runs robot, task and settings; IK runs robot and settings), so an edit of the task
+//   keeps the identities of the study's IK runs.
 // - its parameters: the run's kind and every parameter column of its block with its value as stored
 //   in /runs (stored units; strings by value), by column name.
 //
 // Canonical bytes of a run (run_identity_bytes), hashed with SHA-256 into its 256-bit identity:
-//   "kinesweep-run-identity-1\n", the 32-byte context digest, the kind ("trajectory" | "ik"), "\n",
+//   "kinesweep-run-identity-1\n", the 32-byte context digest of the kind, the kind ("trajectory" | "ik"), "\n",
 //   then per parameter column, in byte order of the column names: the name, a NUL, a type tag and the
 //   value: 'f' + the f64's 8 IEEE bytes (little-endian, NaN payloads and -0 as they are), 'i' + the
 //   i64's 8 bytes (little-endian), 's' + the length (u64, little-endian) and the UTF-8 bytes.
-// The context digest is SHA-256 of the context fields' "key\0value\n" in run_context's order.
+// The context digest of a kind is SHA-256 of "key\0value\n" of the context fields of the kind's parts,
+// in run_context's order.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -46,20 +50,22 @@ struct ContextField {
 /// The run context of `study` run with `histories` by kinesweep `engine_version`.
 std::vector<ContextField> run_context(const Study& study, const HistoryPolicy& histories,
                                       const std::string& engine_version = KINESWEEP_VERSION);
-Digest context_digest(const std::vector<ContextField>& context);
+/// The digest of the fields of `context` that runs of `kind` read (its context_parts).
+Digest context_digest(const std::vector<ContextField>& context, BlockKind kind);
 /// What differs from `before` to `after`, one clause per group: "the robot changed: [robot] l: [1, 1, 1]
 /// -> [1, 1.2, 1]; the task changed: ..." ("" when nothing does).
 std::string context_changes(const std::vector<ContextField>& before, const std::vector<ContextField>& after);
 
-/// The canonical bytes of a run (see above): `names` and `cells` are the block's parameter columns
-/// and the run's values of them, in any order.
+/// The canonical bytes of a run (see above): `context` is context_digest(..., kind), `names` and
+/// `cells` are the block's parameter columns and the run's values of them, in any order.
 std::string run_identity_bytes(const Digest& context, BlockKind kind, const std::vector<std::string>& names,
                                const std::vector<Cell>& cells);
 
 /// The identities of one block's runs under a context.
 class BlockIdentity {
  public:
-  BlockIdentity(const Digest& context, const Block& block);
+  /// The runs of `block` under the run context `context` (the parts its kind reads).
+  BlockIdentity(const std::vector<ContextField>& context, const Block& block);
   /// Run `local` of the block (its parameter cells as Block::params gives them: as a run stores them).
   Digest run(std::uint64_t local) const;
   /// A stored row of a run of the block: its cells at `column[i]` for the block's parameter i

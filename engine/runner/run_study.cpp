@@ -47,7 +47,8 @@ std::vector<store::KindMeta> kind_meta(const Study& study) {
                {"ranking", ranked},
                {"key_metrics", strings(key_metrics(kind))},
                {"objectives", objective_names(block->metrics())},
-               {"history_arrays", names}};
+               {"history_arrays", names},
+               {"resume_context", strings(context_parts(kind))}};
     if (kind == BlockKind::trajectory) k.lists.emplace_back("history_units", units);
     out.push_back(std::move(k));
   }
@@ -287,6 +288,7 @@ class LocalBackend final : public SweepBackend {
     SweepOptions o = r.options;
     if (!edited_) o.histories = histories_;
     if (r.quiet) o.on_progress = nullptr;
+    if (edited_ && !edited_->context_changes.empty()) out << edited_->context_changes << "\n";
     if (edited_)
       out << "the study differs from the one in " << r.output << ": " << edited_->reused << " of its "
           << edited_->old_done << " done runs are runs of this study and are reused; a new file replaces it when "

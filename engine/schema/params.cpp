@@ -89,6 +89,12 @@ std::span<const std::string_view> key_metrics(BlockKind kind) {
   static const std::array<std::string_view, 3> trajectory{"E", "E_M", "tau_inf"}, ik{"iterations", "error", "solution"};
   return kind == BlockKind::trajectory ? trajectory : ik;
 }
+std::span<const std::string_view> context_parts(BlockKind kind) {
+  static const std::array<std::string_view, 3> trajectory{"robot", "task", "settings"};
+  static const std::array<std::string_view, 2> ik{"robot", "settings"};
+  if (kind == BlockKind::trajectory) return trajectory;
+  return ik;
+}
 std::vector<std::string> objective_names(const std::vector<MetricDef>& metrics) {
   std::vector<std::string> out;
   for (const MetricDef& m : metrics)

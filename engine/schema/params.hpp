@@ -126,6 +126,12 @@ Ranking ranking(BlockKind kind);
 /// run), in order: trajectory E, E_M, tau_inf; ik iterations, error, solution.
 std::span<const std::string_view> key_metrics(BlockKind kind);
 
+/// The parts of a study's run context (runner/run_identity.hpp: "robot", "task", "settings") that a
+/// run of the kind reads besides its parameters; a change of any other part keeps the run's identity,
+/// so a resume of the edited study reuses it. Trajectory: robot, task, settings. IK: robot, settings
+/// (its target is a parameter, its initial guess too; it reads no path).
+std::span<const std::string_view> context_parts(BlockKind kind);
+
 /// What an [[optimize]] block of a kind may minimise (a weighted sum of these): every numeric metric
 /// in `metrics` (the block's, per-joint columns for its robot), and "failure_rate" (the fraction of
 /// an evaluation's runs whose status is not the good one). The default is ranking(kind).objective.

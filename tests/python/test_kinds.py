@@ -71,7 +71,8 @@ class Kinds(TempDirTest):
             for kind in ("trajectory", "ik"):
                 a = {k: strings(v) for k, v in f["kinds"][kind].attrs.items()}
                 fallback = kstypes.KIND_MEANING[kind]
-                for key in ("statuses", "good_statuses", "ranking", "key_metrics", "history_arrays"):
+                for key in ("statuses", "good_statuses", "ranking", "key_metrics", "history_arrays",
+                            "resume_context"):
                     self.assertEqual(a[key], fallback[key], f"{kind} {key}")
                 self.assertEqual(a["good_statuses"], a["statuses"][:1])
                 # objectives: every numeric metric column of the kind, in /runs order, and failure_rate

@@ -2,7 +2,8 @@
 runs of the old file that the edited study still has are reused (not computed again), the rest are
 computed, and the file comes out equal to a fresh run of the edited study (the oracle: /runs but
 wall_time, every history and every landscape compared bit for bit with h5py). A change of the robot,
-the task or the settings is refused with the old file left byte for byte as it was.
+the task or the settings that every kind of the study's runs reads is refused with the old file left
+byte for byte as it was; an edited task keeps the IK runs.
 
 usage: /usr/bin/python3 test_resume_edited.py KINESWEEP_BINARY ROBOTS_DIR (studies/robots)
 """
@@ -203,8 +204,8 @@ class ResumeEdited(TempDirTest):
         self.assertEqual(computed(r.stdout), (5 + 7, 23))
         self.assert_equal_to_fresh(out, edited)
 
-    def refused(self, edited, *args, expect):
-        out, old, r = self.old_and_edited(BASE, edited, *args)
+    def refused(self, edited, *args, expect, old_text=BASE):
+        out, old, r = self.old_and_edited(old_text, edited, *args)
         self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
         for e in expect:
             self.assertIn(e, r.stderr)
@@ -216,8 +217,26 @@ class ResumeEdited(TempDirTest):
         self.refused(BASE + "\n[robot]\nm = [5.0, 2.0, 1.5]\n",
                      expect=["the robot changed: [robot] m: [5, 2, 1] -> [5, 2, 1.5]"])
 
-    def test_dt_default_changed_is_refused(self):
-        self.refused(BASE + "\n[task]\ndt = 0.002\n", expect=["the task changed: [task] dt: 0.001 -> 0.002"])
+    def test_task_changed_computes_the_trajectory_runs_again_and_keeps_the_ik_runs(self):
+        # IK runs read no path (their kind's resume_context has no task): an edited [task] keeps them
+        edited = BASE + "\n[task]\ndt = 0.002\n"
+        out, old, r = self.old_and_edited(BASE, edited)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("the task changed: [task] dt: 0.001 -> 0.002 (read by the trajectory runs, which are "
+                      "computed again)", r.stdout)
+        self.assertEqual(computed(r.stdout), (15, 15))
+        with h5py.File(out, "r") as f, h5py.File(old, "r") as g:
+            block, was_block = runs_column(f["runs"]["block"]), runs_column(g["runs"]["block"])
+            wall, was_wall = f["runs"]["wall_time"][()], g["runs"]["wall_time"][()]
+        ik, was_ik = wall[np.asarray(block) == "basin"], was_wall[np.asarray(was_block) == "basin"]
+        self.assertTrue(bitwise_equal(ik, was_ik))  # copied, not computed again
+        self.assertEqual(len(ik), 15)
+        self.assert_equal_to_fresh(out, edited)
+
+    def test_task_changed_is_refused_when_every_run_reads_it(self):
+        trajectory_only = BASE[:BASE.index("[[block]]\nname = \"basin\"")]
+        self.refused(trajectory_only + "\n[task]\ndt = 0.002\n", old_text=trajectory_only,
+                     expect=["the task changed: [task] dt: 0.001 -> 0.002"])
 
     def test_histories_changed_is_refused(self):
         self.refused("# histories off from now on\n" + BASE, "--histories", "none",
