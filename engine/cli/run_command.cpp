@@ -12,8 +12,7 @@
 #include <iostream>
 #include <thread>
 
-#include "cli/dry_run.hpp"
-#include "cli/human_units.hpp"
+#include "common/human_units.hpp"
 #include "common/shell_word.hpp"
 #include "runner/run_study.hpp"
 #include "store/store.hpp"
@@ -149,13 +148,6 @@ int run_command(const RunArgs& a) {
               << why << '\n';
     return 2;
   }
-  if (a.dry_run) {  // a few seconds at most; its temporary file is removed before it returns
-    const int code = dry_run(study, make_schema(study), {histories, a.threads, a.lanes, a.compression, output}, std::cout, std::cerr);
-    if (!g_stop.load()) return code;
-    std::cerr << "kinesweep run: --dry-run interrupted; nothing written\n";
-    return 130;
-  }
-
   RunRequest r;
   r.study_arg = a.study;
   r.program = a.program;
@@ -163,6 +155,7 @@ int run_command(const RunArgs& a) {
   r.resume = a.resume;
   r.overwrite = a.overwrite;
   r.quiet = a.quiet;
+  r.dry_run = a.dry_run;  // a few seconds at most; its temporary files are removed before it returns
   r.options.threads = a.threads;
   r.options.lanes = a.lanes;
   r.options.histories = histories;

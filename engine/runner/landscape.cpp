@@ -9,7 +9,7 @@ const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 }  // namespace
 
-LandscapeGrid::LandscapeGrid(const Block& block) : block_(block) {
+LandscapeGrid::LandscapeGrid(const Block& block, bool enabled) : block_(block) {
   // The good-status grid (ok / converged), the metrics marked gridded, the status code.
   const auto& ms = block.metrics();
   names_.emplace_back(statuses(block.kind()).front());
@@ -24,7 +24,7 @@ LandscapeGrid::LandscapeGrid(const Block& block) : block_(block) {
   names_.emplace_back("status_code");
   sources_.push_back(Source::status_code);
   metric_index_.push_back(ms.size());
-  enabled_ = block.run_count() <= kMaxLandscapeCells && !block.overflowed();
+  enabled_ = enabled && block.run_count() <= kMaxLandscapeCells && !block.overflowed();
   cell_.assign(names_.size(), kNaN);
 }
 

@@ -16,7 +16,8 @@ inline constexpr std::uint64_t kMaxLandscapeCells = 1ull << 26;  ///< per block 
 /// nothing of the grid is held in memory.
 class LandscapeGrid {
  public:
-  explicit LandscapeGrid(const Block& block);
+  /// The block's grid; `enabled` false (or a block too large for a grid): none, add() does nothing.
+  explicit LandscapeGrid(const Block& block, bool enabled = true);
   bool enabled() const { return enabled_; }
   /// Create the block's landscape in `writer` (replacing one there; a resumed sweep writes the
   /// cells of its done runs again through add).

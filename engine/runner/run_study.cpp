@@ -12,6 +12,7 @@
 #include "common/shell_word.hpp"
 #include "runner/optimize_blocks.hpp"
 #include "runner/resume_edited.hpp"
+#include "runner/dry_run.hpp"
 #include "runner/sweep_backend.hpp"
 
 namespace ks {
@@ -379,9 +380,10 @@ std::unique_ptr<SweepBackend> local_backend() { return std::make_unique<LocalBac
 int run_study(const Study& study, const RunRequest& request, std::ostream& out, std::ostream& err) {
   const StudySchema schema = make_schema(study);
 #ifdef KINESWEEP_HAVE_MPI
-  std::unique_ptr<SweepBackend> backend = launched_under_mpi() ? mpi_backend() : local_backend();
+  std::unique_ptr<SweepBackend> backend =
+      request.dry_run ? dry_run_backend() : launched_under_mpi() ? mpi_backend() : local_backend();
 #else
-  std::unique_ptr<SweepBackend> backend = local_backend();
+  std::unique_ptr<SweepBackend> backend = request.dry_run ? dry_run_backend() : local_backend();
 #endif
   int code = 0;
   try {

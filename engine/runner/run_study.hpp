@@ -16,6 +16,9 @@ struct RunRequest {
   std::string program = "kinesweep";  ///< the command that runs kinesweep, one shell word (for the hint)
   std::string output;      ///< the results file
   bool resume = false, overwrite = false, quiet = false;
+  /// Estimate instead: the runs per block, the file's size and the time, from sample runs of every
+  /// block run by the sweep into a temporary file (runner/dry_run.hpp); nothing else is written.
+  bool dry_run = false;
   /// options.histories was given on the command line (--histories); otherwise it is the study's,
   /// and a plain resume takes the policy the file records instead.
   bool histories_given = false;

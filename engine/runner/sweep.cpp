@@ -30,6 +30,7 @@ struct Job {
   RunRef ref;
   Record row;
   store::EncodedHistory history;
+  double seconds = 0;  // executing the run and encoding its history
 };
 struct Batch {
   std::vector<Job> jobs;
@@ -45,11 +46,12 @@ const std::string& as_str(const Cell& c) {
 class Accumulator {
  public:
   /// `fill` (SweepOptions::fill_landscape, may be empty) is given each landscape once begun.
+  /// `landscapes` false: no grid is written (SweepOptions::landscapes).
   Accumulator(const Study& study, const StudySchema& schema, store::ResultsWriter& writer,
-              const std::function<bool(std::size_t, std::size_t)>& fill)
+              const std::function<bool(std::size_t, std::size_t)>& fill, bool landscapes)
       : study_(study), schema_(schema), writer_(writer) {
     for (std::size_t b = 0; b < study.blocks.size(); ++b) {
-      grids_.emplace_back(study.blocks[b]);
+      grids_.emplace_back(study.blocks[b], landscapes);
       grids_.back().begin(writer);
       filled_.push_back(grids_.back().enabled() && fill && fill(b, grids_.back().handle()));
       BlockReport r;
@@ -305,7 +307,7 @@ std::uint64_t add_previous(const Study& study, const PreviousRuns& previous, sto
 SweepReport run_sweep(const Study& study, const StudySchema& schema, store::ResultsWriter& writer,
                       const SweepOptions& options, const PreviousRuns* previous) {
   const std::uint64_t total = study.run_count();
-  Accumulator acc(study, schema, writer, options.fill_landscape);
+  Accumulator acc(study, schema, writer, options.fill_landscape, options.landscapes);
   const std::uint64_t skipped = previous ? add_previous(study, *previous, writer, acc) : 0;
   const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
   const int stride = options.histories.mode == HistoryPolicy::Mode::none ? 0
@@ -366,7 +368,9 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
                   for (std::size_t i = 0; i < n; ++i) {
                     Job& j = b->jobs[i];
                     const RunOutcome& o = outcomes[i];
+                    const auto t0 = Clock::now();
                     if (!o.history.arrays.empty()) j.history = store::encode_history(o.history, options.compression, writer.history_chunk_rows());
+                    j.seconds = wall[i] + std::chrono::duration<double>(Clock::now() - t0).count();
                     j.row = schema.row(j.id, j.ref.block, study.blocks[j.ref.block], runs[i], o, wall[i]);
                   }
                   return b;
@@ -379,6 +383,7 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
                     acc.add(j.id, j.ref, j.row);
                     writer.write_run(static_cast<std::int64_t>(j.id), j.row, j.history);
                     ++written;
+                    if (options.on_written) options.on_written(j.ref.block, j.seconds, store::encoded_bytes(j.history));
                   }
                   const auto now = Clock::now();
                   if (options.on_progress &&

@@ -47,6 +47,12 @@ struct SweepOptions {
   /// true when it set the cells of every previous run (run_sweep's `previous`), which are then not
   /// gridded from their rows (the runs computed in the sweep are). Empty: every cell from its row.
   std::function<bool(std::size_t block, std::size_t landscape)> fill_landscape;
+  /// Write the blocks' landscapes (false: none; a dry run's sample sweep, whose file is thrown away).
+  bool landscapes = true;
+  /// Called by the writer for each run it writes, in run order: the run's block, the time the run
+  /// took to execute and encode its history [s], and its encoded history [bytes] (a dry run's
+  /// statistics). Empty: nothing.
+  std::function<void(std::size_t block, double seconds, std::size_t history_bytes)> on_written;
 };
 
 /// One notable row for the summary.

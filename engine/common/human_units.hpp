@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <string>
 
-namespace ks::cli {
+namespace ks {
 
 inline std::string human_bytes(double b) {
   const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
@@ -23,4 +23,4 @@ inline std::string human_time(double s) {
   return buf;
 }
 
-}  // namespace ks::cli
+}  // namespace ks
