@@ -28,8 +28,11 @@ LandscapeGrid::LandscapeGrid(const Block& block, bool enabled) : block_(block) {
   cell_.assign(names_.size(), kNaN);
 }
 
-void LandscapeGrid::begin(store::ResultsWriter& writer) {
-  if (enabled_) handle_ = writer.begin_landscape(spec());
+void LandscapeGrid::begin(store::ResultsWriter& writer, bool dense) {
+  if (!enabled_) return;
+  store::LandscapeSpec s = spec();
+  s.dense = dense;
+  handle_ = writer.begin_landscape(s);
 }
 
 void LandscapeGrid::add(std::uint64_t local, const Record& row, const StudySchema& schema, std::size_t b,

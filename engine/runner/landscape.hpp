@@ -20,8 +20,9 @@ class LandscapeGrid {
   explicit LandscapeGrid(const Block& block, bool enabled = true);
   bool enabled() const { return enabled_; }
   /// Create the block's landscape in `writer` (replacing one there; a resumed sweep writes the
-  /// cells of its done runs again through add).
-  void begin(store::ResultsWriter& writer);
+  /// cells of its done runs again through add). `dense`: every cell is written before the writer's
+  /// next commit (store::LandscapeSpec::dense).
+  void begin(store::ResultsWriter& writer, bool dense = false);
   /// The writer's handle of the landscape begin() created.
   std::size_t handle() const { return handle_; }
   /// Write the cell of run `local` of this block (block index `b` in the schema) from its row.

@@ -46,13 +46,14 @@ const std::string& as_str(const Cell& c) {
 class Accumulator {
  public:
   /// `fill` (SweepOptions::fill_landscape, may be empty) is given each landscape once begun.
-  /// `landscapes` false: no grid is written (SweepOptions::landscapes).
+  /// `landscapes` false: no grid is written (SweepOptions::landscapes). `all_done`: every run was
+  /// done before the sweep, so add_previous writes every cell before the writer's next commit.
   Accumulator(const Study& study, const StudySchema& schema, store::ResultsWriter& writer,
-              const std::function<bool(std::size_t, std::size_t)>& fill, bool landscapes)
+              const std::function<bool(std::size_t, std::size_t)>& fill, bool landscapes, bool all_done)
       : study_(study), schema_(schema), writer_(writer) {
     for (std::size_t b = 0; b < study.blocks.size(); ++b) {
       grids_.emplace_back(study.blocks[b], landscapes);
-      grids_.back().begin(writer);
+      grids_.back().begin(writer, all_done);
       filled_.push_back(grids_.back().enabled() && fill && fill(b, grids_.back().handle()));
       BlockReport r;
       r.name = study.blocks[b].name();
@@ -307,7 +308,10 @@ std::uint64_t add_previous(const Study& study, const PreviousRuns& previous, sto
 SweepReport run_sweep(const Study& study, const StudySchema& schema, store::ResultsWriter& writer,
                       const SweepOptions& options, const PreviousRuns* previous) {
   const std::uint64_t total = study.run_count();
-  Accumulator acc(study, schema, writer, options.fill_landscape, options.landscapes);
+  const bool all_done = previous && previous->done.size() >= total &&
+                        std::all_of(previous->done.begin(), previous->done.begin() + static_cast<std::ptrdiff_t>(total),
+                                    [](bool d) { return d; });
+  Accumulator acc(study, schema, writer, options.fill_landscape, options.landscapes, all_done);
   const std::uint64_t skipped = previous ? add_previous(study, *previous, writer, acc) : 0;
   const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
   const int stride = options.histories.mode == HistoryPolicy::Mode::none ? 0

@@ -84,19 +84,6 @@ ByteBuffer planes_stream(const double* values, std::size_t n, std::size_t cols, 
   return out;
 }
 
-/// One libdeflate decompressor per thread.
-libdeflate_decompressor* decompressor() {
-  struct Cache {
-    libdeflate_decompressor* d = nullptr;
-    ~Cache() {
-      if (d) libdeflate_free_decompressor(d);
-    }
-  };
-  thread_local Cache cache;
-  if (!cache.d) cache.d = libdeflate_alloc_decompressor();
-  return cache.d;
-}
-
 /// One chunk of `n` values (`data_values` of them data, the rest NaN padding) of `cols` columns: raw
 /// for level 0; else a zlib stream of its byte planes (planes_stream). A chunk mostly of data keeps
 /// its six (level >= 2) or seven (level 1) low planes stored: close to noise in a history's doubles,
@@ -170,7 +157,7 @@ RunHistory decode_history(const EncodedHistory& history) {
       if (!(c.filter_mask & 0x2)) {  // deflate applied
         plain.resize(bytes);
         std::size_t got = 0;
-        libdeflate_decompressor* d = decompressor();
+        libdeflate_decompressor* d = detail::decompressor();
         if (!d || libdeflate_zlib_decompress(d, p, size, plain.data(), bytes, &got) != LIBDEFLATE_SUCCESS)
           throw StoreError("", "history array '" + e.name + "': chunk " + std::to_string(k) + " does not inflate");
         p = plain.data();

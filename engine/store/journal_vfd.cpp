@@ -45,6 +45,7 @@ struct JFile {
   std::uint64_t seq = 0, session = 0;  // commits in this session; random id of this writer session
   bool durable = false;
   bool poisoned = false;        // an I/O error happened: never commit again (the journal stays)
+  bool abandoned = false;       // the writer gave up (abandon_journal_file): flushes and close commit nothing
   bool readonly = false;        // a reader's overlay of an unapplied commit (open_overlay): no journal
   std::string path;
   std::map<std::uint64_t, unsigned char*> pages;  // page number -> kPage bytes of page_pool
@@ -60,6 +61,11 @@ struct JFile {
   long crash_commit = -1, commits = 0;
   std::string crash_phase;
 };
+
+/// The writers' open files by the address of their descriptor (what get_handle gives), for
+/// poison_journal_file.
+std::mutex g_open_mutex;
+std::map<const int*, JFile*> g_open;
 
 void maybe_crash(JFile* f, const char* phase) {
   if (f->commits == f->crash_commit && f->crash_phase == phase) ::_exit(86);
@@ -195,6 +201,10 @@ H5FD_t* j_open(const char* name, unsigned flags, hid_t fapl, haddr_t /*maxaddr*/
     ::close(f->jfd); ::close(f->fd); delete f; return nullptr;
   }
   pause_point("ready");
+  {
+    std::lock_guard<std::mutex> lk(g_open_mutex);
+    g_open[&f->fd] = f;
+  }
   return &f->pub;
 }
 
@@ -302,6 +312,16 @@ herr_t j_close(H5FD_t* file) {
     delete f;
     return 0;
   }
+  {
+    std::lock_guard<std::mutex> lk(g_open_mutex);
+    g_open.erase(&f->fd);
+  }
+  if (f->abandoned) {  // the file keeps its last commit, the journal stays
+    ::close(f->fd);
+    ::close(f->jfd);
+    delete f;
+    return 0;
+  }
   if (!commit(f)) { set_error("commit failed on close of " + f->path, errno); rc = -1; }
   if (rc == 0) ::unlink(journal_path(f->path).c_str());  // clean close, still locked: nothing to recover
   ::close(f->fd);
@@ -381,7 +401,7 @@ herr_t j_write(H5FD_t* file, H5FD_mem_t, hid_t, haddr_t addr, size_t size, const
 
 herr_t j_flush(H5FD_t* file, hid_t, hbool_t) {
   auto* f = reinterpret_cast<JFile*>(file);
-  if (f->readonly) return 0;
+  if (f->readonly || f->abandoned) return 0;
   if (!commit(f)) { set_error("commit of " + f->path + " failed", errno); return -1; }
   return 0;
 }
@@ -455,6 +475,17 @@ hid_t make_journal_fapl(bool durable) {
   JFapl fa{durable ? 1 : 0, 0};
   H5Pset_driver(fapl, journal_driver_id(), &fa);
   return fapl;
+}
+
+void abandon_journal_file(hid_t file) {
+  void* handle = nullptr;
+  if (H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) < 0 || !handle) {
+    H5Eclear2(H5E_DEFAULT);
+    return;
+  }
+  std::lock_guard<std::mutex> lk(g_open_mutex);
+  const auto it = g_open.find(static_cast<const int*>(handle));
+  if (it != g_open.end()) it->second->abandoned = true;
 }
 
 hid_t make_journal_read_fapl() {

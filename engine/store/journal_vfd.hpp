@@ -17,6 +17,11 @@ hid_t journal_driver_id();
 /// (needed only against power loss, not against a killed process).
 hid_t make_journal_fapl(bool durable);
 
+/// The writer of the open file `file` gave up: its journal driver commits nothing more (flushes do
+/// nothing) and its close succeeds leaving the file in its last committed state, with its journal
+/// (the next writer recovers it). Nothing for a file of another driver.
+void abandon_journal_file(hid_t file);
+
 /// Path of the journal file that belongs to `results_path`.
 std::string journal_path(const std::string& results_path);
 

@@ -1,6 +1,8 @@
 // Byte planes of doubles and their run coder (plane_codec.hpp).
 #include "store/plane_codec.hpp"
 
+#include <libdeflate.h>
+
 #include <array>
 #include <bit>
 #include <cstring>
@@ -97,6 +99,18 @@ void shuffle8(const double* values, std::size_t n, unsigned char* const planes[8
   const auto* b = reinterpret_cast<const unsigned char*>(values);
   for (; i < n; ++i)
     for (int j = 0; j < 8; ++j) planes[j][i] = b[i * 8 + j];
+}
+
+libdeflate_decompressor* decompressor() {
+  struct Cache {
+    libdeflate_decompressor* d = nullptr;
+    ~Cache() {
+      if (d) libdeflate_free_decompressor(d);
+    }
+  };
+  thread_local Cache cache;
+  if (!cache.d) cache.d = libdeflate_alloc_decompressor();
+  return cache.d;
 }
 
 void unshuffle8(const unsigned char* const planes[8], std::size_t n, double* values) {

@@ -5,7 +5,12 @@
 #include <cstddef>
 #include <cstdint>
 
+struct libdeflate_decompressor;
+
 namespace ks::store::detail {
+
+/// This thread's libdeflate decompressor (freed at thread exit), or nullptr when none can be made.
+libdeflate_decompressor* decompressor();
 
 /// HDF5's shuffle filter for 8-byte elements, into eight planes: byte j of value i goes to
 /// planes[j][i], for i in [0, n).

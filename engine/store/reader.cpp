@@ -91,6 +91,7 @@ void ResultsReader::refresh() {
       continue;
     }
     impl_->file = Hid(f);
+    impl_->overlay = view.kind == ReadView::overlay;
     try {
       impl_->columns.clear();
       impl_->meta = StoreMeta{};
@@ -180,6 +181,7 @@ herr_t collect_names(hid_t, const char* name, const H5L_info_t*, void* data) {
 }  // namespace
 
 std::int64_t ResultsReader::raw_file_id() const { return impl_->file; }  // for optimizations_read.cpp
+bool ResultsReader::bytes_are_committed_state() const { return !impl_->overlay; }
 const std::string& ResultsReader::raw_path() const { return impl_->path; }
 
 std::vector<std::string> ResultsReader::landscapes() const {

@@ -33,6 +33,7 @@ struct ResultsReader::Impl {
   std::vector<ColumnSpec> columns;
   std::int64_t n_runs = 0;
   std::string stamp;  // consistency stamp at open
+  bool overlay = false;  // opened through the journal's overlay of a commit not yet applied
   V1ColumnRoles v1_roles;
   /// Handles and index of /histories, read at the first history read after an open (reader_histories.cpp).
   std::unique_ptr<HistoryIndexCache> hist;

@@ -185,6 +185,11 @@ struct LandscapeSpec {
   std::string block;
   std::vector<LandscapeAxis> axes;
   std::vector<LandscapeMetric> metrics;
+  /// Every cell is written before the file's next commit (a sweep whose runs were all done before
+  /// it began: a merge, a resumed complete file). In a new part of the file its metrics are then
+  /// allocated at creation and not filled with NaN first (a first write of part of a contiguous
+  /// dataset fills all of it); a commit with cells still unwritten fails.
+  bool dense = false;
 };
 
 /// One stage of an optimisation (/optimizations/<name>/stages, FORMAT.md).
@@ -400,6 +405,9 @@ class ResultsReader {
  private:
   friend class ResultsWriter;                ///< copy_runs reads a source's chunks as stored
   std::int64_t raw_file_id() const;          ///< the open HDF5 file id (reader.cpp)
+  /// True when the file's bytes on disk are its committed state (no commit waits in its journal),
+  /// so that its raw data may be copied by file offset.
+  bool bytes_are_committed_state() const;
   const std::string& raw_path() const;       ///< the file's path (reader.cpp)
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -399,6 +399,10 @@ void ResultsWriter::Impl::write_rows() {
 
 void ResultsWriter::Impl::do_flush() {
   write_rows();
+  for (const LandscapeStream& s : landscape_streams)
+    if (s.unwritten)  // its cells hold no fill: a commit now would expose bytes that are no values
+      fail("landscape " + s.block + " would be committed with " + std::to_string(s.unwritten) +
+           " cells not written (a dense landscape)");
   try {
     runs_chunks.write_partial();  // incomplete chunks raw, so the commit holds every row written
   } catch (const StoreError&) {

@@ -45,6 +45,10 @@ struct ResultsWriter::Impl {
     /// Created by this writer since its last commit: its grids lie past the committed size, where
     /// writes go straight to the file (journal_vfd.cpp), so they hold no journal memory.
     bool fresh = false;
+    /// A dense stream created without the NaN fill (LandscapeSpec::dense, fresh): its cells not yet
+    /// written, which must be none at the next commit.
+    std::uint64_t unwritten = 0;
+    void written(std::uint64_t n) { unwritten -= std::min(unwritten, n); }
   };
   std::vector<LandscapeStream> landscape_streams;
   /// The histories' shared row space (writer_histories.cpp, FORMAT.md: /histories).
@@ -79,11 +83,14 @@ struct ResultsWriter::Impl {
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false, broken = false;
 
+  /// Marks the writer broken and throws StoreError: the file keeps its last commit (the journal
+  /// driver commits nothing more: abandon_journal_file; close() leaves the file as that commit left it).
   void fail(const std::string& what) {
     broken = true;
     std::string cause = what + ": " + detail::h5_error_text();
     std::string j = detail::journal_last_error();
     if (!j.empty()) cause += " (" + j + ")";
+    if (file.get() >= 0) detail::abandon_journal_file(file);
     throw StoreError(path, cause);
   }
   void usable() const {

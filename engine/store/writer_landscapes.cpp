@@ -1,8 +1,10 @@
 // ResultsWriter's landscapes (store.hpp, FORMAT.md "/landscapes"): the group, its axes as dimension
 // scales, and metric datasets whose cells are streamed in with the rows of their runs.
 #include <hdf5_hl.h>  // H5DS: dimension scales
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 #include <limits>
 #include <numeric>
@@ -18,6 +20,34 @@ using namespace detail;
 
 namespace {
 constexpr std::size_t kPendingCells = 1 << 16;  // cells held before they are written (rows: kRowBatch)
+
+/// The file descriptor of an open HDF5 file (its driver's handle: the sec2 and journal drivers hold
+/// one), or -1.
+int file_descriptor(hid_t file) {
+  void* handle = nullptr;
+  if (H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) < 0 || !handle) return -1;
+  return *static_cast<int*>(handle);
+}
+
+/// `bytes` of file `in` at `from` copied to file `out` at `to` inside the kernel (copy_file_range:
+/// no pass through this process's memory). False, nothing copied, when the kernel cannot copy
+/// between these files; StoreError (`path`) on a failure part way.
+bool kernel_copy(int in, std::uint64_t from, int out, std::uint64_t to, std::uint64_t bytes, const std::string& path) {
+  auto a = static_cast<loff_t>(from), b = static_cast<loff_t>(to);
+  bool first = true;
+  while (bytes > 0) {
+    const ssize_t n = ::copy_file_range(in, &a, out, &b, static_cast<std::size_t>(bytes), 0);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (first && n < 0 && (errno == EXDEV || errno == EINVAL || errno == ENOSYS || errno == EOPNOTSUPP || errno == EBADF))
+        return false;
+      throw StoreError(path, std::string("cannot copy landscape cells: ") + (n < 0 ? std::strerror(errno) : "short copy"));
+    }
+    first = false;
+    bytes -= static_cast<std::uint64_t>(n);
+  }
+  return true;
+}
 
 /// The stream of begun landscape `landscape` of `m` and its number of cells; StoreError naming `call`.
 std::pair<ResultsWriter::Impl::LandscapeStream*, hsize_t> begun_stream(ResultsWriter::Impl& m, std::size_t landscape,
@@ -147,10 +177,17 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
   stream.block = spec.block;
   stream.dims = dims;
   stream.fresh = !m.freed_space;
+  // A dense landscape in a new part of the file: allocated now, never filled (every cell is written
+  // before the next commit, which checks it: do_flush).
+  const bool unfilled = spec.dense && stream.fresh && !dims.empty();
+  if (unfilled)
+    stream.unwritten = std::accumulate(dims.begin(), dims.end(), hsize_t{1}, std::multiplies<>()) * spec.metrics.size();
   Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  if (!dcpl.ok() || H5Pset_layout(dcpl, H5D_CONTIGUOUS) < 0 || H5Pset_alloc_time(dcpl, H5D_ALLOC_TIME_LATE) < 0 ||
-      H5Pset_fill_value(dcpl, H5T_NATIVE_DOUBLE, &nan) < 0 || H5Pset_fill_time(dcpl, H5D_FILL_TIME_ALLOC) < 0)
+  if (!dcpl.ok() || H5Pset_layout(dcpl, H5D_CONTIGUOUS) < 0 ||
+      H5Pset_alloc_time(dcpl, unfilled ? H5D_ALLOC_TIME_EARLY : H5D_ALLOC_TIME_LATE) < 0 ||
+      H5Pset_fill_value(dcpl, H5T_NATIVE_DOUBLE, &nan) < 0 ||
+      H5Pset_fill_time(dcpl, unfilled ? H5D_FILL_TIME_NEVER : H5D_FILL_TIME_ALLOC) < 0)
     m.fail("cannot set up landscape " + spec.block);
   for (auto& mt : spec.metrics) {
     Hid space(dims.empty() ? H5Screate(H5S_SCALAR)
@@ -205,6 +242,7 @@ void ResultsWriter::write_landscape_range(std::size_t landscape, std::uint64_t f
   m.write_landscape_cells();  // the cells set one by one before these
   for (std::size_t mt = 0; mt < s.metrics.size(); ++mt)
     if (!write_consecutive(s.metrics[mt], s.dims, first, count, values[mt])) m.fail("cannot write landscape cells of " + s.block);
+  s.written(count * s.metrics.size());
   if (!s.fresh) m.uncommitted_bytes += count * s.metrics.size() * sizeof(double);
   if (m.uncommitted_bytes >= Impl::kMaxUncommittedBytes) m.do_flush();
 }
@@ -245,6 +283,24 @@ bool ResultsWriter::copy_landscape(std::size_t landscape, const std::vector<cons
   }
   H5Eclear2(H5E_DEFAULT);
   m.write_landscape_cells();  // the cells set one by one before these
+  // A dense landscape (allocated, never written, past the committed size, where the journal driver
+  // writes straight to the file) takes the sources' bytes by file offset, copied by the kernel,
+  // when every source's bytes on disk are its committed state and every grid has its address.
+  const std::size_t n_metrics = s.metrics.size();
+  bool by_offset = s.unwritten > 0;
+  const int out_fd = by_offset ? file_descriptor(m.file) : -1;
+  std::vector<haddr_t> to(n_metrics, HADDR_UNDEF);
+  std::vector<std::vector<haddr_t>> from_at(sources.size());
+  std::vector<int> in_fd(sources.size(), -1);
+  for (std::size_t mt = 0; mt < n_metrics && by_offset; ++mt) to[mt] = H5Dget_offset(s.metrics[mt]);
+  for (std::size_t k = 0; k < sources.size() && by_offset; ++k) {
+    if (!used[k]) continue;
+    in_fd[k] = sources[k]->bytes_are_committed_state() ? file_descriptor(static_cast<hid_t>(sources[k]->raw_file_id())) : -1;
+    for (const Hid& d : in[k]) from_at[k].push_back(H5Dget_offset(d));
+    by_offset = in_fd[k] >= 0 && std::none_of(from_at[k].begin(), from_at[k].end(), [](haddr_t a) { return a == HADDR_UNDEF; });
+  }
+  by_offset = by_offset && out_fd >= 0 && std::none_of(to.begin(), to.end(), [](haddr_t a) { return a == HADDR_UNDEF; });
+  H5Eclear2(H5E_DEFAULT);
   // By ranges of one owner, in pieces of kPiece cells: a write of many megabytes at once is several
   // times slower than the same bytes in pieces of this size (measured on Linux 6, ext4).
   constexpr hsize_t kPiece = hsize_t{1} << 16;  // cells moved at once (512 KiB)
@@ -253,13 +309,19 @@ bool ResultsWriter::copy_landscape(std::size_t landscape, const std::vector<cons
     hsize_t hi = lo + 1;  // [lo, hi): one owner, at most kPiece cells
     while (hi < cells && hi - lo < kPiece && owner[hi] == owner[lo]) ++hi;
     if (owner[lo] >= 0) {
-      v.resize(hi - lo);
-      const auto& from = in[static_cast<std::size_t>(owner[lo])];
-      for (std::size_t mt = 0; mt < s.metrics.size(); ++mt)
-        if (!read_consecutive(from[mt], s.dims, lo, hi - lo, v.data()) ||
-            !write_consecutive(s.metrics[mt], s.dims, lo, hi - lo, v.data()))
-          m.fail("cannot copy the landscape cells of " + s.block);
-      if (!s.fresh) m.uncommitted_bytes += (hi - lo) * s.metrics.size() * sizeof(double);
+      const auto k = static_cast<std::size_t>(owner[lo]);
+      constexpr std::uint64_t w = sizeof(double);
+      for (std::size_t mt = 0; mt < n_metrics && by_offset; ++mt)
+        by_offset = kernel_copy(in_fd[k], from_at[k][mt] + lo * w, out_fd, to[mt] + lo * w, (hi - lo) * w, m.path);
+      if (!by_offset) {  // the kernel cannot copy between these files: through HDF5 (all metrics again)
+        v.resize(hi - lo);
+        for (std::size_t mt = 0; mt < n_metrics; ++mt)
+          if (!read_consecutive(in[k][mt], s.dims, lo, hi - lo, v.data()) ||
+              !write_consecutive(s.metrics[mt], s.dims, lo, hi - lo, v.data()))
+            m.fail("cannot copy the landscape cells of " + s.block);
+      }
+      s.written((hi - lo) * n_metrics);
+      if (!s.fresh) m.uncommitted_bytes += (hi - lo) * n_metrics * sizeof(double);
       if (m.uncommitted_bytes >= Impl::kMaxUncommittedBytes) m.do_flush();
     }
     lo = hi;
@@ -298,6 +360,7 @@ void ResultsWriter::Impl::write_landscape_cells() {
         i = j;
       }
     }
+    s.written(n * metrics);
     if (!s.fresh) uncommitted_bytes += n * metrics * sizeof(double);
     s.cells.clear();
     s.values.clear();
