@@ -217,6 +217,12 @@ std::vector<std::string> read_str_list_attr(hid_t obj, const char* name) {
   return read_strings(attr);
 }
 
+int file_descriptor(hid_t file) {
+  void* handle = nullptr;
+  if (H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) < 0 || !handle) return -1;
+  return *static_cast<int*>(handle);
+}
+
 bool link_exists(hid_t loc, const std::string& path) { return H5Lexists(loc, path.c_str(), H5P_DEFAULT) > 0; }
 
 std::vector<ColumnSpec> read_run_columns(hid_t file, const std::string& path, std::int64_t& n_runs,

@@ -109,6 +109,9 @@ std::string read_str_attr(hid_t obj, const char* name);  // "" when absent
 std::int64_t read_i64_attr(hid_t obj, const char* name, std::int64_t fallback);
 std::vector<std::string> read_str_list_attr(hid_t obj, const char* name);
 bool link_exists(hid_t loc, const std::string& path);
+/// The file descriptor of an open HDF5 file (its driver's handle: the sec2 and journal drivers hold
+/// one), or -1.
+int file_descriptor(hid_t file);
 /// The /runs column specs (name, type, unit, description, and with `roles_stored` role and kinds) in
 /// file order, and the n_runs attribute (-1 when absent). Format 1 files store no role/kinds: pass
 /// false, and their columns keep the ColumnSpec defaults. Throws StoreError naming `path` when a

@@ -21,14 +21,6 @@ using namespace detail;
 namespace {
 constexpr std::size_t kPendingCells = 1 << 16;  // cells held before they are written (rows: kRowBatch)
 
-/// The file descriptor of an open HDF5 file (its driver's handle: the sec2 and journal drivers hold
-/// one), or -1.
-int file_descriptor(hid_t file) {
-  void* handle = nullptr;
-  if (H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) < 0 || !handle) return -1;
-  return *static_cast<int*>(handle);
-}
-
 /// `bytes` of file `in` at `from` copied to file `out` at `to` inside the kernel (copy_file_range:
 /// no pass through this process's memory). False, nothing copied, when the kernel cannot copy
 /// between these files; StoreError (`path`) on a failure part way.
