@@ -18,7 +18,7 @@ std::string cf_units(const std::string& unit) {
   if (unit.empty() || unit.rfind("labels:", 0) == 0) return {};
   // Labels the engine writes that UDUNITS-2 spells otherwise; the rest are UDUNITS-2 already.
   static const std::pair<const char*, const char*> spelled[] = {
-      {"Nm", "N m"}, {"1/s", "s-1"}, {"1/s^2", "s-2"}, {"rad/s^2", "rad s-2"}, {"m/s^2", "m s-2"}};
+      {"Nm", "N m"}, {"1/s", "s^-1"}, {"1/s^2", "s^-2"}, {"rad/s^2", "rad s^-2"}, {"m/s^2", "m s^-2"}};
   for (const auto& [label, cf] : spelled)
     if (unit == label) return cf;
   // Not expressible (E_M's kg^(1/2): UDUNITS-2 has integer powers only) or not one unit.

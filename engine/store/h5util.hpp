@@ -105,7 +105,7 @@ void write_i64_list_attr(hid_t obj, const char* name, const std::vector<std::int
 std::vector<std::int64_t> read_i64_list_attr(hid_t obj, const char* name);  // empty when absent
 void write_str_list_attr(hid_t obj, const char* name, const std::vector<std::string>& values);
 bool has_attr(hid_t obj, const char* name);
-/// The CF `units` (UDUNITS-2) of an engine unit label: "Nm" -> "N m", "1/s" -> "s-1"; "" when the
+/// The CF `units` (UDUNITS-2) of an engine unit label: "Nm" -> "N m", "1/s" -> "s^-1"; "" when the
 /// label has none: dimensionless (""), categorical ("labels:..."), a per-column list ("rad, rad, mm"),
 /// or no UDUNITS-2 form (a half power, "problem units", "rad or mm") (cf_units.cpp).
 std::string cf_units(const std::string& unit);
