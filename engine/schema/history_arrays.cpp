@@ -21,6 +21,20 @@ std::string joint_units(const RobotShape& robot, const char* revolute, const cha
   return u;
 }
 
+/// The unit of the norm of a vector whose components have the units `units` ("rad, rad, rad"):
+/// their one unit, or "problem units" when they differ or are not known.
+std::string norm_of(const std::string& units) {
+  std::string first;
+  for (std::size_t at = 0; at <= units.size();) {
+    const std::size_t end = std::min(units.find(", ", at), units.size());
+    const std::string part = units.substr(at, end - at);
+    if (at == 0) first = part;
+    else if (part != first) return "problem units";
+    at = end + 2;
+  }
+  return first.empty() ? "problem units" : first;
+}
+
 }  // namespace
 
 std::vector<HistoryArrayDef> trajectory_history_arrays(const RobotShape& robot) {
@@ -37,17 +51,20 @@ std::vector<HistoryArrayDef> trajectory_history_arrays(const RobotShape& robot) 
 }
 
 std::vector<HistoryArrayDef> ik_history_arrays(IkProblem problem, const RobotShape& robot) {
-  std::string q_unit, f_unit = "problem units", step_unit = "problem units";
+  // A norm's unit: its components' one unit, "problem units" when they mix units (q in rad and mm).
+  std::string q_unit, f_unit = "problem units", norm_unit = "problem units", step_unit;
   std::size_t nq = 3, m = 3;
   switch (problem) {
     case IkProblem::scara:
       q_unit = "rad, rad, mm";
+      f_unit = norm_unit = "mm";
       break;
     case IkProblem::planar3r_pose:
-      q_unit = "rad, rad, rad";
+      q_unit = step_unit = "rad, rad, rad";
       break;
     case IkProblem::planar3r_position:
-      q_unit = "rad, rad, rad";
+      q_unit = step_unit = "rad, rad, rad";
+      f_unit = norm_unit = "m";
       m = 2;
       break;
     case IkProblem::position:
@@ -58,7 +75,10 @@ std::vector<HistoryArrayDef> ik_history_arrays(IkProblem problem, const RobotSha
       std::string u;
       for (int j = 0; j < robot.joints; ++j) u += (j ? ", " : "") + std::string(robot.is_prismatic(j) ? "m" : "rad");
       q_unit = step_unit = u;
-      f_unit = pose ? "m, rad" : "m";
+      const std::size_t lengths = robot.planar ? 2 : 3;
+      f_unit.clear();
+      for (std::size_t i = 0; i < m; ++i) f_unit += (i ? ", " : "") + std::string(i < lengths ? "m" : "rad");
+      if (!pose) f_unit = norm_unit = "m";
       break;
     }
   }
@@ -66,8 +86,8 @@ std::vector<HistoryArrayDef> ik_history_arrays(IkProblem problem, const RobotSha
       {"k", "", 1, "iteration of the row (every stride-th and the last)"},
       {"q", q_unit, nq, "iterate q_k"},
       {"F", f_unit, m, "residual F(q_k)"},
-      {"norm_F", f_unit, 1, "||F(q_k)||"},
-      {"step", step_unit, 1, "||q_k - q_{k-1}|| (0 at k = 0)"},
+      {"norm_F", norm_unit, 1, "||F(q_k)||"},
+      {"step", norm_of(step_unit), 1, "||q_k - q_{k-1}|| (0 at k = 0)"},
       {"lambda", "", 1, "damping of the step to q_k (lm, lm_adaptive; 0 otherwise)"},
   };
 }

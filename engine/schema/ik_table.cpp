@@ -117,7 +117,9 @@ std::vector<MetricDef> ik_metrics(const KindContext& ctx) {
   iterations.if_failed = [](const RunSpec& r) { return double(std::get<IkRun>(r).options.max_iter); };
   std::vector<MetricDef> m{
       iterations,
-      metric<R>("error", CellType::f64, "problem units", "||F|| at the final iterate (mm for scara, m/rad for planar3r)",
+      metric<R>("error", CellType::f64, ctx.scara ? "mm" : "problem units",
+                "||F|| at the final iterate (mm for scara; for the other problems the residual's own units: m, or "
+                "m and rad mixed)",
                 true, [](const R& r) { return r.error; })
           .labelled("final ‖F‖"),
       metric<R>("solution", CellType::i64, "", "index of the known exact solution reached (mod 2 pi), -1 if none",
@@ -134,7 +136,7 @@ std::vector<MetricDef> ik_metrics(const KindContext& ctx) {
   for (int j = 0; j < n; ++j) {
     const std::string i = std::to_string(j + 1);
     std::string unit = ctx.robot.is_prismatic(j) ? "m" : "rad", what = "final iterate, joint " + i;
-    if (j == 2 && !ctx.robot.chain) unit = "rad or mm", what += " (scara: d in mm)";
+    if (j == 2 && !ctx.robot.chain) unit = ctx.scara ? "mm" : "rad", what += ctx.scara ? " (d)" : "";
     if (unit == "rad") what += " (converged, limits not enforced: wrapped to (-pi, pi])";
     m.push_back(metric<R>("q_final_" + i, CellType::f64, unit, what, false, [j](const R& r) {
       return j < r.q.size() ? r.q[j] : std::numeric_limits<double>::quiet_NaN();

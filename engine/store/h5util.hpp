@@ -105,6 +105,16 @@ void write_i64_list_attr(hid_t obj, const char* name, const std::vector<std::int
 std::vector<std::int64_t> read_i64_list_attr(hid_t obj, const char* name);  // empty when absent
 void write_str_list_attr(hid_t obj, const char* name, const std::vector<std::string>& values);
 bool has_attr(hid_t obj, const char* name);
+/// The CF `units` (UDUNITS-2) of an engine unit label: "Nm" -> "N m", "1/s" -> "s^-1"; "" when the
+/// label has none: dimensionless (""), categorical ("labels:..."), a per-column list ("rad, rad, mm"),
+/// or no UDUNITS-2 form (a half power, "problem units", "rad or mm") (cf_units.cpp).
+std::string cf_units(const std::string& unit);
+/// The CF units of each of `cols` columns of a per-column label ("rad, rad, mm"); empty unless every
+/// column has one.
+std::vector<std::string> cf_column_units(const std::string& unit, std::size_t cols);
+/// Writes `units` on dataset `d` (cf_units of `unit`, or the one unit all its `cols` columns share)
+/// or, when the columns differ, `column_units` (one UDUNITS-2 string per column); nothing otherwise.
+void write_cf_units(hid_t d, const std::string& unit, std::size_t cols = 1);
 std::string read_str_attr(hid_t obj, const char* name);  // "" when absent
 std::int64_t read_i64_attr(hid_t obj, const char* name, std::int64_t fallback);
 std::vector<std::string> read_str_list_attr(hid_t obj, const char* name);

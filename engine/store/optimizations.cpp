@@ -44,6 +44,7 @@ struct Out {
     if (!d.ok() || (!v.empty() && H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0))
       m.fail("cannot write " + where + "/" + name);
     write_str_attr(d, "unit", unit);
+    write_cf_units(d, unit, cols);
     write_str_attr(d, "description", desc);
   }
   void i64(hid_t g, const std::string& name, const std::vector<std::int64_t>& v, const std::string& desc) {

@@ -143,6 +143,7 @@ void ResultsWriter::Impl::write_history(std::int64_t id, const EncodedHistory& g
       d.dset = Hid(H5Dcreate2(histories, d.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT));
       if (!d.dset.ok()) fail("cannot create /histories/" + d.name);
       write_str_attr(d.dset, "unit", a.unit);
+      write_cf_units(d.dset, a.unit, a.cols);
       write_str_attr(d.dset, "array", a.name);
       h.datasets.push_back(std::move(d));
     }

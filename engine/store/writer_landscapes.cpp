@@ -89,6 +89,29 @@ std::vector<Hid> same_grid_metrics(hid_t g, const LandscapeSpec& spec, const std
   }
   return metrics;
 }
+
+/// CF flags of a categorical axis (its values the codes 0..n-1): flag_values, the codes, and
+/// flag_meanings, each code's label (spaces as underscores), in place of units.
+void write_label_axis_flags(hid_t d, const std::string& labels, std::size_t n) {
+  std::string meanings, label;
+  std::vector<double> codes;
+  for (std::size_t i = 0; i <= labels.size(); ++i) {
+    if (i < labels.size() && labels[i] != ',') {
+      label += labels[i] == ' ' ? '_' : labels[i];
+      continue;
+    }
+    meanings += (codes.empty() ? "" : " ") + label;
+    codes.push_back(static_cast<double>(codes.size()));
+    label.clear();
+  }
+  if (codes.size() != n) return;
+  hsize_t len = n;
+  Hid space(H5Screate_simple(1, &len, nullptr));
+  Hid a(H5Acreate2(d, "flag_values", H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT));
+  if (a.ok()) H5Awrite(a, H5T_NATIVE_DOUBLE, codes.data());
+  write_str_attr(d, "flag_meanings", meanings);
+}
+
 }  // namespace
 
 std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
@@ -156,7 +179,8 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
     if (!d.ok() || H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.values.data()) < 0)
       m.fail("cannot write landscape axis " + a.name);
     write_str_attr(d, "unit", a.unit);
-    write_str_attr(d, "units", a.unit);  // the CF name, which xarray's plots label axes with
+    write_cf_units(d, a.unit);  // CF units, which xarray's plots label axes with
+    if (a.unit.rfind("labels:", 0) == 0) write_label_axis_flags(d, a.unit.substr(7), a.values.size());
     write_str_attr(d, "kind", "axis");
     if (H5DSset_scale(d, a.name.c_str()) < 0) m.fail("cannot make landscape axis " + a.name + " a dimension scale");
     axis_dsets.push_back(std::move(d));
@@ -187,7 +211,7 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
     Hid d(H5Dcreate2(g, mt.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT));
     if (!d.ok()) m.fail("cannot create landscape metric " + mt.name);
     write_str_attr(d, "unit", mt.unit);
-    write_str_attr(d, "units", mt.unit);
+    write_cf_units(d, mt.unit);
     write_str_attr(d, "description", mt.description);
     write_str_attr(d, "long_name", mt.description);
     if (!mt.display_name.empty()) write_str_attr(d, "display_name", mt.display_name);

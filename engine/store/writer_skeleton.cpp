@@ -92,6 +92,7 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
     Hid d(check(H5Dcreate2(runs, c.name.c_str(), ftype, space, H5P_DEFAULT, dcpl, H5P_DEFAULT), path,
                 "create /runs/" + c.name));
     write_str_attr(d, "unit", c.unit);
+    write_cf_units(d, c.unit);
     write_str_attr(d, "description", c.description);
     write_str_attr(d, "type", type_attr);
     write_str_attr(d, "role", std::string(to_string(c.role)));
@@ -112,7 +113,12 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
     Hid ft(file_type_of(c.type));
     switch (c.type) {
       case CellType::f64: make(c, ft, H5T_NATIVE_DOUBLE, &nan, "f64"); break;
-      case CellType::i64: make(c, ft, H5T_NATIVE_INT64, &minus1, "i64"); break;
+      case CellType::i64: {  // -1: missing, which CF readers learn from _FillValue
+        make(c, ft, H5T_NATIVE_INT64, &minus1, "i64");
+        Hid d(check(H5Dopen2(runs, c.name.c_str(), H5P_DEFAULT), path, "open /runs/" + c.name));
+        write_i64_attr(d, "_FillValue", minus1);
+        break;
+      }
       case CellType::str: make(c, ft, ft, nullptr, "str"); break;  // null = ""
     }
   }
