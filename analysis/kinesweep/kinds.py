@@ -22,6 +22,21 @@ KIND_MEANING = {
            "resume_context": ["robot", "settings"]},
 }
 GOOD_STATUSES = [s for m in KIND_MEANING.values() for s in m["good_statuses"]]
+# Keywords of xarray's Dataset.sel: a landscape axis of one of these names is stored (and is a
+# dimension) under the name with "_" appended (store/h5util.hpp axis_dataset_name), so that
+# ds.sel(method_="lm") selects along it.
+SEL_KEYWORDS = ("method", "tolerance", "drop", "indexers")
+
+
+def is_netcdf_dimension(dataset):
+    """True for a dataset that only names a netCDF dimension (no values: /histories' run_id and
+    history_row, /optimizations' evaluation, variable, ...; FORMAT.md)."""
+    return b"This is a netCDF dimension but not a netCDF variable" in bytes(dataset.attrs.get("NAME", b""))
+
+
+def axis_dataset_name(axis):
+    """The dataset and dimension name of landscape axis `axis` (see SEL_KEYWORDS)."""
+    return axis + "_" if axis in SEL_KEYWORDS else axis
 # Display labels of metrics for files written before the engine recorded them (the attribute
 # `display_name` of each metric column and landscape metric, from the kind's metric table); a metric
 # not listed shows its name. "convergence" is the fraction of converged runs the plots derive.
@@ -204,11 +219,12 @@ class Landscape:
 
     def to_xarray(self):
         """The landscape as an xarray.Dataset: one data variable per metric over the dimensions named
-        after the axes, each axis a coordinate (its labels for a string axis such as `method`); units
+        after the axes (`method_` for `method`, as in the file: SEL_KEYWORDS), each axis a coordinate
+        (its labels for a string axis such as `method`); units
         and descriptions in the variables' attrs ("units", "long_name"), block and kind in the Dataset's."""
         import xarray as xr  # optional dependency
-        dims = [a.name for a in self.axes]
-        coords = {a.name: (a.name, self._coordinate(a), {"units": a.unit}) for a in self.axes}
+        dims = [axis_dataset_name(a.name) for a in self.axes]
+        coords = {d: (d, self._coordinate(a), {"units": a.unit}) for d, a in zip(dims, self.axes)}
         data = {m: (dims, v, {"units": self.units.get(m, ""), "long_name": self.descriptions.get(m, "")})
                 for m, v in self.metrics.items()}
         return xr.Dataset(data, coords=coords, attrs={"block": self.block, "kind": self.kind})

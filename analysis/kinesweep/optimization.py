@@ -2,7 +2,7 @@
 local polishes and best point), as kinesweep.read returns it. Run with /usr/bin/python3."""
 import numpy as np
 
-from kinesweep.kinds import Table, _s
+from kinesweep.kinds import Table, _s, is_netcdf_dimension
 
 RAD2DEG = 180.0 / np.pi
 
@@ -43,6 +43,8 @@ class Optimization:
         def table(grp, point_cols=()):
             t = Table()
             for k in grp:
+                if is_netcdf_dimension(grp[k]):
+                    continue
                 v = grp[k][()]
                 if v.dtype.kind in "OSU":
                     v = np.array([_s(x) for x in v], dtype=object)

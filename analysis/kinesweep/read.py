@@ -41,7 +41,7 @@ from kinesweep.solutions import cluster_solutions  # noqa: F401 (part of this mo
 from kinesweep.kinds import FormatVersionError  # noqa: F401 (the same)
 from kinesweep.kinds import (GOOD_STATUSES, IK_STATUSES, KIND_MEANING, METRIC_LABELS, OTHER_SOLUTION_COLOUR,  # noqa: F401
                              STATUS_COLOURS, THESIS_TABLE4, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s,
-                             display_name, enum_labels, text_values)
+                             axis_dataset_name, display_name, enum_labels, text_values)
 
 RAD2DEG = 180.0 / np.pi
 FORMAT_VERSIONS = (2, 3, 4)  # the results formats this module reads (engine/store/FORMAT.md)
@@ -400,8 +400,9 @@ class Results:
         g = self.f["landscapes"][block]
         axes = []
         for a in (_s(x) for x in g.attrs["axes"]):
-            unit = _s(g[a].attrs.get("unit", ""))
-            vals = np.array(g[a][()], dtype=float)
+            d = g[axis_dataset_name(a)] if axis_dataset_name(a) in g else g[a]  # (older files: g[a])
+            unit = _s(d.attrs.get("unit", ""))
+            vals = np.array(d[()], dtype=float)
             labels = None
             if unit.startswith("labels:"):
                 labels, unit = unit[len("labels:"):].split(","), ""

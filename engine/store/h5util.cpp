@@ -1,5 +1,7 @@
 #include "store/h5util.hpp"
 
+#include <hdf5_hl.h>  // H5DS: dimension scales
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -215,6 +217,73 @@ std::vector<std::string> read_str_list_attr(hid_t obj, const char* name) {
   if (H5Aexists(obj, name) <= 0) return {};
   Hid attr(H5Aopen(obj, name, H5P_DEFAULT));
   return read_strings(attr);
+}
+
+hid_t netcdf_dimension(hid_t g, const std::string& name, hsize_t n, bool unlimited) {
+  if (link_exists(g, name)) return H5Dopen2(g, name.c_str(), H5P_DEFAULT);
+  hsize_t max = unlimited ? H5S_UNLIMITED : n;
+  Hid space(H5Screate_simple(1, &n, &max));
+  Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
+  if (unlimited) {
+    const hsize_t chunk = 1024;
+    H5Pset_chunk(dcpl, 1, &chunk);
+  }
+  H5Pset_fill_time(dcpl, H5D_FILL_TIME_NEVER);
+  hid_t d = H5Dcreate2(g, name.c_str(), H5T_IEEE_F32LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT);
+  if (d < 0) return -1;
+  const std::string tag = "This is a netCDF dimension but not a netCDF variable. " + std::to_string(n);
+  if (H5DSset_scale(d, tag.c_str()) < 0) {
+    H5Dclose(d);
+    return -1;
+  }
+  return d;
+}
+
+bool name_netcdf_dimensions(hid_t g, const std::string& rows, const std::string& columns) {
+  H5G_info_t info{};
+  if (H5Gget_info(g, &info) < 0) return false;
+  std::vector<std::string> names;
+  for (hsize_t i = 0; i < info.nlinks; ++i) {
+    char name[256];
+    if (H5Lget_name_by_idx(g, ".", H5_INDEX_NAME, H5_ITER_INC, i, name, sizeof name, H5P_DEFAULT) > 0) names.emplace_back(name);
+  }
+  for (const std::string& name : names) {
+    H5O_info_t oi{};
+    if (H5Oget_info_by_name2(g, name.c_str(), &oi, H5O_INFO_BASIC, H5P_DEFAULT) < 0 || oi.type != H5O_TYPE_DATASET) continue;
+    Hid d(H5Dopen2(g, name.c_str(), H5P_DEFAULT));
+    if (!d.ok() || H5DSis_scale(d) > 0 || name == rows || name == columns) continue;
+    Hid space(H5Dget_space(d));
+    const int rank = H5Sget_simple_extent_ndims(space);
+    hsize_t dims[2] = {0, 0};
+    if (rank < 1 || rank > 2 || H5Sget_simple_extent_dims(space, dims, nullptr) < 0) continue;
+    Hid r(netcdf_dimension(g, rows, dims[0]));
+    if (!r.ok() || H5DSattach_scale(d, r, 0) < 0) return false;
+    if (rank == 1) continue;
+    std::string c = columns.empty() ? name + "_column" : columns;
+    hsize_t have = dims[1];
+    if (link_exists(g, c)) {
+      Hid e(H5Dopen2(g, c.c_str(), H5P_DEFAULT));
+      Hid es(H5Dget_space(e));
+      H5Sget_simple_extent_dims(es, &have, nullptr);
+      if (have != dims[1]) c = name + "_column";
+    }
+    Hid s(netcdf_dimension(g, c, dims[1]));
+    if (!s.ok() || H5DSattach_scale(d, s, 1) < 0) return false;
+  }
+  return true;
+}
+
+std::string axis_dataset_name(const std::string& axis) {
+  for (const char* k : {"method", "tolerance", "drop", "indexers"})
+    if (axis == k) return axis + "_";
+  return axis;
+}
+
+hid_t open_axis_dataset(hid_t g, const std::string& axis) {
+  const std::string name = axis_dataset_name(axis);
+  if (link_exists(g, name)) return H5Dopen2(g, name.c_str(), H5P_DEFAULT);
+  if (name != axis && link_exists(g, axis)) return H5Dopen2(g, axis.c_str(), H5P_DEFAULT);
+  return -1;
 }
 
 int file_descriptor(hid_t file) {

@@ -119,6 +119,24 @@ std::string read_str_attr(hid_t obj, const char* name);  // "" when absent
 std::int64_t read_i64_attr(hid_t obj, const char* name, std::int64_t fallback);
 std::vector<std::string> read_str_list_attr(hid_t obj, const char* name);
 bool link_exists(hid_t loc, const std::string& path);
+/// A netCDF dimension without a coordinate variable, as netCDF-4 stores one: a dimension scale
+/// `name` of length `n` in group `g` whose NAME says "This is a netCDF dimension but not a netCDF
+/// variable." (never written: it takes no space; `unlimited`: extendible, H5Dset_extent it with
+/// the datasets it measures). Returns it (the one there when `g` already has it), or -1.
+hid_t netcdf_dimension(hid_t g, const std::string& name, hsize_t n, bool unlimited = false);
+/// Names the dimensions of every dataset of group `g` (not its subgroups) for netCDF readers:
+/// dimension 0 of each is `rows` (created with the length of the first such dataset when absent),
+/// dimension 1 `columns` or, when that is empty or of another length, `<dataset>_column`.
+/// Datasets that are dimension scales are left alone. False on an HDF5 failure.
+bool name_netcdf_dimensions(hid_t g, const std::string& rows, const std::string& columns = "");
+
+/// The dataset (and dimension) name of landscape axis `axis`: the axis name, with "_" appended when
+/// it is a keyword of xarray's Dataset.sel (method, tolerance, drop, indexers), so that
+/// ds.sel(method_=...) selects along it (ds.sel(method=...) would be taken as sel's own argument).
+std::string axis_dataset_name(const std::string& axis);
+/// Landscape axis `axis` of group `g`: its dataset under axis_dataset_name, or under the axis name
+/// (files written before the rename). -1 when neither exists.
+hid_t open_axis_dataset(hid_t g, const std::string& axis);
 /// The file descriptor of an open HDF5 file (its driver's handle: the sec2 and journal drivers hold
 /// one), or -1.
 int file_descriptor(hid_t file);

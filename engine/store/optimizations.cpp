@@ -68,6 +68,10 @@ struct Out {
     write_str_attr(d, "unit", "");
     write_str_attr(d, "description", desc);
   }
+  /// netCDF dimensions of the datasets of `g` (name_netcdf_dimensions).
+  void dimensions(hid_t g, const std::string& rows, const std::string& columns = "") {
+    if (!name_netcdf_dimensions(g, rows, columns)) m.fail("cannot name the dimensions of " + where);
+  }
   Hid group(hid_t parent, const std::string& name) {
     Hid g(H5Gcreate2(parent, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
     if (!g.ok()) m.fail("cannot create " + where + "/" + name);
@@ -136,6 +140,7 @@ void ResultsWriter::write_optimization(const OptimizationRecord& r) {
     o.str(e, "stage", r.stage, "sweep | global | local");
     o.str(e, "status", r.status, "the run's status (an evaluation set: the first failure and the count)");
     o.i64(e, "start", r.start, "local: index of the start (row of local/from); sweep: the cell's run id; global: -1");
+    o.dimensions(e, "evaluation", "variable");
   }
   // Stages.
   {
@@ -157,6 +162,7 @@ void ResultsWriter::write_optimization(const OptimizationRecord& r) {
     o.f64(s, "best_objective", best, 0, "", "best objective of the stage");
     o.f64(s, "best_x", bx, d, "", "best point of the stage, one column per variable");
     o.i64(s, "evaluations", ev, "objective evaluations of the stage");
+    o.dimensions(s, "stage", "variable");
   }
   // Local starts.
   {
@@ -165,6 +171,7 @@ void ResultsWriter::write_optimization(const OptimizationRecord& r) {
     o.f64(l, "from", r.local_from, d, "", "start of each local polish");
     o.f64(l, "to", r.local_to, d, "", "best point each local polish reached");
     o.f64(l, "objective", r.local_value, 0, "", "best objective each local polish reached");
+    o.dimensions(l, "start", "variable");
   }
   // The best point's run: metrics and history.
   {
@@ -184,6 +191,7 @@ void ResultsWriter::write_optimization(const OptimizationRecord& r) {
       o.f64(h, a.name, a.data, a.cols, a.unit, "the best point's run");
     }
     write_str_list_attr(h, "arrays", arrays);
+    o.dimensions(h, "row");
   }
   m.do_flush();
 }

@@ -210,8 +210,12 @@ LandscapeSpec ResultsReader::read_landscape(const std::string& block, bool grids
     return std::make_pair(std::move(v), read_str_attr(d, "unit"));
   };
   for (auto& name : read_str_list_attr(g, "axes")) {
-    auto [v, unit] = read_all(name);
-    spec.axes.push_back({name, unit, std::move(v)});
+    Hid d(check(open_axis_dataset(g, name), impl_->path, "open /" + gp + "/" + axis_dataset_name(name)));
+    Hid s(H5Dget_space(d));
+    std::vector<double> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
+    if (!v.empty())
+      check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), impl_->path, "read " + name);
+    spec.axes.push_back({name, read_str_attr(d, "unit"), std::move(v)});
   }
   for (auto& name : read_str_list_attr(g, "metrics")) {
     if (!grids) {

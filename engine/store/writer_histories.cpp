@@ -2,6 +2,8 @@
 // datasets shared by all runs, one per array, at a chunk-aligned start in one row space, with a
 // per-run index. The chunks come encoded from the worker threads (history_codec.cpp): the writer
 // thread creates no per-run object and compresses nothing.
+#include <hdf5_hl.h>  // H5DS: dimension scales
+
 #include <algorithm>
 #include <limits>
 #include <set>
@@ -106,6 +108,11 @@ void ResultsWriter::Impl::write_history(std::int64_t id, const EncodedHistory& g
       *dsets[k] = Hid(check(H5Dcreate2(histories, kIndex[k], H5T_STD_I64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT),
                             path, std::string("create /histories/") + kIndex[k]));
     }
+    // their netCDF dimension: one per run (/runs' run ids), named run_id
+    Hid run_dim(netcdf_dimension(histories, "run_id", n));
+    for (Hid* d : dsets)
+      if (!run_dim.ok() || H5DSattach_scale(*d, run_dim, 0) < 0) fail("cannot name the dimension of the /histories index");
+    write_str_attr(h.rows, "sample_dimension", "history_row");  // CF: the count of a ragged array's rows
     write_str_attr(h.start, "description", "first row of the run's history in every history dataset (-1: none)");
     write_str_attr(h.rows, "description", "rows of the run's history");
     write_str_attr(h.layout, "description", "index into the attribute layouts of /histories (-1: none)");
@@ -116,7 +123,8 @@ void ResultsWriter::Impl::write_history(std::int64_t id, const EncodedHistory& g
   std::vector<std::string> dnames;
   const auto taken = [&](const std::string& n) {
     return std::any_of(h.datasets.begin(), h.datasets.end(), [&](const HistoryDataset& d) { return d.name == n; }) ||
-           n == "start" || n == "rows" || n == "layout";
+           n == "start" || n == "rows" || n == "layout" || n == "run_id" || n == "history_row" ||
+           link_exists(histories, n) || link_exists(histories, n + "_column");
   };
   for (const auto& a : enc->arrays) {
     HistoryDataset* found = nullptr;
@@ -145,6 +153,16 @@ void ResultsWriter::Impl::write_history(std::int64_t id, const EncodedHistory& g
       write_str_attr(d.dset, "unit", a.unit);
       write_cf_units(d.dset, a.unit, a.cols);
       write_str_attr(d.dset, "array", a.name);
+      // netCDF dimensions: the shared rows (history_row) and the dataset's columns (<name>_column)
+      if (!h.row_dim.ok()) {
+        h.row_dim = Hid(netcdf_dimension(histories, "history_row", 0, true));
+        Hid rs(h.row_dim.ok() ? H5Dget_space(h.row_dim) : -1);
+        if (rs.ok()) H5Sget_simple_extent_dims(rs, &h.row_dim_extent, nullptr);
+      }
+      Hid col_dim(netcdf_dimension(histories, d.name + "_column", a.cols));
+      if (!h.row_dim.ok() || !col_dim.ok() || H5DSattach_scale(d.dset, h.row_dim, 0) < 0 ||
+          H5DSattach_scale(d.dset, col_dim, 1) < 0)
+        fail("cannot name the dimensions of /histories/" + d.name);
       h.datasets.push_back(std::move(d));
     }
     dnames.push_back(found ? found->name : h.datasets.back().name);
@@ -172,6 +190,10 @@ void ResultsWriter::Impl::write_history(std::int64_t id, const EncodedHistory& g
       grow[0] = std::max<hsize_t>(grow[0], 64 * C);
       if (H5Dset_extent(d.dset, grow) < 0) fail("cannot extend /histories/" + d.name);
       d.extent = grow[0];
+      if (h.row_dim.ok() && h.row_dim_extent < d.extent) {  // the dimension spans its longest dataset
+        if (H5Dset_extent(h.row_dim, &d.extent) < 0) fail("cannot extend /histories/history_row");
+        h.row_dim_extent = d.extent;
+      }
     }
     for (std::size_t c = 0; c < a.chunks.size(); ++c) {
       hsize_t offset[2] = {start + c * C, 0};
@@ -217,12 +239,17 @@ void ResultsWriter::Impl::write_history_index() {
 }
 
 void ResultsWriter::Impl::trim_histories() {
+  // every dataset (and the dimension history_row) to used_rows: one row space, of one length
   for (auto& d : hist.datasets)
-    if (d.cols > 0 && d.extent > hist.used_rows) {
+    if (d.cols > 0 && d.extent != hist.used_rows) {
       hsize_t dims[2] = {hist.used_rows, d.cols};
       if (H5Dset_extent(d.dset, dims) < 0) fail("cannot trim /histories/" + d.name);
       d.extent = hist.used_rows;
     }
+  if (hist.row_dim.ok() && hist.row_dim_extent != hist.used_rows) {
+    if (H5Dset_extent(hist.row_dim, &hist.used_rows) < 0) fail("cannot trim /histories/history_row");
+    hist.row_dim_extent = hist.used_rows;
+  }
 }
 
 }  // namespace ks::store

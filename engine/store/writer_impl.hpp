@@ -62,11 +62,14 @@ struct ResultsWriter::Impl {
     std::vector<HistoryDataset> datasets;
     std::vector<std::string> layouts;
     detail::Hid start, rows, layout;          ///< the index datasets (absent until the first history)
+    detail::Hid row_dim;                      ///< the netCDF dimension history_row (opened at the first need)
+    hsize_t row_dim_extent = 0;
     std::map<std::int64_t, HistoryIndexEntry> pending;  ///< index entries not yet in the datasets
     bool layouts_dirty = false;
     void close_handles() {
       datasets.clear();
-      start.reset(); rows.reset(); layout.reset();
+      start.reset(); rows.reset(); layout.reset(); row_dim.reset();
+      row_dim_extent = 0;
     }
   } hist;
   std::set<std::string> begun_landscapes;  // blocks begin_landscape was called for by this writer

@@ -68,7 +68,7 @@ std::vector<Hid> same_grid_metrics(hid_t g, const LandscapeSpec& spec, const std
   for (auto& a : spec.axes) names.push_back(a.name);
   if (read_str_list_attr(g, "axes") != names) return {};
   for (auto& a : spec.axes) {
-    Hid d(H5Dopen2(g, a.name.c_str(), H5P_DEFAULT));
+    Hid d(open_axis_dataset(g, a.name));
     if (!d.ok() || read_str_attr(d, "unit") != a.unit) return {};
     const std::vector<double> v = read_doubles(d);
     if (v.size() != a.values.size() || std::memcmp(v.data(), a.values.data(), v.size() * sizeof(double)) != 0) return {};
@@ -175,14 +175,15 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
   for (auto& a : spec.axes) {
     hsize_t n = a.values.size();
     Hid space(H5Screate_simple(1, &n, nullptr));
-    Hid d(H5Dcreate2(g, a.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+    const std::string dname = axis_dataset_name(a.name);
+    Hid d(H5Dcreate2(g, dname.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
     if (!d.ok() || H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, a.values.data()) < 0)
       m.fail("cannot write landscape axis " + a.name);
     write_str_attr(d, "unit", a.unit);
     write_cf_units(d, a.unit);  // CF units, which xarray's plots label axes with
     if (a.unit.rfind("labels:", 0) == 0) write_label_axis_flags(d, a.unit.substr(7), a.values.size());
     write_str_attr(d, "kind", "axis");
-    if (H5DSset_scale(d, a.name.c_str()) < 0) m.fail("cannot make landscape axis " + a.name + " a dimension scale");
+    if (H5DSset_scale(d, dname.c_str()) < 0) m.fail("cannot make landscape axis " + a.name + " a dimension scale");
     axis_dsets.push_back(std::move(d));
   }
   // Metrics: contiguous, allocated (and filled with NaN) when their first cell is written, so a

@@ -67,6 +67,12 @@ max_evals = 30
 """
 
 
+def axis_dataset_name(axis):
+    """The dataset (and netCDF dimension) of landscape axis `axis`, as FORMAT.md states it: the axis
+    name, with "_" appended to the keywords of xarray's Dataset.sel."""
+    return axis + "_" if axis in ("method", "tolerance", "drop", "indexers") else axis
+
+
 def bitwise_equal(x, y):
     """Arrays equal bit for bit (NaN payloads included)."""
     if x.shape != y.shape:

@@ -126,6 +126,8 @@ def hash_results(path):
                 if "wall_time" in rel:
                     return
                 name = f"optimizations/{opt}/{rel}"
+                if isinstance(obj, h5py.Dataset) and b"not a netCDF variable" in bytes(obj.attrs.get("NAME", b"")):
+                    return  # a netCDF dimension's scale: structure, no values
                 if isinstance(obj, h5py.Dataset):
                     items[name] = entry(obj[()], obj)
                 else:

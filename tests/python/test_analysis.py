@@ -16,7 +16,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, history, runs_column
+from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, axis_dataset_name, history, runs_column
 
 KS = None
 ROOT = None
@@ -118,7 +118,7 @@ class AnalysisTest(unittest.TestCase):
         with h5py.File(self.files["landscape"], "r") as f:
             g = f["landscapes"]["local"]
             self.assertEqual([h5str(x) for x in g.attrs["axes"]], ["method", "alpha1A", "k"])
-            labels = h5str(g["method"].attrs["unit"])[len("labels:"):].split(",")
+            labels = h5str(g[axis_dataset_name("method")].attrs["unit"])[len("labels:"):].split(",")
             m = labels.index("local_unweighted")
             E = g["E"][()][m]          # alpha1A x k
             st = g["status_code"][()][m]
@@ -276,7 +276,7 @@ class AnalysisTest(unittest.TestCase):
         names = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution"]
         with h5py.File(self.files["basins"], "r") as f:
             g = f["landscapes"]["basins"]
-            labels = h5str(g["method"].attrs["unit"])[len("labels:"):].split(",")
+            labels = h5str(g[axis_dataset_name("method")].attrs["unit"])[len("labels:"):].split(",")
             st, sol, it = g["status_code"][()], g["solution"][()], g["iterations"][()]
         self.assertEqual([p["label"] for p in d["panels"]], labels)
         for m, p in enumerate(d["panels"]):

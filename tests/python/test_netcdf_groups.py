@@ -16,7 +16,7 @@ import h5py
 import numpy as np
 import xarray as xr
 
-from e2e_common import runs_column, shipped_results
+from e2e_common import axis_dataset_name, runs_column, shipped_results
 
 RESULTS = None
 
@@ -64,7 +64,8 @@ class NetcdfGroups(unittest.TestCase):
                 blocks = list(f["landscapes"]) if "landscapes" in f else []
                 for block in blocks:
                     g = f["landscapes"][block]
-                    axes = [a.decode() if isinstance(a, bytes) else str(a) for a in g.attrs["axes"]]
+                    # the dimensions: the axes' datasets (`method_` for the axis `method`)
+                    axes = [axis_dataset_name(a.decode() if isinstance(a, bytes) else str(a)) for a in g.attrs["axes"]]
                     with self.subTest(file=os.path.basename(path), block=block), \
                             xr.open_dataset(path, group=f"landscapes/{block}", engine="h5netcdf") as ds:
                         for m in g.attrs["metrics"]:
@@ -81,6 +82,8 @@ class NetcdfGroups(unittest.TestCase):
                                 self.assertIn(block, f["designs"], a)
                                 continue
                             self.assertEqual(ds.sel({a: values[0]})[a].values.item(), values[0])
+                            # and by keyword: no dimension is one of sel's own arguments
+                            self.assertEqual(ds.sel(**{a: values[0]})[a].values.item(), values[0])
                         seen += 1
         self.assertGreater(seen, 5)
 

@@ -24,7 +24,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import Histories, runs_column
+from e2e_common import Histories, axis_dataset_name, runs_column
 from regression_hashes import FULL_HISTORIES
 
 KS = None
@@ -111,7 +111,7 @@ def landscape_axes(g):
     repeated values (a Saltelli design)."""
     out = []
     for a in g.attrs["axes"]:
-        d = g[h5str(a)]
+        d = g[axis_dataset_name(h5str(a))]
         cat = h5str(d.attrs.get("unit", "")).startswith("labels:")
         v = d[()].astype(float)
         steps = np.diff(v)
@@ -359,7 +359,7 @@ class PlotStudiesTest(unittest.TestCase):
         _, d, _ = self.plot("plot_landscape.py", h5, size=(1200, 500))
         with h5py.File(h5, "r") as f:
             g = f["landscapes"]["local"]
-            labels = h5str(g["method"].attrs["unit"])[len("labels:"):].split(",")
+            labels = h5str(g[axis_dataset_name("method")].attrs["unit"])[len("labels:"):].split(",")
             E = np.where(g["status_code"][()] == 0, g["E"][()], np.nan)
         self.assertEqual(d["facet"], "method")
         self.assertIsNone(d["reduce"])

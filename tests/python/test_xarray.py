@@ -11,7 +11,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import StudyFileTest, bitwise_equal
+from e2e_common import StudyFileTest, axis_dataset_name, bitwise_equal
 
 STUDY = """
 [study]
@@ -47,7 +47,8 @@ def stored(path, block):
     """The landscape as h5py reads it: axes [(name, unit, values)], metrics {name: (unit, array)}."""
     with h5py.File(path, "r") as f:
         g = f["landscapes"][block]
-        axes = [(a, g[a].attrs["unit"], g[a][()]) for a in g.attrs["axes"]]
+        axes = [(axis_dataset_name(a), g[axis_dataset_name(a)].attrs["unit"], g[axis_dataset_name(a)][()])
+                for a in (x.decode() if isinstance(x, bytes) else str(x) for x in g.attrs["axes"])]
         metrics = {m: (g[m].attrs["unit"], g[m][()]) for m in g.attrs["metrics"]}
     return axes, metrics
 
@@ -66,12 +67,12 @@ class Xarray(StudyFileTest):
                 for name, unit, values in axes:
                     self.assertIn(name, ds.coords)
                     self.assertTrue(bitwise_equal(ds[name].values, values), name)
-                    self.assertEqual(ds[name].attrs["units"], unit)
+                    self.assertEqual(ds[name].attrs["unit"], unit)  # (the engine's label; CF `units` beside it)
                 self.assertEqual(set(ds.data_vars), set(metrics))
                 for m, (unit, values) in metrics.items():
                     self.assertEqual(list(ds[m].dims), names)
                     self.assertTrue(bitwise_equal(ds[m].values, values), m)
-                    self.assertEqual(ds[m].attrs["units"], unit)
+                    self.assertEqual(ds[m].attrs["unit"], unit)
                 # selecting by coordinate value: the grid cell of the first run of the block
                 first = ds.isel({n: 0 for n in names})
                 self.assertTrue(bitwise_equal(np.asarray(first[list(metrics)[0]].values),
@@ -84,7 +85,7 @@ class Xarray(StudyFileTest):
             deg = r.to_xarray("local", degrees=True)
         axes, metrics = stored(self.h5, "local")
         self.assertEqual(list(ds.dims), [a[0] for a in axes])
-        self.assertEqual(list(ds["method"].values), ["local_weighted", "local_unweighted"])
+        self.assertEqual(list(ds["method_"].values), ["local_weighted", "local_unweighted"])
         self.assertEqual(ds["alpha1A"].attrs["units"], "rad")
         self.assertEqual(deg["alpha1A"].attrs["units"], "deg")
         self.assertTrue(np.allclose(deg["alpha1A"].values, [-20, -10, 0, 10, 20], rtol=0, atol=1e-12))
@@ -92,7 +93,8 @@ class Xarray(StudyFileTest):
         self.assertTrue(bitwise_equal(ds["E"].values, metrics["E"][1]))
         self.assertEqual(ds.attrs["kind"], "trajectory")
         # one cell by its coordinates: method by name, alpha1A and k by value
-        cell = ds["E"].sel({"method": "local_unweighted", "k": 0.1}).isel(alpha1A=2)  # `method` is also a keyword of sel()
+        # (the axis `method` is the dimension `method_`: sel's own keyword is `method`)
+        cell = ds["E"].sel(method_="local_unweighted", k=0.1).isel(alpha1A=2)
         i = ["local_weighted", "local_unweighted"].index("local_unweighted")
         self.assertTrue(bitwise_equal(np.asarray(cell.values), np.asarray(metrics["E"][1][i, 2, 1])))
 
