@@ -15,6 +15,8 @@
 #include "common/shell_word.hpp"
 #include "store/store.hpp"
 
+#include "git_commit.hpp"  // KINESWEEP_GIT_COMMIT, generated at build time (engine/package/git_commit.cmake)
+
 int main(int argc, char** argv) {
   // A sweep's histories travel as buffers of a few hundred KiB, made by the workers and freed by
   // the writer thread. glibc's defaults return memory to the kernel once 128 KiB lie free at the
@@ -24,7 +26,9 @@ int main(int argc, char** argv) {
   mallopt(M_TRIM_THRESHOLD, 64 << 20);
   mallopt(M_MMAP_THRESHOLD, 16 << 20);
   CLI::App app{"kinesweep: parameter-sweep studies of redundant manipulators"};
-  app.set_version_flag("--version", std::string("kinesweep ") + KINESWEEP_VERSION);
+  const std::string commit = KINESWEEP_GIT_COMMIT;
+  app.set_version_flag("--version", std::string("kinesweep ") + KINESWEEP_VERSION + (commit.empty() ? "" : " (" + commit + ")"));
+  ks::store::set_engine_commit(commit);
   app.require_subcommand(1);
   ks::cli::RunArgs& run = ks::cli::add_run_command(app);
   run.program = ks::command_name(argc > 0 ? argv[0] : "");

@@ -55,6 +55,7 @@ install(CODE "
 ")
 install(FILES ${PROJECT_SOURCE_DIR}/analysis/README.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/kinesweep RENAME analysis.md)
 install(FILES ${PROJECT_SOURCE_DIR}/engine/store/FORMAT.md ${PROJECT_SOURCE_DIR}/README.md
+              ${PROJECT_SOURCE_DIR}/engine/package/LICENSE ${PROJECT_SOURCE_DIR}/engine/package/CITATION.cff
         DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/kinesweep)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/studies/ DESTINATION ${CMAKE_INSTALL_DATADIR}/kinesweep/studies)
 

@@ -428,6 +428,11 @@ void replace_results_file(const std::string& from, const std::string& path, cons
 /// Delete a closed results file and its journal (a staged file given up). Errors are ignored.
 void remove_results_file(const std::string& path);
 
+/// The git commit of the program that writes results files, recorded in every new file's root
+/// attribute `engine_commit` (the kinesweep executable sets it once at startup, from its build;
+/// not set: the attribute is not written).
+void set_engine_commit(std::string commit);
+
 /// Name of run `run_id`'s group under /histories in format 2 files ("000123"; wider when n_runs needs it).
 std::string history_group_name(std::int64_t run_id, std::int64_t n_runs);
 

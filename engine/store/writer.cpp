@@ -453,6 +453,7 @@ void ResultsWriter::close() {
     return;
   }
   m.trim_histories();
+  write_str_attr(m.file, "closed", now_iso8601());  // the end of the (last) session that wrote it
   m.do_flush();
   m.runs_chunks.clear();
   m.col_dsets.clear();

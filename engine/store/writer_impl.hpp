@@ -130,6 +130,10 @@ std::unique_ptr<ResultsWriter::Impl> open_writer_impl(const std::string& path, c
 /// Writes a new results file's skeleton into the open `file`: root attributes, /study, the /runs
 /// columns (n_runs rows, every row missing), /kinds, /designs, /histories, /landscapes
 /// (writer_skeleton.cpp).
+/// The commit set_engine_commit recorded ("" when none).
+std::string& engine_commit();
+/// The time now, ISO 8601 UTC ("2026-12-05T02:30:00Z").
+std::string now_iso8601();
 void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta, const std::vector<ColumnSpec>& columns,
                     std::int64_t n_runs);
 }  // namespace detail

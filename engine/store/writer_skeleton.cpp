@@ -13,7 +13,10 @@
 
 namespace ks::store::detail {
 
-namespace {
+std::string& engine_commit() {
+  static std::string commit;
+  return commit;
+}
 
 std::string now_iso8601() {
   std::time_t t = std::time(nullptr);
@@ -23,6 +26,8 @@ std::string now_iso8601() {
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return buf;
 }
+
+namespace {
 
 hid_t file_type_of(CellType t) {
   switch (t) {
@@ -39,6 +44,7 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
   write_str_attr(file, "format", kFormatName);
   write_i64_attr(file, "format_version", kFormatVersion);
   write_str_attr(file, "engine_version", meta.engine_version);
+  if (!engine_commit().empty()) write_str_attr(file, "engine_commit", engine_commit());
   write_str_attr(file, "study_sha256", meta.study_sha256);
   write_str_attr(file, "created", meta.created.empty() ? now_iso8601() : meta.created);
   write_str_attr(file, "study_name", meta.study_name);
@@ -144,3 +150,7 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
 }
 
 }  // namespace ks::store::detail
+
+namespace ks::store {
+void set_engine_commit(std::string commit) { detail::engine_commit() = std::move(commit); }
+}  // namespace ks::store

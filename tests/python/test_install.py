@@ -91,6 +91,7 @@ class Install(unittest.TestCase):
                     "share/man/man1/kinesweep.1", "share/bash-completion/completions/kinesweep",
                     "share/kinesweep/studies/thesis_table4.toml", "share/kinesweep/studies/robots/arm7.urdf",
                     "share/doc/kinesweep/analysis.md", "share/doc/kinesweep/FORMAT.md", "share/doc/kinesweep/README.md",
+                    "share/doc/kinesweep/LICENSE", "share/doc/kinesweep/CITATION.cff",
                     os.path.join(python_dir(), "kinesweep", "__init__.py"),
                     os.path.join(python_dir(), "kinesweep", "plot_landscape.py")]:
             self.assertTrue(os.path.exists(os.path.join(PREFIX, rel)), rel)
