@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <optional>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
@@ -62,7 +63,7 @@ std::vector<std::string> find_shards(const std::string& output) {
 /// order; then landscapes via run_sweep (which computes nothing, every run being done); then the
 /// shards are deleted. Returns the report and the final file, still open.
 SweepResult merge(const Study& study, const StudySchema& schema, const RunRequest& run, const HistoryPolicy& histories,
-                  int threads) {
+                  int threads, const SweepReport* ranks) {
   const std::string& out = run.output;
   const std::uint64_t total = study.run_count();
   // Commits are the store's main cost (each journals every dirty page of /runs); the merge can be
@@ -133,12 +134,22 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
   o.threads = threads;
   o.histories = histories;
   o.compression = level;
+  bool all_copied = true;
   if (copied && fresh)
     o.fill_landscape = [&](std::size_t b, std::size_t landscape) {
-      return writer->copy_landscape(landscape, sources, owner.data() + study.first_run(b));
+      const bool ok = writer->copy_landscape(landscape, sources, owner.data() + study.first_run(b));
+      all_copied = all_copied && ok;
+      return ok;
     };
+  // The ranks' reports cover every run when none was done before this job: then the summary needs
+  // no /runs column of the merged file (run_sweep reads none when every landscape was copied).
+  o.report_previous = !(ranks && copied && fresh);
   SweepResult res;
   res.report = run_sweep(study, schema, *writer, o, &all);
+  if (!o.report_previous && all_copied) {
+    res.report.blocks = ranks->blocks;
+    res.report.seed_rows = ranks->seed_rows;
+  }
   readers.clear();
   writer->flush();
   for (const auto& s : shards) store::remove_results_file(s);
@@ -361,12 +372,33 @@ SweepResult MpiBackend::sweep(const Study& study, const StudySchema& schema, con
     res.report.seed_rows.clear();
     return res;
   }
+  // Every rank's report of the runs it computed, to rank 0: all the job's runs when none was done
+  // before it (each report a few kilobytes).
+  std::optional<SweepReport> ranks;
+  if (todo_n == total) {
+    const std::string mine = encode_report(res.report);
+    int n = static_cast<int>(mine.size());
+    std::vector<int> sizes(static_cast<std::size_t>(size_)), at(static_cast<std::size_t>(size_));
+    MPI_Gather(&n, 1, MPI_INT, sizes.data(), 1, MPI_INT, 0, comm_);
+    std::string all;
+    if (rank_ == 0) {
+      for (int k = 0, t = 0; k < size_; t += sizes[static_cast<std::size_t>(k)], ++k) at[static_cast<std::size_t>(k)] = t;
+      all.resize(static_cast<std::size_t>(at.back() + sizes.back()));
+    }
+    MPI_Gatherv(mine.data(), n, MPI_CHAR, all.data(), sizes.data(), at.data(), MPI_CHAR, 0, comm_);
+    if (rank_ == 0) {
+      ranks = decode_report(all.substr(0, static_cast<std::size_t>(sizes[0])));
+      for (int k = 1; k < size_; ++k)
+        merge_reports(*ranks, decode_report(all.substr(static_cast<std::size_t>(at[static_cast<std::size_t>(k)]),
+                                                       static_cast<std::size_t>(sizes[static_cast<std::size_t>(k)]))));
+    }
+  }
   if (rank_ != 0) return res;
   if (r.options.on_progress && !r.quiet) r.options.on_progress({todo_n, todo_n, sweep_s});
   // 4. Rank 0 merges (the others wait in finish()).
   const auto t0 = Clock::now();
   try {
-    res = merge(study, schema, r, histories_, threads_);
+    res = merge(study, schema, r, histories_, threads_, ranks ? &*ranks : nullptr);
   } catch (const store::StoreError& e) {
     throw store::StoreError(r.output, std::string(e.what()) + " (the shards are kept: run again with --resume)");
   }

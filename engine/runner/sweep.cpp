@@ -201,11 +201,20 @@ class Accumulator {
   }
 
   SweepReport finish() {
-    for (auto& [id, s] : seed_) report_.seed_rows.push_back(s);
+    for (auto& [id, s] : seed_) {
+      report_.seed_rows.push_back(s);
+      report_.seed_rows.back().run_id = id;
+    }
     return std::move(report_);
   }
 
   SweepReport& report() { return report_; }
+  /// True when fill_landscape set the cells of every landscape (none left to grid from rows).
+  bool all_filled() const {
+    for (std::size_t b = 0; b < grids_.size(); ++b)
+      if (grids_[b].enabled() && !filled_[b]) return false;
+    return true;
+  }
 
  private:
   bool is_seed_preset(const std::string& preset) const {
@@ -229,7 +238,7 @@ class Accumulator {
     if (keys.size() == 3 && !(k < keys.back())) return;
     const auto at = std::upper_bound(keys.begin(), keys.end(), k) - keys.begin();
     keys.insert(keys.begin() + at, k);
-    br.best.insert(br.best.begin() + at, BestRun{k.run, k.objective, label(row, b)});
+    br.best.insert(br.best.begin() + at, BestRun{k.run, k.objective, k.tie, label(row, b)});
     if (keys.size() > 3) keys.pop_back(), br.best.pop_back();
   }
   /// The swept parameters of the run, in file units (angles in degrees).
@@ -312,7 +321,11 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
                         std::all_of(previous->done.begin(), previous->done.begin() + static_cast<std::ptrdiff_t>(total),
                                     [](bool d) { return d; });
   Accumulator acc(study, schema, writer, options.fill_landscape, options.landscapes, all_done);
-  const std::uint64_t skipped = previous ? add_previous(study, *previous, writer, acc) : 0;
+  const std::uint64_t skipped =
+      !previous ? 0
+      : options.report_previous || !acc.all_filled()
+          ? add_previous(study, *previous, writer, acc)
+          : static_cast<std::uint64_t>(std::count(previous->done.begin(), previous->done.end(), true));
   const int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
   const int stride = options.histories.mode == HistoryPolicy::Mode::none ? 0
                      : options.histories.mode == HistoryPolicy::Mode::every ? options.histories.stride

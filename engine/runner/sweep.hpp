@@ -49,6 +49,10 @@ struct SweepOptions {
   std::function<bool(std::size_t block, std::size_t landscape)> fill_landscape;
   /// Write the blocks' landscapes (false: none; a dry run's sample sweep, whose file is thrown away).
   bool landscapes = true;
+  /// Count the runs done before the sweep (run_sweep's `previous`) in its report (false: the report
+  /// covers the runs computed now only, and when fill_landscape sets every landscape's cells the
+  /// previous runs' rows are not read at all: a distributed merge whose ranks' reports cover them).
+  bool report_previous = true;
   /// Called by the writer for each run it writes, in run order: the run's block, the time the run
   /// took to execute and encode its history [s], and its encoded history [bytes] (a dry run's
   /// statistics). Empty: nothing.
@@ -59,6 +63,7 @@ struct SweepOptions {
 struct BestRun {
   std::uint64_t run_id = 0;
   double value = 0.0;    ///< the kind's ranking objective (ranking(kind): E, iterations)
+  double tie = 0.0;      ///< its tie metric (ranking(kind).tie; 0 when the kind has none)
   std::string label;     ///< "method=..., alpha1A=..., k=..." or "method=..., lambda=..."
 };
 
@@ -72,6 +77,7 @@ struct BlockReport {
 
 /// A run whose preset names a row of seed 000's Table 4 (for the thesis-vs-kinesweep table).
 struct SeedRow {
+  std::uint64_t run_id = 0;
   std::string preset, inertia, status;
   double E = 0, tau[3] = {0, 0, 0};
 };
@@ -99,6 +105,14 @@ PreviousRuns previous_runs(const store::ResultsWriter& writer);
 SweepReport run_sweep(const Study& study, const StudySchema& schema, store::ResultsWriter& writer,
                       const SweepOptions& options, const PreviousRuns* previous = nullptr);
 
+/// Adds `part`, the report of other runs of the same study (another rank's), to `into`: status counts
+/// summed, the best runs per block by the ranking rule (objective, tie, run id; up to 3), seed rows
+/// in run-id order (up to 1000), written counts summed.
+void merge_reports(SweepReport& into, const SweepReport& part);
+/// A report as bytes and back (to send it between processes); decode_report throws
+/// std::runtime_error on bytes encode_report did not make.
+std::string encode_report(const SweepReport& report);
+SweepReport decode_report(const std::string& bytes);
 /// Print the summary (runs by status, best rows per block, the thesis comparison when present).
 void print_report(std::ostream& os, const Study& study, const SweepReport& report);
 

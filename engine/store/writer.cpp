@@ -202,6 +202,7 @@ std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, co
   impl->done.assign(static_cast<std::size_t>(n_runs), false);
   impl->open_objects();
   impl->count_chunk_done();
+  impl->touched = true;
   return std::unique_ptr<ResultsWriter>(new ResultsWriter(std::move(impl)));
 }
 
@@ -245,6 +246,7 @@ void ResultsWriter::write_run(std::int64_t run_id, const Record& record, const E
   QuietHdf5 quiet;
   Impl& m = *impl_;
   m.usable();
+  m.touched = true;
   if (run_id < 0 || run_id >= m.n_runs)
     throw StoreError(m.path, "run id " + std::to_string(run_id) + " outside 0.." + std::to_string(m.n_runs - 1));
   if (record.cells.size() != m.columns.size())
@@ -453,7 +455,7 @@ void ResultsWriter::close() {
     return;
   }
   m.trim_histories();
-  write_str_attr(m.file, "closed", now_iso8601());  // the end of the (last) session that wrote it
+  if (m.touched) write_str_attr(m.file, "closed", now_iso8601());  // the end of the last session that wrote it
   m.do_flush();
   m.runs_chunks.clear();
   m.col_dsets.clear();

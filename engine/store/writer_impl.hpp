@@ -85,6 +85,7 @@ struct ResultsWriter::Impl {
   static constexpr std::size_t kMaxUncommittedBytes = std::size_t{4} << 20;
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false, broken = false;
+  bool touched = false;  ///< this writer created the file or wrote into it (close() then records when)
 
   /// Marks the writer broken and throws StoreError: the file keeps its last commit (the journal
   /// driver commits nothing more: abandon_journal_file; close() leaves the file as that commit left it).

@@ -118,6 +118,7 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
   QuietHdf5 quiet;
   Impl& m = *impl_;
   m.usable();
+  m.touched = true;
   validate_name(m.path, spec.block, "landscape block");
   std::vector<hsize_t> dims;
   std::set<std::string> names;

@@ -230,8 +230,14 @@ def check_column_layout(runs, n):
             check(set(d[()].tolist()) <= set(range(len(labels))) | {255}, f"/runs/{name} codes {set(d[()].tolist())}")
         else:
             check(h5py.check_enum_dtype(d.dtype) is None, f"/runs/{name} is not an enum")
-            for a in ("flag_values", "flag_meanings", "_FillValue"):
+            for a in ("flag_values", "flag_meanings"):
                 check(a not in d.attrs, f"/runs/{name} has no {a} attribute")
+            if d.dtype.kind == "i":  # integers: -1 is the missing value, and CF readers learn it here
+                fill = d.attrs.get("_FillValue")
+                check(fill is not None and int(np.asarray(fill).ravel()[0]) == -1 and int(d.fillvalue) == -1,
+                      f"/runs/{name} _FillValue {fill!r}")
+            else:
+                check("_FillValue" not in d.attrs, f"/runs/{name} has no _FillValue attribute")
         if kind == "O":
             info = h5py.check_string_dtype(d.dtype)
             check(info is not None and info.length is None and info.encoding == "utf-8",

@@ -88,14 +88,15 @@ def history(f, run_id):
     return {name: a for name, a, _unit in Histories(f).read(run_id)}
 
 
-def same_histories(test, fa, fb):
+def same_histories(test, fa, fb, unit=lambda u: u):
     """Assert that two open results files hold the same histories, bit for bit (NaN payloads included):
-    the same runs, each with the same arrays in the same order."""
+    the same runs, each with the same arrays in the same order, of the same units (as `unit` reads
+    them)."""
     ha, hb = Histories(fa), Histories(fb)
     test.assertEqual(ha.ids().tolist(), hb.ids().tolist())
     for i in ha.ids():
         a, b = ha.read(i), hb.read(i)
-        test.assertEqual([(n, u) for n, _, u in a], [(n, u) for n, _, u in b], f"run {i}")
+        test.assertEqual([(n, unit(u)) for n, _, u in a], [(n, unit(u)) for n, _, u in b], f"run {i}")
         for (name, x, _), (_, y, _) in zip(a, b):
             test.assertTrue(bitwise_equal(x, y), f"run {i} {name}")
 

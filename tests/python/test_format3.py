@@ -9,6 +9,7 @@ regression manifest pins): only wall_time, the file name and the creation stamp 
 usage: /usr/bin/python3 test_format3.py KINESWEEP_BINARY FORMAT3_DIR (tests/format3)
 """
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -33,11 +34,24 @@ def ks(*args):
     return r.stdout
 
 
+# Unit labels the engine has made precise since the format 3 fixture was written (the SCARA's IK
+# residual and error in mm, its third joint's iterate in mm, instead of "problem units" and "rad or
+# mm"): read alike on both sides, so that every other difference still shows.
+REFINED_UNITS = {"problem units": "mm", "rad or mm": "mm"}
+
+
+def as_now(text):
+    for old, new in REFINED_UNITS.items():
+        text = text.replace(old, new)
+    return text
+
+
 def comparable(text, path):
     """A command's output without what names the file, its source or its creation (the file, study and
-    engine lines of info)."""
+    engine lines of info), unit labels as REFINED_UNITS reads them."""
     out = []
-    for line in text.replace(path, "FILE").splitlines():
+    for line in as_now(text.replace(path, "FILE")).splitlines():
+        line = re.sub(r"-{2,}", "--", re.sub(r" +", " ", line))  # (a column's width follows its unit label's)
         if line.startswith(("file ", "engine ", "study ")):
             continue
         out.append(line)
@@ -99,7 +113,7 @@ class Format3(unittest.TestCase):
                 if c == "wall_time":
                     continue
                 self.assertTrue(bitwise_equal(np.asarray(t3[c]), np.asarray(t4[c])), c)
-                self.assertEqual(t3.units[c], t4.units[c], c)
+                self.assertEqual(as_now(t3.units[c]), as_now(t4.units[c]), c)
             d3, d4 = r3.to_pandas(), r4.to_pandas()
             self.assertEqual(list(d3.columns), list(d4.columns))
             for c in d3.columns:
@@ -152,7 +166,7 @@ class Format3(unittest.TestCase):
                 if c == "wall_time":
                     continue
                 self.assertTrue(bitwise_equal(runs_column(fr["runs"][c]), runs_column(f4["runs"][c])), c)
-            same_histories(self, fr, f4)
+            same_histories(self, fr, f4, unit=as_now)
 
 
 if __name__ == "__main__":
