@@ -71,4 +71,19 @@ store::LandscapeSpec test_landscape() {
   return s;
 }
 
+std::vector<ColumnSpec> copy_columns() {
+  return {{"x", CellType::f64, "m", "a smooth value", Role::metric, ""},
+          {"n", CellType::i64, "", "an integer", Role::metric, ""},
+          {"word", CellType::str, "", "one of three words or none", Role::parameter, "", {"alpha", "beta", "delta"}}};
+}
+
+Record copy_record(std::int64_t id) {
+  static const char* words[] = {"alpha", "beta", "delta", ""};
+  Record r;
+  r.cells.emplace_back(std::sin(0.001 * static_cast<double>(id)) + 1e-3 * static_cast<double>(id % 97));
+  r.cells.emplace_back(id % 11 == 0 ? std::int64_t{-1} : id * 3);
+  r.cells.emplace_back(std::string(words[id % 4]));
+  return r;
+}
+
 }  // namespace ks::store_test

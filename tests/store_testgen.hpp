@@ -18,6 +18,10 @@ Record test_record(std::int64_t id);
 RunHistory test_history(std::int64_t id);
 store::StoreMeta test_meta();
 store::LandscapeSpec test_landscape();
+/// Three columns (a smooth f64 "x", an i64 "n" with missing values, a labelled "word") and run id's
+/// row of them: the column tests' and the merge tests' content.
+std::vector<ColumnSpec> copy_columns();
+Record copy_record(std::int64_t id);
 
 /// A fresh directory under /tmp, removed with its contents at scope exit.
 struct TempDir {

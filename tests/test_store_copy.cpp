@@ -21,21 +21,6 @@ using namespace ks;
 using namespace ks::store;
 using namespace ks::store_test;
 
-std::vector<ColumnSpec> copy_columns() {
-  return {{"x", CellType::f64, "m", "a smooth value", Role::metric, ""},
-          {"n", CellType::i64, "", "an integer", Role::metric, ""},
-          {"word", CellType::str, "", "one of three words or none", Role::parameter, "", {"alpha", "beta", "delta"}}};
-}
-
-Record copy_record(std::int64_t id) {
-  static const char* words[] = {"alpha", "beta", "delta", ""};
-  Record r;
-  r.cells.emplace_back(std::sin(0.001 * static_cast<double>(id)) + 1e-3 * static_cast<double>(id % 97));
-  r.cells.emplace_back(id % 11 == 0 ? std::int64_t{-1} : id * 3);
-  r.cells.emplace_back(std::string(words[id % 4]));
-  return r;
-}
-
 bool has_run_history(std::int64_t id) { return id % 5000 == 7; }
 
 /// The stored bytes of the chunk holding row `row` of /runs/<name> (HDF5's direct chunk read).

@@ -21,21 +21,6 @@ using namespace ks;
 using namespace ks::store;
 using namespace ks::store_test;
 
-std::vector<ColumnSpec> scan_columns() {
-  return {{"x", CellType::f64, "m", "a smooth value", Role::metric, ""},
-          {"n", CellType::i64, "", "an integer", Role::metric, ""},
-          {"word", CellType::str, "", "one of three words or none", Role::parameter, "", {"alpha", "beta", "delta"}}};
-}
-
-Record scan_record(std::int64_t id) {
-  static const char* words[] = {"alpha", "beta", "delta", ""};
-  Record r;
-  r.cells.emplace_back(std::sin(0.001 * static_cast<double>(id)) + 1e-3 * static_cast<double>(id % 97));
-  r.cells.emplace_back(id % 11 == 0 ? std::int64_t{-1} : id * 3);
-  r.cells.emplace_back(std::string(words[id % 4]));
-  return r;
-}
-
 /// /runs/<name> read whole by HDF5 (its filter pipeline), as `mtype`, elements of `size` bytes.
 std::vector<unsigned char> hdf5_read(const std::string& path, const std::string& name, hid_t mtype, std::size_t size,
                                      hsize_t n) {
@@ -53,12 +38,12 @@ TEST(StoreScan, ColumnReadsEqualHdf5sOwnReadOfEveryKindOfChunk) {
   const std::int64_t C = static_cast<std::int64_t>(kRunsChunkRows), n = 5 * C + 123;
   const std::string path = td.file("scan.h5");
   {
-    auto w = ResultsWriter::create(path, test_meta(), scan_columns(), n);
+    auto w = ResultsWriter::create(path, test_meta(), copy_columns(), n);
     // chunks 0 and 1 whole (compressed), chunk 2 half (committed stored), chunk 4 a few rows, the
     // rest never written
-    for (std::int64_t id = 0; id < 2 * C + C / 2; ++id) w->write_run(id, scan_record(id));
+    for (std::int64_t id = 0; id < 2 * C + C / 2; ++id) w->write_run(id, copy_record(id));
     w->flush();
-    for (std::int64_t id = 4 * C + 5; id < 4 * C + 40; ++id) w->write_run(id, scan_record(id));
+    for (std::int64_t id = 4 * C + 5; id < 4 * C + 40; ++id) w->write_run(id, copy_record(id));
     w->close();
   }
   const ResultsReader r(path);
@@ -81,7 +66,7 @@ TEST(StoreScan, ColumnReadsEqualHdf5sOwnReadOfEveryKindOfChunk) {
   // and the values are the runs' own where they were written
   const std::vector<Record> rows = r.read_rows(0, n);
   for (std::int64_t id : {std::int64_t{0}, C + 17, 2 * C + C / 2 - 1, 4 * C + 39})
-    EXPECT_EQ(rows[static_cast<std::size_t>(id)].cells, scan_record(id).cells) << id;
+    EXPECT_EQ(rows[static_cast<std::size_t>(id)].cells, copy_record(id).cells) << id;
 }
 
 /// A 40 x 3000 grid with metrics "u" and "v".
@@ -105,7 +90,7 @@ TEST(StoreScan, DenseLandscapeCopiedFromItsOwnersByOffset) {
   for (std::size_t c = 0; c < cells; ++c) owner[c] = static_cast<std::int32_t>((c / 70001 + c / 999) % 2);
   auto value = [](std::size_t c, std::size_t m, int s) { return 10.0 * s + m + 1e-4 * static_cast<double>(c); };
   for (int s = 0; s < 2; ++s) {
-    auto w = ResultsWriter::create(td.file("src" + std::to_string(s) + ".h5"), test_meta(), scan_columns(), 4);
+    auto w = ResultsWriter::create(td.file("src" + std::to_string(s) + ".h5"), test_meta(), copy_columns(), 4);
     const std::size_t h = w->begin_landscape(dense_grid(false));
     for (std::size_t c = 0; c < cells; ++c)
       if (owner[c] == s) {
@@ -114,7 +99,7 @@ TEST(StoreScan, DenseLandscapeCopiedFromItsOwnersByOffset) {
       }
     w->close();
   }
-  auto w = ResultsWriter::create(td.file("dst.h5"), test_meta(), scan_columns(), 4);
+  auto w = ResultsWriter::create(td.file("dst.h5"), test_meta(), copy_columns(), 4);
   const std::size_t h = w->begin_landscape(dense_grid(true));
   ResultsReader r0(td.file("src0.h5")), r1(td.file("src1.h5"));
   ASSERT_TRUE(w->copy_landscape(h, {&r0, &r1}, owner.data()));
@@ -128,8 +113,8 @@ TEST(StoreScan, DenseLandscapeCopiedFromItsOwnersByOffset) {
 TEST(StoreScan, ACommitWithCellsOfADenseLandscapeUnwrittenFails) {
   TempDir td;
   const std::string path = td.file("dense.h5");
-  auto w = ResultsWriter::create(path, test_meta(), scan_columns(), 4);
-  w->write_run(0, scan_record(0));
+  auto w = ResultsWriter::create(path, test_meta(), copy_columns(), 4);
+  w->write_run(0, copy_record(0));
   w->flush();
   const std::size_t h = w->begin_landscape(dense_grid(true));
   const double v[2] = {1.0, 2.0};

@@ -73,6 +73,15 @@ def axis_dataset_name(axis):
     return axis + "_" if axis in ("method", "tolerance", "drop", "indexers") else axis
 
 
+def same(a, b):
+    """Equal shapes and values, NaN equal to NaN, numbers compared as float when either side is one
+    (xarray's decoded values against h5py's)."""
+    a, b = np.asarray(a), np.asarray(b)
+    if a.dtype.kind in "fc" or b.dtype.kind in "fc":
+        return a.shape == b.shape and np.array_equal(a.astype(float), b.astype(float), equal_nan=True)
+    return a.shape == b.shape and np.array_equal(a, b)
+
+
 def bitwise_equal(x, y):
     """Arrays equal bit for bit (NaN payloads included)."""
     if x.shape != y.shape:

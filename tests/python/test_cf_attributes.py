@@ -19,7 +19,7 @@ import numpy as np
 import pint
 import xarray as xr
 
-from e2e_common import shipped_results
+from e2e_common import same, shipped_results
 
 RESULTS = None
 UDUNITS2 = shutil.which("udunits2")
@@ -62,13 +62,6 @@ def groups_of(path):
         out = ["/"]
         f.visititems(lambda n, o: out.append("/" + n) if isinstance(o, h5py.Group) else None)
     return out
-
-
-def same(a, b):
-    a, b = np.asarray(a), np.asarray(b)
-    if a.dtype.kind in "fc" or b.dtype.kind in "fc":
-        return a.shape == b.shape and np.array_equal(a.astype(float), b.astype(float), equal_nan=True)
-    return a.shape == b.shape and np.array_equal(a, b)
 
 
 class CfAttributes(unittest.TestCase):

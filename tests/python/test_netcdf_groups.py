@@ -16,16 +16,9 @@ import h5py
 import numpy as np
 import xarray as xr
 
-from e2e_common import axis_dataset_name, runs_column, shipped_results
+from e2e_common import axis_dataset_name, runs_column, same, shipped_results
 
 RESULTS = None
-
-
-def same(a, b):
-    a, b = np.asarray(a), np.asarray(b)
-    if a.dtype.kind in "fc" or b.dtype.kind in "fc":
-        return a.shape == b.shape and np.array_equal(a.astype(float), b.astype(float), equal_nan=True)
-    return a.shape == b.shape and np.array_equal(a, b)
 
 
 class NetcdfGroups(unittest.TestCase):
