@@ -1,7 +1,8 @@
 #pragma once
 // Where a study's runs are computed and stored (internal to engine/runner): this process's threads
-// into the results file, or MPI ranks into shards merged by rank 0. run_study drives either through
-// the same steps: open, sweep, then (leader only) optimisations and report, then finish.
+// into the results file, MPI ranks into shards merged by rank 0, or (runner/dry_run.hpp) sample runs
+// into a temporary file for the dry run's estimates. run_study drives each through the same steps:
+// open, sweep, then (leader only) optimisations and report, then finish.
 #include <memory>
 #include <optional>
 #include <ostream>
