@@ -11,7 +11,7 @@
 #include "methods/chain_start.hpp"
 #include "methods/global_spline.hpp"
 #include "methods/path_global.hpp"
-#include "methods/path_global_chain.hpp"
+#include "methods/path_global_planar.hpp"
 
 using namespace ks;
 
@@ -35,8 +35,8 @@ TEST(PathGlobalChain, CoordinatesOfAConfigurationGiveItBack) {
     for (Extension ext : {Extension::self_motion, Extension::alpha}) {
       double z[kMaxJoints];
       Elbow elbow;
-      ChainGlobalProblem(chain, task, Extension::alpha, Elbow::positive).coordinates_of(0, q, z, elbow);
-      const ChainGlobalProblem problem(chain, task, ext, elbow);
+      PlanarChartProblem(chain, task, Extension::alpha, Elbow::positive).coordinates_of(0, q, z, elbow);
+      const PlanarChartProblem problem(chain, task, ext, elbow);
       problem.coordinates_of(0, q, z, elbow);
       double zz[kMaxJoints][3] = {};
       for (int k = 0; k < problem.coordinates(); ++k) zz[k][0] = z[k];
@@ -57,7 +57,7 @@ TEST(PathGlobalChain, SeedArmAsAChainMatchesTheClosedForm) {
   const SampledPath path(seed_square(), 1e-3);
   const ChainTask task(TaskSpace::planar_position, seed_square(), 1e-3);
   const PathGlobalProblem closed(arm, path, Elbow::positive, 1e-9, Extension::self_motion);
-  const ChainGlobalProblem generic(chain, task, Extension::self_motion, Elbow::positive);
+  const PlanarChartProblem generic(chain, task, Extension::self_motion, Elbow::positive);
   const AlphaBasis b = cubic_spline_basis(path, 12);
   std::vector<double> c(12);
   for (int k = 0; k < 12; ++k) c[k] = closed.coordinate(0, -20.0 * std::numbers::pi / 180.0, Elbow::positive) + 0.2 * std::sin(k);
@@ -73,8 +73,8 @@ TEST(PathGlobalChain, GradientMatchesFiniteDifferences) {
   const VecN q = start_of(chain, -20.0 * std::numbers::pi / 180.0);
   double z[kMaxJoints];
   Elbow elbow;
-  ChainGlobalProblem(chain, task, Extension::alpha, Elbow::positive).coordinates_of(0, q, z, elbow);
-  const ChainGlobalProblem problem(chain, task, Extension::self_motion, elbow);
+  PlanarChartProblem(chain, task, Extension::alpha, Elbow::positive).coordinates_of(0, q, z, elbow);
+  const PlanarChartProblem problem(chain, task, Extension::self_motion, elbow);
   problem.coordinates_of(0, q, z, elbow);
   const AlphaBasis b = cubic_spline_basis(task.path.size(), task.path.dt(), 2.0, 6);
   std::vector<double> c(12);

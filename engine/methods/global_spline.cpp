@@ -157,6 +157,9 @@ TrajectoryMetrics solve_global_spline(const PlanarArm3& arm, const SampledPath& 
   if (o.method != TrajectoryMethod::global_spline) throw std::invalid_argument("global_spline: another method");
   if (path.dt() != o.dt) throw std::invalid_argument("global_spline: path sampled at another dt");
   const PathGlobalOptions& g = o.global;
+  if (g.spline == AlphaSpline::cubic && g.extension == Extension::joints)
+    throw std::invalid_argument("global_spline: the seed's closed-form arm takes the self_motion or alpha extension "
+                                "(joints: the arm as a chain robot)");
   const AlphaBasis basis =
       g.spline == AlphaSpline::cubic ? cubic_spline_basis(path, static_cast<int>(g.knots), g.end == EndState::rest)
                                       : vertex_quintic_basis(path);

@@ -1,13 +1,18 @@
 // solve_global_spline_chain (methods/path_global_chain.hpp): the start from the chain's local run,
-// the SLSQP solve over every coordinate's spline, and the final measure.
+// the extension, the SLSQP solve over every coordinate's spline with the robot's limits as
+// constraints, and the final measure.
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <stdexcept>
 
 #include "methods/global_solve.hpp"
-#include "methods/path_global_chain.hpp"
+#include "methods/path_global_joints.hpp"
+#include "methods/path_global_planar.hpp"
+#include "model/planar_chain_dynamics.hpp"
 
 namespace ks {
 
@@ -18,6 +23,12 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
   const PathGlobalOptions& g = o.global;
   if (g.spline != AlphaSpline::cubic || g.start == GlobalStart::vertex)
     throw std::invalid_argument("global_spline on a chain: cubic splines from a local or random start only");
+  const bool chart = g.extension != Extension::joints;
+  if (chart && !(planar_revolute(chain) && task.space == TaskSpace::planar_position))
+    throw std::invalid_argument("global_spline: the " + std::string(to_string(g.extension)) +
+                                " extension needs a planar chain of revolute joints on a position path (else: joints)");
+  if (task.space != TaskSpace::planar_position && task.space != TaskSpace::spatial_position)
+    throw std::invalid_argument("global_spline on a chain: a position path");
   const int n = chain.dof();
   // the start: the chain's local run (its first sample is the start solve's configuration), each
   // coordinate along it unwrapped and fitted by the spline
@@ -33,13 +44,20 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
   const TrajectoryMetrics local = local_run(g.start_method);
   if (local.status == RunStatus::unreachable_start || h.size == 0) return not_simulated(RunStatus::unreachable_start, n);
   const VecN q_start = h.q.col(0);
-  Elbow elbow = Elbow::positive;
-  {
+  std::unique_ptr<ChainGlobalProblem> extension;
+  double solved_code = 0.0;
+  if (chart) {
+    Elbow elbow = Elbow::positive;
     double z[kMaxJoints];
-    ChainGlobalProblem probe(chain, task, Extension::alpha, Elbow::positive);
-    probe.coordinates_of(0, q_start, z, elbow);  // the last three joints' branch at the start
+    PlanarChartProblem(chain, task, Extension::alpha, Elbow::positive).coordinates_of(0, q_start, z, elbow);
+    extension = std::make_unique<PlanarChartProblem>(chain, task, g.extension, elbow);  // the start's branch
+  } else {
+    const int m = position_rows(task.space);
+    extension = std::make_unique<JointExtensionProblem>(
+        chain, task, JointExtensionProblem::choose_solved(chain, m, h.q, h.size), q_start);
+    for (int j : static_cast<const JointExtensionProblem&>(*extension).solved_joints()) solved_code = 10 * solved_code + j + 1;
   }
-  const ChainGlobalProblem problem(chain, task, g.extension, elbow);
+  const ChainGlobalProblem& problem = *extension;
   const AlphaBasis basis = cubic_spline_basis(task.path.size(), task.path.dt(), task.path.path().duration(),
                                               static_cast<int>(g.knots), g.end == EndState::rest);
   const int K = basis.coefficients, r = problem.coordinates();
@@ -101,18 +119,52 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
     return full.data();
   };
   const double start_f = problem.objective(basis, c.data(), g.objective, nullptr);
+  // the robot's limits, one constraint per window of samples (as many windows as knots) and limited quantity
+  const LimitConstraints limits = LimitConstraints::of(chain, problem.samples(), static_cast<int>(g.knots));
+  const unsigned rows = limits.count();
+  // one pass gives the objective, the constraints and both gradients: NLopt asks for them in turn at each point
+  std::vector<double> cached_x, con(rows), jac(static_cast<std::size_t>(rows) * c.size());
+  double cached_f = 0.0;
+  bool constrained = false;
+  const auto evaluate = [&](const double* xs) {
+    if (!cached_x.empty() && std::equal(cached_x.begin(), cached_x.end(), xs)) return;
+    cached_f = problem.objective(basis, at(xs), g.objective, grad.data(), constrained ? &limits : nullptr, con.data(),
+                                 jac.data());
+    cached_x.assign(xs, xs + free.size());
+  };
   SlsqpSpec spec;
   spec.bound = bound;
   spec.tolerance = g.tolerance;
   spec.max_evaluations = g.max_evaluations;
-  spec.f = [&](const double* xs, double* gx) {
+  spec.f = [&](const double* xs, double* gx) {  // (NLopt's count, as max_evaluations counts)
     ++evaluations;
-    const double f = problem.objective(basis, at(xs), g.objective, gx ? grad.data() : nullptr);
+    evaluate(xs);
     if (gx)
       for (std::size_t m = 0; m < free.size(); ++m) gx[m] = grad[free[m]];
-    return f;
+    return cached_f;
   };
-  const RunStatus outcome = minimise_slsqp(spec, x);
+  spec.con = [&](const double* xs, double* cs, double* jx) {
+    evaluate(xs);
+    std::copy(con.begin(), con.end(), cs);
+    if (jx)
+      for (unsigned row = 0; row < rows; ++row)
+        for (std::size_t m = 0; m < free.size(); ++m) jx[row * free.size() + m] = jac[row * c.size() + free[m]];
+  };
+  // without the limits first; when the optimum leaves them, again from the start with the limits as
+  // constraints (SLSQP from a point beyond them may not get back within them)
+  const std::vector<double> x_start = x;
+  RunStatus outcome = minimise_slsqp(spec, x);
+  if (rows > 0 && evaluations < g.max_evaluations) {
+    problem.objective(basis, at(x.data()), g.objective, nullptr, &limits, con.data(), nullptr);
+    if (std::ranges::any_of(con, [](double v) { return !(v <= 0.0); })) {
+      constrained = true;
+      cached_x.clear();
+      spec.constraints = rows;
+      spec.max_evaluations = g.max_evaluations - evaluations;
+      x = x_start;
+      outcome = minimise_slsqp(spec, x);
+    }
+  }
   const std::vector<double> best(at(x.data()), at(x.data()) + c.size());
   if (coefficients) *coefficients = best;
   TrajectoryMetrics m = problem.measure(basis, best.data(), q_start, o, history);
@@ -124,6 +176,11 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
     if (!at_lower && !at_upper) norm = std::max(norm, std::abs(grad[idx]));
   }
   m.opt_gradient_norm = norm;
+  m.opt_solved_joints = chart ? std::numeric_limits<double>::quiet_NaN() : solved_code;
+  if (rows > 0) {
+    problem.objective(basis, best.data(), g.objective, nullptr, &limits, con.data(), nullptr);
+    m.opt_active_limits = static_cast<double>(std::ranges::count_if(con, [](double v) { return v > -1e-4; }));
+  }
   m.opt_start_objective = start_f;
   m.opt_evaluations = static_cast<double>(evaluations);
   return m;

@@ -34,7 +34,8 @@ constexpr NameTable<GlobalStart, 3> kStarts{
     {{GlobalStart::local, "local"}, {GlobalStart::vertex, "vertex"}, {GlobalStart::random, "random"}}};
 constexpr NameTable<StartMethod, 2> kStartMethods{
     {{StartMethod::local_unweighted, "local_unweighted"}, {StartMethod::local_weighted, "local_weighted"}}};
-constexpr NameTable<Extension, 2> kExtensions{{{Extension::alpha, "alpha"}, {Extension::self_motion, "self_motion"}}};
+constexpr NameTable<Extension, 3> kExtensions{
+    {{Extension::alpha, "alpha"}, {Extension::self_motion, "self_motion"}, {Extension::joints, "joints"}}};
 constexpr NameTable<EndState, 2> kEnds{{{EndState::rest, "rest"}, {EndState::free, "free"}}};
 constexpr NameTable<StartPosture, 2> kPostures{{{StartPosture::fixed, "fixed"}, {StartPosture::free, "free"}}};
 constexpr NameTable<OnViolation, 3> kOnViolation{

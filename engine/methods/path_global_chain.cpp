@@ -1,151 +1,61 @@
-// ChainGlobalProblem (methods/path_global_chain.hpp): the canonical map of a planar revolute chain,
-// the joint path from the coordinates, the objective with its chain-rule gradient, the metrics.
+// ChainGlobalProblem (methods/path_global_chain.hpp): the objective with its chain-rule gradient, the
+// limit constraints with theirs, and the run's metrics, for any extension.
 #include "methods/path_global_chain.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
-
-#include "methods/path_global.hpp"
-#include "methods/sample_sums.hpp"
-#include "model/planar_chain_dynamics.hpp"
 
 namespace ks {
 namespace {
 
-using V2 = Eigen::Vector2d;
 constexpr double kViolationWeight = 1e6;
 constexpr double kInfeasibleFloor = 1e4;  // per unit of 1 / samples, in the objective's units
-constexpr double kClamp = 1.0 - 1e-12;
+constexpr double kSingularDet = 1e-12;    // an extension this close to singular costs the floor too
 
-V2 dir(double a) { return {std::cos(a), std::sin(a)}; }
-V2 perp(const V2& v) { return {-v.y(), v.x()}; }  // turned by +90 degrees
 double wrap(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
-V2 turned(const V2& v, double a) {  // v rotated by a
-  const double c = std::cos(a), s = std::sin(a);
-  return {c * v.x() - s * v.y(), s * v.x() + c * v.y()};
-}
 
 }  // namespace
 
-ChainGlobalProblem::ChainGlobalProblem(const Chain& chain, const ChainTask& task, Extension extension, Elbow elbow)
-    : chain_(chain), task_(task), extension_(extension), elbow_(elbow), n_(chain.dof()), a_(chain.dof() - 3) {
-  if (!planar_revolute(chain) || n_ < 3 || task.space != TaskSpace::planar_position)
-    throw std::invalid_argument("global_spline: a planar chain of 3 or more revolute joints on a position path");
-  for (int i = 0; i < n_; ++i) {
-    const ChainJoint& j = chain.joints[static_cast<std::size_t>(i)];
-    ox_[i] = j.origin.p.x();
-    oy_[i] = j.origin.p.y();
-    beta_[i] = std::atan2(j.origin.R(1, 0), j.origin.R(0, 0));
-    sigma_[i] = j.axis.z() > 0.0 ? 1.0 : -1.0;
+LimitConstraints LimitConstraints::of(const Chain& chain, std::size_t samples, int windows) {
+  LimitConstraints L;
+  L.table = LimitTable::of(chain);
+  for (int j = 0; j < chain.dof(); ++j) {
+    if (L.table.inv_half[j] > 0) L.rows.push_back({0, j});
+    if (L.table.inv_velocity[j] > 0) L.rows.push_back({1, j});
+    if (L.table.inv_effort[j] > 0) L.rows.push_back({2, j});
   }
-  const V2 o1(ox_[a_ + 1], oy_[a_ + 1]), o2(ox_[a_ + 2], oy_[a_ + 2]), t(chain.tip.p.x(), chain.tip.p.y());
-  L1_ = o1.norm(), L2_ = o2.norm(), L3_ = t.norm();
-  d1_ = std::atan2(o1.y(), o1.x()), d2_ = std::atan2(o2.y(), o2.x()), d3_ = std::atan2(t.y(), t.x());
-  tip_angle_ = std::atan2(chain.tip.R(1, 0), chain.tip.R(0, 0));
-  if (!(L1_ > 0 && L2_ > 0 && L3_ > 0))
-    throw std::invalid_argument("global_spline: the last three joints need links of positive length");
-  const SampledPath3& path = task.path;
-  velocity_.reserve(path.size());
-  for (std::size_t i = 0; i < path.size(); ++i) velocity_.push_back(path.path().sample_on(path.segment(i), path.time(i)).v.head<2>());
+  if (L.rows.empty() || samples == 0) return L;
+  const std::size_t w = std::clamp<std::size_t>(static_cast<std::size_t>(std::max(windows, 1)), 1, samples);
+  for (std::size_t k = 1; k <= w; ++k) L.window_end.push_back(samples * k / w);
+  return L;
 }
 
-void ChainGlobalProblem::sample(std::size_t i, const double (*z)[3], ChainGlobalSample& s) const {
-  const SampledPath3& path = task_.path;
-  s.q.resize(n_), s.qd.resize(n_), s.qdd.resize(n_), s.tau.resize(n_);
-  s.violation = 0.0;
-  // the first joints: their frames' angles and the base of the last three, P_a, with its derivatives
-  double phi = 0, phid = 0, phidd = 0;
-  V2 P(ox_[0], oy_[0]), Pd(0, 0), Pdd(0, 0);
-  for (int k = 0; k < a_; ++k) {
-    s.q[k] = z[k][0], s.qd[k] = z[k][1], s.qdd[k] = z[k][2];
-    phi += beta_[k] + sigma_[k] * z[k][0];
-    phid += sigma_[k] * z[k][1];
-    phidd += sigma_[k] * z[k][2];
-    const V2 o = turned(V2(ox_[k + 1], oy_[k + 1]), phi);
-    P += o;
-    Pd += phid * perp(o);
-    Pdd += phidd * perp(o) - phid * phid * o;
-  }
-  const V2 d = path.position(i).head<2>() - P, dd = velocity_[i] - Pd, ddd = path.acceleration(i).head<2>() - Pdd;
-  // the last three joints' tip direction A (theta3) and branch
-  const double* x = z[n_ - 3];
-  double A, Ad, Add, beta = 0.0;
-  Elbow elbow = elbow_;
-  if (extension_ == Extension::self_motion) {
-    ChartSample c;
-    const double r = d.norm(), L = L1_ + L2_;
-    const double gamma = (r * r + L3_ * L3_ - L * L) / (2.0 * L3_ * r);
-    s.violation += std::max(0.0, std::abs(gamma) - 1.0) + std::max(0.0, std::abs(L1_ - L2_) - (r - L3_));
-    self_motion_chart(d, dd, ddd, L, L3_, c);
-    const double g = std::clamp(gamma, -kClamp, kClamp);
-    if (!(std::abs(gamma) < 1.0)) c.beta[0] = std::acos(g), c.beta[1] = c.beta[2] = 0.0;  // off the chart: held at its edge
-    const double sp = std::sin(x[0]), cp = std::cos(x[0]);
-    A = c.phi[0] + c.beta[0] * sp;
-    Ad = c.phi[1] + c.beta[1] * sp + c.beta[0] * cp * x[1];
-    Add = c.phi[2] + c.beta[2] * sp + 2.0 * c.beta[1] * cp * x[1] - c.beta[0] * sp * x[1] * x[1] + c.beta[0] * cp * x[2];
-    elbow = cp >= 0.0 ? Elbow::positive : Elbow::negative;
-    beta = c.beta[0];
-  } else {
-    A = x[0] - tip_angle_ + d3_, Ad = x[1], Add = x[2];
-  }
-  s.alpha = A - d3_ + tip_angle_;
-  // the wrist, then the 2R solve of the first two of the last three
-  const V2 eA = dir(A);
-  const V2 w = d - L3_ * eA, wd = dd - L3_ * Ad * perp(eA), wdd = ddd - L3_ * (Add * perp(eA) - Ad * Ad * eA);
-  const double cr_raw = (w.squaredNorm() - L1_ * L1_ - L2_ * L2_) / (2.0 * L1_ * L2_);
-  s.violation += std::max(0.0, std::abs(cr_raw) - 1.0);
-  const bool charted = extension_ == Extension::self_motion && s.violation == 0.0;
-  const double rho = charted ? self_motion_elbow(x[0], beta, d.norm(), L3_, L1_, L2_)
-                             : static_cast<int>(elbow) * std::acos(std::clamp(cr_raw, -kClamp, kClamp));
-  const double cr = std::cos(rho), sr = std::sin(rho);
-  const double t1 = std::atan2(w.y(), w.x()) - std::atan2(L2_ * sr, L1_ + L2_ * cr), t2 = t1 + rho;
-  Eigen::Matrix2d M2;
-  M2 << -L1_ * std::sin(t1), -L2_ * std::sin(t2), L1_ * std::cos(t1), L2_ * std::cos(t2);
-  s.det = M2.determinant();
-  const Eigen::PartialPivLU<Eigen::Matrix2d> lu(M2);
-  const V2 td = lu.solve(wd);
-  const V2 tdd = lu.solve(wdd + L1_ * td[0] * td[0] * dir(t1) + L2_ * td[1] * td[1] * dir(t2));
-  // back to the joints: phi_a = theta1 - delta1, phi_a+1 = theta2 - delta2, phi_a+2 = A - delta3
-  const int a = a_;
-  s.q[a] = wrap(sigma_[a] * (t1 - d1_ - phi - beta_[a]));
-  s.q[a + 1] = wrap(sigma_[a + 1] * (t2 - d2_ - (t1 - d1_) - beta_[a + 1]));
-  s.q[a + 2] = wrap(sigma_[a + 2] * (A - d3_ - (t2 - d2_) - beta_[a + 2]));
-  s.qd[a] = sigma_[a] * (td[0] - phid), s.qd[a + 1] = sigma_[a + 1] * (td[1] - td[0]), s.qd[a + 2] = sigma_[a + 2] * (Ad - td[1]);
-  s.qdd[a] = sigma_[a] * (tdd[0] - phidd), s.qdd[a + 1] = sigma_[a + 1] * (tdd[1] - tdd[0]);
-  s.qdd[a + 2] = sigma_[a + 2] * (Add - tdd[1]);
-  evaluate_dynamics(chain_, data_, s.q, s.qd, state_);
-  s.tau = state_.M * s.qdd + state_.c + state_.g;
+ChainGlobalProblem::ChainGlobalProblem(const Chain& chain, const ChainTask& task)
+    : chain_(chain), task_(task), n_(chain.dof()), rows_(position_rows(task.space)) {
+  if (task.space != TaskSpace::planar_position && task.space != TaskSpace::spatial_position)
+    throw std::invalid_argument("global_spline: a position path (planar_position or spatial_position)");
 }
 
-void ChainGlobalProblem::coordinates_of(std::size_t i, const VecN& q, double* z, Elbow& elbow) const {
-  double phi = 0;
-  V2 P(ox_[0], oy_[0]);
-  for (int k = 0; k < a_; ++k) {
-    z[k] = q[k];
-    phi += beta_[k] + sigma_[k] * q[k];
-    P += turned(V2(ox_[k + 1], oy_[k + 1]), phi);
+double ChainGlobalProblem::ratio(const LimitConstraints& limits, const std::array<int, 2>& row,
+                                 const ChainGlobalSample& s) const {
+  const LimitTable& L = limits.table;
+  const int j = row[1];
+  switch (row[0]) {
+    case 0: {
+      const double off = s.q[j] - L.mid[j];
+      return std::abs(wraps_angles() ? wrap(off) : off) * L.inv_half[j];
+    }
+    case 1: return std::abs(s.qd[j]) * L.inv_velocity[j];
+    default: return std::abs(s.tau[j]) * L.inv_effort[j];
   }
-  const double phia = phi + beta_[a_] + sigma_[a_] * q[a_], phib = phia + beta_[a_ + 1] + sigma_[a_ + 1] * q[a_ + 1];
-  const double phic = phib + beta_[a_ + 2] + sigma_[a_ + 2] * q[a_ + 2];
-  const double t1 = phia + d1_, t2 = phib + d2_, A = phic + d3_;
-  elbow = std::sin(t2 - t1) >= 0.0 ? Elbow::positive : Elbow::negative;
-  if (extension_ == Extension::alpha) {
-    z[n_ - 3] = A - d3_ + tip_angle_;
-    return;
-  }
-  const V2 d = task_.path.position(i).head<2>() - P;
-  const double r = d.norm(), L = L1_ + L2_;
-  const double gamma = std::clamp((r * r + L3_ * L3_ - L * L) / (2.0 * L3_ * r), -kClamp, kClamp);
-  const double s = std::clamp(wrap(A - std::atan2(d.y(), d.x())) / std::acos(gamma), -1.0, 1.0);
-  z[n_ - 3] = std::atan2(s, static_cast<int>(elbow) * std::sqrt(1.0 - s * s));
 }
 
-double ChainGlobalProblem::cost(std::size_t i, const double (*z)[3], GlobalObjective objective) const {
-  ChainGlobalSample s;
-  sample(i, z, s);
+double ChainGlobalProblem::cost(std::size_t i, const ChainGlobalSample& s, GlobalObjective objective) const {
   const std::size_t n = samples();
   const double trapezoid = (i == 0 || i + 1 == n) ? 0.5 * task_.path.dt() : task_.path.dt();
   // a sample off the chart or out of reach: its torques (at the clamped boundary, near singular) are
@@ -153,7 +63,7 @@ double ChainGlobalProblem::cost(std::size_t i, const double (*z)[3], GlobalObjec
   // keep the optimiser away
   if (s.violation > 0.0) return kInfeasibleFloor / static_cast<double>(n) + kViolationWeight * s.violation * s.violation;
   double f = 0.0;
-  if (extension_ == Extension::alpha && !(std::abs(s.det) >= 1e-12)) f += kInfeasibleFloor / static_cast<double>(n);
+  if (singular(s, kSingularDet)) f += kInfeasibleFloor / static_cast<double>(n);
   switch (objective) {
     case GlobalObjective::E: return f + s.tau.norm() / static_cast<double>(n);
     case GlobalObjective::E_M: return f + std::sqrt(s.tau.dot(state_.M.ldlt().solve(s.tau))) / static_cast<double>(n);
@@ -163,27 +73,72 @@ double ChainGlobalProblem::cost(std::size_t i, const double (*z)[3], GlobalObjec
   return f;
 }
 
-double ChainGlobalProblem::objective(const AlphaBasis& basis, const double* c, GlobalObjective objective,
-                                     double* grad) const {
-  const int K = basis.coefficients, r = coordinates();
+double ChainGlobalProblem::objective(const AlphaBasis& basis, const double* c, GlobalObjective objective, double* grad,
+                                     const LimitConstraints* limits, double* con, double* jac) const {
+  const int K = basis.coefficients, r = coordinates(), width = 3 * r;
+  const std::size_t P = limits ? limits->rows.size() : 0, rows = limits ? limits->count() : 0;
   if (grad) std::fill(grad, grad + static_cast<std::ptrdiff_t>(K) * r, 0.0);
+  // per constraint: the largest ratio so far, its sample and the ratio's partials there (z, zd, zdd of each coordinate)
+  std::vector<double> top(rows, -std::numeric_limits<double>::infinity()), partial;
+  std::vector<std::size_t> top_sample(rows, 0);
+  if (jac) partial.assign(rows * static_cast<std::size_t>(width), 0.0);
+  std::vector<std::size_t> raised;  // the constraints this sample raised
+  std::size_t window = 0;
   double f = 0.0, z[kMaxJoints][3];
+  ChainGlobalSample s, up, down;
+  begin_pass();
   for (std::size_t i = 0; i < samples(); ++i) {
     for (int k = 0; k < r; ++k) basis.at(i, c + k * K, z[k][0], z[k][1], z[k][2]);
-    f += cost(i, z, objective);
-    if (!grad) continue;
-    const BasisRow& row = basis.rows[i];
+    sample(i, z, s);
+    f += cost(i, s, objective);
+    accept(i, z, s);
+    raised.clear();
+    if (P > 0) {
+      while (limits->window_end[window] <= i) ++window;
+      for (std::size_t p = 0; p < P; ++p) {
+        const std::size_t row = window * P + p;
+        const double v = ratio(*limits, limits->rows[p], s);
+        if (v > top[row]) top[row] = v, top_sample[row] = i, raised.push_back(row);
+      }
+    }
+    if (!grad && !(jac && !raised.empty())) continue;
+    const BasisRow& brow = basis.rows[i];
     for (int k = 0; k < r; ++k)
       for (int d = 0; d < 3; ++d) {
         const double x = z[k][d], h = 1e-6 * std::max(1.0, std::abs(x));
         z[k][d] = x + h;
-        const double up = cost(i, z, objective);
+        sample(i, z, up);
+        const double f_up = grad ? cost(i, up, objective) : 0.0;
         z[k][d] = x - h;
-        const double down = cost(i, z, objective);
+        sample(i, z, down);
+        const double f_down = grad ? cost(i, down, objective) : 0.0;
         z[k][d] = x;
-        const double partial = (up - down) / (2.0 * h);
-        for (int m = 0; m < kBasisWidth && row.first + m < K; ++m) grad[k * K + row.first + m] += partial * row.w[d][m];
+        if (grad) {
+          const double dfdz = (f_up - f_down) / (2.0 * h);
+          for (int m = 0; m < kBasisWidth && brow.first + m < K; ++m) grad[k * K + brow.first + m] += dfdz * brow.w[d][m];
+        }
+        if (jac)
+          for (std::size_t row : raised) {
+            const auto& lim = limits->rows[row % P];
+            partial[row * width + static_cast<std::size_t>(3 * k + d)] =
+                (ratio(*limits, lim, up) - ratio(*limits, lim, down)) / (2.0 * h);
+          }
       }
+  }
+  if (con)
+    for (std::size_t row = 0; row < rows; ++row)  // (no finite ratio in a window: infeasible)
+      con[row] = std::isfinite(top[row]) ? top[row] - (1.0 - limits->margin) : 1.0;
+  if (jac) {
+    const std::size_t cols = static_cast<std::size_t>(K) * r;
+    std::fill(jac, jac + rows * cols, 0.0);
+    for (std::size_t row = 0; row < rows; ++row) {
+      const BasisRow& brow = basis.rows[top_sample[row]];
+      for (int k = 0; k < r; ++k)
+        for (int d = 0; d < 3; ++d)
+          for (int m = 0; m < kBasisWidth && brow.first + m < K; ++m)
+            jac[row * cols + static_cast<std::size_t>(k * K + brow.first + m)] +=
+                partial[row * width + static_cast<std::size_t>(3 * k + d)] * brow.w[d][m];
+    }
   }
   return f;
 }
@@ -191,10 +146,12 @@ double ChainGlobalProblem::objective(const AlphaBasis& basis, const double* c, G
 double ChainGlobalProblem::worst_violation(const AlphaBasis& basis, const double* c) const {
   const int K = basis.coefficients, r = coordinates();
   double worst = 0.0, z[kMaxJoints][3];
+  ChainGlobalSample s;
+  begin_pass();
   for (std::size_t i = 0; i < samples(); ++i) {
     for (int k = 0; k < r; ++k) basis.at(i, c + k * K, z[k][0], z[k][1], z[k][2]);
-    ChainGlobalSample s;
     sample(i, z, s);
+    accept(i, z, s);
     worst = std::max(worst, s.violation);
   }
   return worst;
@@ -204,23 +161,25 @@ TrajectoryMetrics ChainGlobalProblem::measure(const AlphaBasis& basis, const dou
                                               const TrajectoryOptions& o, ChainHistory* history) const {
   const std::size_t n = samples();
   const int K = basis.coefficients, r = coordinates();
-  if (history) history->prepare(n, n_, 2);
+  if (history) history->prepare(n, n_, rows_);
   const LimitTable limits = LimitTable::of(chain_);
   SampleSums<double, kMaxJoints> sums(o.tracking_bound, o.orientation_bound, &limits);
   VecN q_prev = q_start;
   RunStatus stop = RunStatus::ok;
   double z[kMaxJoints][3];
   const auto keep = [](double updated, double) { return updated; };
+  ChainGlobalSample s;
+  begin_pass();
   for (std::size_t i = 0; i < n; ++i) {
     for (int k = 0; k < r; ++k) basis.at(i, c + k * K, z[k][0], z[k][1], z[k][2]);
-    ChainGlobalSample s;
     sample(i, z, s);
+    accept(i, z, s);
     if (i == 0) sums.start_alpha(s.alpha);
     if (s.violation > 0.0 || !s.tau.allFinite()) {
       stop = s.violation > 0.0 ? RunStatus::infeasible : RunStatus::diverged;
       break;
     }
-    if (extension_ == Extension::alpha && !(std::abs(s.det) >= o.singular_tolerance)) {
+    if (singular(s, o.singular_tolerance)) {
       stop = RunStatus::singular_extension;
       break;
     }
@@ -232,11 +191,12 @@ TrajectoryMetrics ChainGlobalProblem::measure(const AlphaBasis& basis, const dou
       stop = RunStatus::diverged;
       break;
     }
+    const double w2 = std::max(0.0, rows_ == 2 ? (state_.J.topRows<2>() * state_.J.topRows<2>().transpose()).determinant()
+                                               : (state_.J.topRows<3>() * state_.J.topRows<3>().transpose()).determinant());
     forward_kinematics(chain_, data_, s.q);
-    const V2 tip = data_.tip.p.head<2>();
-    const double err2 = (tip - task_.path.position(i).head<2>()).squaredNorm();
-    const Eigen::Matrix<double, 2, Eigen::Dynamic, 0, 2, kMaxJoints> Jp = state_.J.topRows<2>();
-    const double w2 = std::max(0.0, (Jp * Jp.transpose()).determinant());
+    const Eigen::Vector3d tip = data_.tip.p;
+    const Eigen::Vector3d miss = tip - task_.path.position(i);
+    const double err2 = rows_ == 2 ? miss.head<2>().squaredNorm() : miss.squaredNorm();
     double p6 = 0;
     for (int j = 0; j < n_; ++j) p6 += (s.tau[j] * s.qd[j]) * (s.tau[j] * s.qd[j]);
     const double qf = s.tau.dot(state_.M.ldlt().solve(s.tau));
@@ -252,8 +212,7 @@ TrajectoryMetrics ChainGlobalProblem::measure(const AlphaBasis& basis, const dou
       history->qd.col(col) = s.qd;
       history->qdd.col(col) = s.qdd;
       history->tau.col(col) = s.tau;
-      history->x(0, col) = tip.x();
-      history->x(1, col) = tip.y();
+      for (int a = 0; a < rows_; ++a) history->x(a, col) = tip[a];
       history->alpha[col] = s.alpha;
     }
     if ((off || beyond) && o.on_violation == OnViolation::stop) break;

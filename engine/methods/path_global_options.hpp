@@ -24,12 +24,15 @@ enum class AlphaSpline {
   vertex_quintic,  ///< alpha at the path's vertices, a quintic per segment (seed cases 3-5's family)
 };
 
-/// The redundant coordinate the spline describes (cubic splines; vertex_quintic is always alpha).
+/// The redundant coordinates the splines describe (cubic splines; vertex_quintic is always alpha). The
+/// seed's arm and planar revolute chains take any; other chains joints.
 enum class Extension {
   alpha,        ///< the tip angle alpha on the start's elbow branch; singular where theta2 = 0 (stretched)
   self_motion,  ///< the angle psi along the arm's self-motion circle at the tip: alpha = phi + beta sin psi,
                 ///< elbow branch = sign(cos psi) (phi: the tip's direction, beta: half the reachable alpha
                 ///< arc), so a path may cross elbow branches through the stretched arm
+  joints,       ///< r of the robot's joint angles; the other m (as many as the task has rows) are solved on
+                ///< the tip position by Newton's method, singular where their task Jacobian is (any chain)
 };
 
 /// Where the optimiser starts.

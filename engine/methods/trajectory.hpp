@@ -145,6 +145,12 @@ struct TrajectoryMetrics {
   double opt_objective = std::numeric_limits<double>::quiet_NaN();
   double opt_evaluations = std::numeric_limits<double>::quiet_NaN();
   double opt_gradient_norm = std::numeric_limits<double>::quiet_NaN();
+  /// The joints the joints extension solved on the task, 1-based, as decimal digits (124: joints 1, 2
+  /// and 4); NaN for the planar charts.
+  double opt_solved_joints = std::numeric_limits<double>::quiet_NaN();
+  /// Limit constraints (window x limited quantity) active at the optimum (ratio within 1e-4 of its
+  /// bound); 0 when the robot has limits and none binds, NaN when it has none.
+  double opt_active_limits = std::numeric_limits<double>::quiet_NaN();
   /// the metrics of methods/sample_metrics.hpp's table, in its order (NaN: no sample, or not a metric)
   std::array<double, kMaxSampleMetrics> sampled = nan_array();
 

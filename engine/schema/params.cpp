@@ -134,6 +134,7 @@ RunSpec default_run(BlockKind kind, const KindContext& c) {
   r.options.dt = c.dt;
   r.options.vertex_alpha.assign(c.path_vertices >= 1 ? c.path_vertices - 1 : 0, 0.0);
   r.inertia = c.inertia;
+  if (c.robot.chain && !c.robot.planar) r.options.global.extension = Extension::joints;  // no planar chart
   return r;
 }
 

@@ -33,6 +33,8 @@ struct RobotShape {
   bool is_prismatic(int j) const { return j < static_cast<int>(prismatic.size()) && prismatic[j]; }
   /// vertex_alpha (the seed's non-redundant baseline) is defined: a planar 3-joint arm, position path.
   bool vertex_alpha() const { return planar && joints == 3 && !pose_task; }
+  /// global_spline is defined (a position path: the seed's arm, planar or spatial chains).
+  bool path_global() const { return !pose_task; }
 };
 
 /// What a block's tables depend on: its path and the study-wide defaults of [task] and [robot].

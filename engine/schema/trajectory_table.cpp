@@ -15,13 +15,13 @@ using Run = TrajectoryRun;
 namespace {
 // global_spline starts from a local run (k, K_N) or a vertex_alpha one (vertex_alpha_i)
 const EffectRule kLocalOnly{"method", {"local_weighted", "local_unweighted", "global_spline"}};
-const EffectRule kLocalSpring{"method", {"local_weighted", "local_unweighted"}};
+const EffectRule kLocalSpring{"method", {"local_weighted", "local_unweighted", "global_spline"}};
 const EffectRule kVertexOnly{"method", {"vertex_alpha"}};
 const EffectRule kVertexAngles{"method", {"vertex_alpha", "global_spline"}};
 const EffectRule kGlobalOnly{"method", {"global_spline"}};
 
 /// global_spline's own parameters (methods/path_global_options.hpp).
-void global_params(std::vector<ParamDef>& t) {
+void global_params(std::vector<ParamDef>& t, const RobotShape& robot) {
   t.push_back(named<Run>("spline", names_of<AlphaSpline>(AlphaSpline::cubic, AlphaSpline::vertex_quintic),
                          "global_spline: alpha(t) as a clamped cubic B-spline (knots) or a quintic per path "
                          "segment through vertex values (seed cases 3-5's family)",
@@ -29,9 +29,17 @@ void global_params(std::vector<ParamDef>& t) {
   t.push_back(integer<Run>("knots", "", PathGlobalOptions::knots_rule,
                            "global_spline, cubic: breakpoints evenly spaced in time (= coefficients)",
                            [](auto& r) -> auto& { return r.options.global.knots; }, kGlobalOnly));
-  t.push_back(named<Run>("extension", names_of<Extension>(Extension::self_motion, Extension::alpha),
-                         "global_spline, cubic: the coordinate the spline describes: the angle along the arm's "
-                         "self-motion circle (crosses elbow branches) or the tip angle alpha (one elbow branch)",
+  // the planar chart (self_motion, alpha) is defined for the seed's arm and planar revolute chains;
+  // joint coordinates for every chain
+  const bool chart = robot.planar && !robot.pose_task;
+  std::vector<std::string> extensions =
+      !robot.chain ? names_of<Extension>(Extension::self_motion, Extension::alpha)
+      : chart      ? names_of<Extension>(Extension::self_motion, Extension::alpha, Extension::joints)
+                   : names_of<Extension>(Extension::joints);
+  t.push_back(named<Run>("extension", std::move(extensions),
+                         "global_spline, cubic: the coordinates the splines describe: the angle along the arm's "
+                         "self-motion circle (crosses elbow branches), the tip angle alpha (one elbow branch), or "
+                         "joint angles, the other joints solved on the task (joints; any chain)",
                          [](auto& r) -> auto& { return r.options.global.extension; }, kGlobalOnly));
   t.push_back(named<Run>("global_objective",
                          names_of<GlobalObjective>(GlobalObjective::E, GlobalObjective::E_M,
@@ -90,7 +98,7 @@ ParamDef preset_param() {
 std::vector<ParamDef> trajectory_params(const KindContext& ctx) {
   std::vector<ParamDef> t;
   t.push_back(preset_param());
-  // (global_spline: planar arms of revolute joints on a position path; other robots are refused at the key)
+  // (global_spline: revolute chains on a position path; other robots are refused at the key)
   t.push_back(named<Run>("method",
                          names_of<TrajectoryMethod>(TrajectoryMethod::local_weighted, TrajectoryMethod::local_unweighted,
                                                     TrajectoryMethod::vertex_alpha, TrajectoryMethod::global_spline),
@@ -114,7 +122,7 @@ std::vector<ParamDef> trajectory_params(const KindContext& ctx) {
                           "orientation at vertex " + std::to_string(v) + " (vertex_alpha; global_spline: its vertex start)",
                           [i](auto& r) -> auto& { return r.options.vertex_alpha[i]; }, kVertexAngles));
   }
-  if (ctx.path_global && robot.planar && !robot.pose_task) global_params(t);
+  if (ctx.path_global && robot.path_global()) global_params(t, robot);
   t.push_back(named<Run>("integrator", names_of<Integrator>(Integrator::semi_implicit_euler, Integrator::rk4),
                          "time integrator", [](auto& r) -> auto& { return r.options.integrator; }));
   t.push_back(real<Run>("dt", FileUnit::none, "s", TrajectoryOptions::dt_rule, "sample / integration step",
@@ -227,7 +235,7 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
                           e.gridded, [k](const M& r) { return r.sampled[k]; })
                     .labelled(std::string(e.label)));
   });
-  if (ctx.path_global && robot.planar && !robot.pose_task) {
+  if (ctx.path_global && robot.path_global()) {
     m.push_back(metric<M>("opt_start_objective", CellType::f64, "",
                           "global_spline: the objective at the optimiser's start (units of global_objective)", false,
                           [](const M& r) { return r.opt_start_objective; }));
@@ -240,6 +248,16 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
                           "global_spline: infinity norm of the projected gradient at the optimum (objective units "
                           "per rad)",
                           false, [](const M& r) { return r.opt_gradient_norm; }));
+    if (robot.chain)
+      m.push_back(metric<M>("opt_solved_joints", CellType::f64, "",
+                            "global_spline, joints extension: the joints solved on the task, 1-based, as digits "
+                            "(124: joints 1, 2 and 4; NaN: the planar chart)",
+                            false, [](const M& r) { return r.opt_solved_joints; }));
+    if (robot.chain && robot.limited)
+      m.push_back(metric<M>("opt_active_limits", CellType::f64, "",
+                            "global_spline: limit constraints (window of samples x limited quantity) active at the "
+                            "optimum (ratio within 1e-4 of the bound)",
+                            false, [](const M& r) { return r.opt_active_limits; }));
   }
   if (robot.chain) {
     m.push_back(metric<M>("max_q_limit_ratio", CellType::f64, "",

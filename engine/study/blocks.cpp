@@ -308,11 +308,11 @@ void Parser::check_robot_supports(const BlockDraft& d, const Study& s) {
                      "); expected a robot with more joints than task equations, or a position task");
     return;
   }
-  // global_spline on a chain: planar, revolute joints, a position path; cubic splines from a local
-  // or random start (the vertex family and start are the seed's 3R's)
+  // global_spline on a chain: revolute joints, a position path; cubic splines from a local or random
+  // start (the vertex family and start are the seed's 3R's)
   bool prismatic = false;
   for (int j = 0; j < r.joints; ++j) prismatic = prismatic || r.is_prismatic(j);
-  const char* global_why = !r.planar ? "a spatial robot" : r.pose_task ? "an orientation path" : prismatic ? "prismatic joints" : nullptr;
+  const char* global_why = r.pose_task || s.task.hold_orientation ? "an orientation path" : prismatic ? "prismatic joints" : nullptr;
   const auto refuse_global = [&](const std::string& key, const std::string& value, const std::string& why,
                                  const auto& at, bool axis) {
     error(at, key + " = \"" + value + "\" " + why + (axis ? " (the " + key + " axis includes it)" : "") + "; expected " +
@@ -320,7 +320,7 @@ void Parser::check_robot_supports(const BlockDraft& d, const Study& s) {
   };
   const auto check_global = [&](const std::string& key, const std::string& value, const auto& at, bool axis) {
     if (key == "method" && value == "global_spline" && global_why) {
-      refuse_global(key, value, std::string("is the path-global method of planar arms of revolute joints on a position path, not of ") + global_why, at, axis);
+      refuse_global(key, value, std::string("is the path-global method of arms of revolute joints on a position path, not of ") + global_why, at, axis);
       return true;
     }
     if ((key == "spline" && value == "vertex_quintic") || (key == "global_start" && value == "vertex")) {
