@@ -44,31 +44,34 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
   const TrajectoryMetrics local = local_run(g.start_method);
   if (local.status == RunStatus::unreachable_start || h.size == 0) return not_simulated(RunStatus::unreachable_start, n);
   const VecN q_start = h.q.col(0);
-  std::unique_ptr<ChainGlobalProblem> extension;
+  // the extension: the planar chart on the start's elbow branch, or joint coordinates with the solved
+  // joints chosen along the local run in h
   double solved_code = 0.0;
-  if (chart) {
-    Elbow elbow = Elbow::positive;
-    double z[kMaxJoints];
-    PlanarChartProblem(chain, task, Extension::alpha, Elbow::positive).coordinates_of(0, q_start, z, elbow);
-    extension = std::make_unique<PlanarChartProblem>(chain, task, g.extension, elbow);  // the start's branch
-  } else {
-    const int m = position_rows(task.space);
-    extension = std::make_unique<JointExtensionProblem>(
-        chain, task, JointExtensionProblem::choose_solved(chain, m, h.q, h.size), q_start);
-    for (int j : static_cast<const JointExtensionProblem&>(*extension).solved_joints()) solved_code = 10 * solved_code + j + 1;
-  }
-  const ChainGlobalProblem& problem = *extension;
+  const auto extension_of_run = [&]() -> std::unique_ptr<ChainGlobalProblem> {
+    if (chart) {
+      Elbow elbow = Elbow::positive;
+      double z[kMaxJoints];
+      PlanarChartProblem(chain, task, Extension::alpha, Elbow::positive).coordinates_of(0, q_start, z, elbow);
+      return std::make_unique<PlanarChartProblem>(chain, task, g.extension, elbow);
+    }
+    auto p = std::make_unique<JointExtensionProblem>(
+        chain, task, JointExtensionProblem::choose_solved(chain, position_rows(task.space), h.q, h.size), q_start);
+    solved_code = 0.0;
+    for (int j : p->solved_joints()) solved_code = 10 * solved_code + j + 1;
+    return p;
+  };
+  std::unique_ptr<ChainGlobalProblem> extension = extension_of_run();
   const AlphaBasis basis = cubic_spline_basis(task.path.size(), task.path.dt(), task.path.path().duration(),
                                               static_cast<int>(g.knots), g.end == EndState::rest);
-  const int K = basis.coefficients, r = problem.coordinates();
+  const int K = basis.coefficients, r = extension->coordinates();
   std::vector<double> first(r);
   const auto fitted = [&]() {  // the coefficients of the run in h
-    const std::size_t count = std::min<std::size_t>(static_cast<std::size_t>(h.size), problem.samples());
+    const std::size_t count = std::min<std::size_t>(static_cast<std::size_t>(h.size), extension->samples());
     std::vector<std::vector<double>> series(r, std::vector<double>(count));
     for (std::size_t i = 0; i < count; ++i) {
       double z[kMaxJoints];
       Elbow e;
-      problem.coordinates_of(i, h.q.col(static_cast<Eigen::Index>(i)), z, e);
+      extension->coordinates_of(i, h.q.col(static_cast<Eigen::Index>(i)), z, e);
       for (int k = 0; k < r; ++k)
         series[k][i] = i == 0 ? z[k] : series[k][i - 1] + std::remainder(z[k] - series[k][i - 1], 2.0 * std::numbers::pi);
     }
@@ -83,7 +86,7 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
   const auto usable = [&](const std::vector<double>& cs) {
     for (double v : cs)
       if (!std::isfinite(v)) return false;
-    return problem.worst_violation(basis, cs.data()) == 0.0;
+    return extension->worst_violation(basis, cs.data()) == 0.0;
   };
   std::vector<double> c = fitted();
   if (g.start == GlobalStart::random) {
@@ -92,15 +95,18 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
     for (int k = 0; k < r; ++k)
       for (int j = 0; j < K; ++j) c[k * K + j] = first[k] + u(rng);
   } else if (!usable(c)) {
-    // a local run far off its path can leave the chart once put on the path: the other local method's
-    // run, when it stays on it
+    // a local run far off its path can leave the chart (or the solved joints' reach) once put on the
+    // path: the other local method's run, when it stays on it
     const std::vector<double> keep = c, keep_first = first;
+    const double keep_code = solved_code;
     const StartMethod other = g.start_method == StartMethod::local_unweighted ? StartMethod::local_weighted
                                                                               : StartMethod::local_unweighted;
     local_run(other);
-    c = h.size > 0 ? fitted() : keep;
-    if (h.size == 0 || !usable(c)) c = keep, first = keep_first;
+    std::unique_ptr<ChainGlobalProblem> kept = std::move(extension);
+    if (h.size > 0) extension = extension_of_run(), c = fitted();
+    if (h.size == 0 || !usable(c)) extension = std::move(kept), c = keep, first = keep_first, solved_code = keep_code;
   }
+  const ChainGlobalProblem& problem = *extension;
   for (double v : c)  // a local run that diverged at both methods: nothing to start from
     if (!std::isfinite(v)) return not_simulated(RunStatus::infeasible, n);
   const bool fixed = g.posture == StartPosture::fixed;
