@@ -2,16 +2,20 @@
 // its rates and accelerations are its time derivatives (central differences in time); the objective's
 // gradient and the limit constraints' Jacobian match finite differences; the 7-DOF arm's global run
 // is on its path, within its limits and below its local run; a limit the unconstrained optimum
-// crosses is kept by the constrained one.
+// crosses is kept by the constrained one; the KKT residual is the non-negative least-squares optimum.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
+#include <random>
 #include <vector>
+
+#include <Eigen/QR>
 
 #include "methods/alpha_basis.hpp"
 #include "methods/chain_start.hpp"
 #include "methods/chain_trajectory.hpp"
+#include "methods/global_solve.hpp"
 #include "methods/path_global_joints.hpp"
 #include "robot/urdf.hpp"
 
@@ -201,4 +205,47 @@ TEST(PathGlobalJoints, ALimitTheUnconstrainedOptimumCrossesIsKept) {
   EXPECT_GE(kept.opt_active_limits, 1.0);
   std::printf("4R, |q%d| <= %.3f rad: constrained %.4f Nm (%g active), unconstrained %.4f Nm (|q| up to %.3f)\n", j + 1,
               limit, kept.E, kept.opt_active_limits, free.E, free_max);
+}
+
+// The KKT residual's non-negative least squares against an enumeration of the active sets: for every
+// subset of the constraints, the least-squares multipliers when they are all non-negative; the best
+// residual (2-norm) of those is the NNLS optimum.
+TEST(PathGlobalJoints, KktResidualIsTheNonNegativeLeastSquaresOptimum) {
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> u;
+  for (int trial = 0; trial < 200; ++trial) {
+    const int n = 6, m = 1 + trial % 4;
+    Eigen::MatrixXd J(m, n);
+    for (int a = 0; a < m; ++a)
+      for (int b = 0; b < n; ++b) J(a, b) = u(rng);
+    Eigen::VectorXd g(n);
+    for (int b = 0; b < n; ++b) g[b] = u(rng);
+    if (trial % 3 == 0) {  // a stationary point: g = -J^T lambda with lambda >= 0
+      Eigen::VectorXd lambda(m);
+      for (int a = 0; a < m; ++a) lambda[a] = std::abs(u(rng));
+      g = -J.transpose() * lambda;
+    }
+    double best2 = g.squaredNorm();
+    Eigen::VectorXd best_r = g;
+    for (unsigned mask = 1; mask < (1u << m); ++mask) {
+      std::vector<int> S;
+      for (int a = 0; a < m; ++a)
+        if (mask & (1u << a)) S.push_back(a);
+      Eigen::MatrixXd A(n, static_cast<Eigen::Index>(S.size()));
+      for (std::size_t k = 0; k < S.size(); ++k) A.col(static_cast<Eigen::Index>(k)) = -J.row(S[k]).transpose();
+      const Eigen::VectorXd l = A.colPivHouseholderQr().solve(g);
+      if ((l.array() < 0).any()) continue;
+      const Eigen::VectorXd r = g - A * l;
+      if (r.squaredNorm() < best2) best2 = r.squaredNorm(), best_r = r;
+    }
+    std::vector<double> gv(g.data(), g.data() + n), jv(static_cast<std::size_t>(m * n));
+    for (int a = 0; a < m; ++a)
+      for (int b = 0; b < n; ++b) jv[static_cast<std::size_t>(a * n + b)] = J(a, b);
+    const double kkt = kkt_residual(gv, jv, static_cast<std::size_t>(m));
+    EXPECT_NEAR(kkt, best_r.cwiseAbs().maxCoeff(), 1e-9) << "trial " << trial;
+    if (trial % 3 == 0) {
+      EXPECT_LT(kkt, 1e-9) << "trial " << trial;
+    }
+  }
+  EXPECT_EQ(kkt_residual({1.0, -3.0}, {}, 0), 3.0);  // no constraint: the gradient's norm
 }

@@ -1,9 +1,54 @@
 // minimise_slsqp (methods/global_solve.hpp).
 #include "methods/global_solve.hpp"
 
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
 #include <nlopt.hpp>
 
 namespace ks {
+
+double kkt_residual(const std::vector<double>& grad, const std::vector<double>& jac, std::size_t rows) {
+  const auto n = static_cast<Eigen::Index>(grad.size()), m = static_cast<Eigen::Index>(rows);
+  const Eigen::Map<const Eigen::VectorXd> g(grad.data(), n);
+  if (m == 0) return n ? g.cwiseAbs().maxCoeff() : 0.0;
+  // min ||A lambda - g|| over lambda >= 0 with A = -jac^T
+  const Eigen::MatrixXd A = -Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+                                 jac.data(), m, n).transpose();
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(m);
+  std::vector<bool> passive(static_cast<std::size_t>(m), false);
+  const double tiny = 1e-12 * std::max(1.0, g.cwiseAbs().maxCoeff()) * std::max(1.0, A.cwiseAbs().maxCoeff());
+  for (Eigen::Index outer = 0; outer < 3 * m + 10; ++outer) {
+    const Eigen::VectorXd w = A.transpose() * (g - A * lambda);
+    Eigen::Index t = -1;
+    double best = tiny;
+    for (Eigen::Index j = 0; j < m; ++j)
+      if (!passive[j] && w[j] > best) best = w[j], t = j;
+    if (t < 0) break;
+    passive[t] = true;
+    for (Eigen::Index inner = 0; inner < 3 * m + 10; ++inner) {
+      std::vector<Eigen::Index> P;
+      for (Eigen::Index j = 0; j < m; ++j)
+        if (passive[j]) P.push_back(j);
+      Eigen::MatrixXd AP(n, static_cast<Eigen::Index>(P.size()));
+      for (std::size_t k = 0; k < P.size(); ++k) AP.col(static_cast<Eigen::Index>(k)) = A.col(P[k]);
+      const Eigen::VectorXd zP = AP.colPivHouseholderQr().solve(g);
+      Eigen::VectorXd z = Eigen::VectorXd::Zero(m);
+      for (std::size_t k = 0; k < P.size(); ++k) z[P[k]] = zP[static_cast<Eigen::Index>(k)];
+      double step = 1.0;
+      for (Eigen::Index j : P)
+        if (z[j] <= 0.0) step = std::min(step, lambda[j] / (lambda[j] - z[j]));
+      if (step >= 1.0) {
+        lambda = z;
+        break;
+      }
+      lambda += step * (z - lambda);
+      for (Eigen::Index j : P)
+        if (lambda[j] <= tiny) passive[j] = false, lambda[j] = 0.0;
+    }
+  }
+  return (g - A * lambda).cwiseAbs().maxCoeff();
+}
 
 RunStatus minimise_slsqp(const SlsqpSpec& spec, std::vector<double>& x) {
   nlopt::opt opt(nlopt::LD_SLSQP, static_cast<unsigned>(x.size()));

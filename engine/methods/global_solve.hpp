@@ -21,6 +21,12 @@ struct SlsqpSpec {
   std::int64_t max_evaluations = 1;   ///< objective evaluations allowed
 };
 
+/// The KKT residual at a point with active inequality constraints: min over lambda >= 0 of the
+/// infinity norm of grad + jac^T lambda (non-negative least squares, Lawson and Hanson's active set
+/// method), per variable. \param[in] grad (n), jac (rows x n, row-major: the active constraints'
+/// gradients). Without rows: the infinity norm of grad.
+double kkt_residual(const std::vector<double>& grad, const std::vector<double>& jac, std::size_t rows);
+
 /// Minimise from x (updated in place to the last point SLSQP returns). Status: ok (a tolerance was
 /// met, or SLSQP stopped on roundoff: NLopt's "typically useful result"), max_evaluations, or
 /// not_converged (any other NLopt failure).

@@ -175,18 +175,27 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
   if (coefficients) *coefficients = best;
   TrajectoryMetrics m = problem.measure(basis, best.data(), q_start, o, history);
   if (m.status == RunStatus::ok) m.status = outcome;
-  m.opt_objective = problem.objective(basis, best.data(), g.objective, grad.data());
-  double norm = 0.0;
-  for (int idx : free) {
+  m.opt_objective =
+      problem.objective(basis, best.data(), g.objective, grad.data(), rows ? &limits : nullptr, con.data(), jac.data());
+  // stationarity: the gradient over the free coefficients not held by their box bound, with the limit
+  // constraints within 1e-4 of their bound as active ones (the KKT residual; without any, the
+  // projected gradient's norm)
+  std::vector<double> g_kept, jac_active;
+  std::vector<std::size_t> kept;
+  for (std::size_t v = 0; v < free.size(); ++v) {
+    const int idx = free[v];
     const bool at_lower = best[idx] <= -bound && grad[idx] > 0, at_upper = best[idx] >= bound && grad[idx] < 0;
-    if (!at_lower && !at_upper) norm = std::max(norm, std::abs(grad[idx]));
+    if (!at_lower && !at_upper) kept.push_back(v), g_kept.push_back(grad[idx]);
   }
-  m.opt_gradient_norm = norm;
+  std::size_t active = 0;
+  for (unsigned row = 0; row < rows; ++row)
+    if (con[row] > -1e-4) {
+      ++active;
+      for (std::size_t v : kept) jac_active.push_back(jac[row * c.size() + static_cast<std::size_t>(free[v])]);
+    }
+  m.opt_gradient_norm = kkt_residual(g_kept, jac_active, active);
   m.opt_solved_joints = chart ? std::numeric_limits<double>::quiet_NaN() : solved_code;
-  if (rows > 0) {
-    problem.objective(basis, best.data(), g.objective, nullptr, &limits, con.data(), nullptr);
-    m.opt_active_limits = static_cast<double>(std::ranges::count_if(con, [](double v) { return v > -1e-4; }));
-  }
+  if (rows > 0) m.opt_active_limits = static_cast<double>(active);
   m.opt_start_objective = start_f;
   m.opt_evaluations = static_cast<double>(evaluations);
   return m;

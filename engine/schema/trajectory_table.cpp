@@ -245,8 +245,9 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
     m.push_back(metric<M>("opt_evaluations", CellType::f64, "", "global_spline: objective evaluations made", true,
                           [](const M& r) { return r.opt_evaluations; }));
     m.push_back(metric<M>("opt_gradient_norm", CellType::f64, "",
-                          "global_spline: infinity norm of the projected gradient at the optimum (objective units "
-                          "per rad)",
+                          "global_spline: infinity norm of the projected gradient at the optimum, or with active "
+                          "limit constraints the KKT residual min over lambda >= 0 of |grad + J^T lambda| "
+                          "(objective units per rad)",
                           false, [](const M& r) { return r.opt_gradient_norm; }));
     if (robot.chain)
       m.push_back(metric<M>("opt_solved_joints", CellType::f64, "",

@@ -254,6 +254,14 @@ void ResultsWriter::write_landscape_range(std::size_t landscape, std::uint64_t f
   m.usable();
   const auto [stream, cells] = begun_stream(m, landscape, "write_landscape_range");
   Impl::LandscapeStream& s = *stream;
+  if (s.dims.empty() && first + count <= cells && values.size() == s.metrics.size()) {  // a block without axes: one cell
+    std::vector<double> cell(s.metrics.size());
+    for (std::uint64_t c = 0; c < count; ++c) {
+      for (std::size_t mt = 0; mt < values.size(); ++mt) cell[mt] = values[mt][c];
+      write_landscape_cell(landscape, first + c, cell.data());
+    }
+    return;
+  }
   if (first > cells || count > cells - first || values.size() != s.metrics.size() || s.dims.empty())
     throw StoreError(m.path, "landscape " + s.block + ": cells " + std::to_string(first) + " + " +
                                  std::to_string(count) + " of " + std::to_string(cells));

@@ -1,6 +1,8 @@
-"""The path-global method end to end: global_spline runs (the seed's 3R and a 4R chain) give the same
-file, bit for bit, on 1 and 2 threads, on 2 MPI ranks, and after a SIGKILL and `--resume`; every `ok`
-global run is on its path (tracking at rounding) and below the local runs of its file.
+"""The path-global method end to end: global_spline runs (the seed's 3R, a 4R chain and a 7-DOF arm)
+give the same file, bit for bit, on 1 and 2 threads, on 2 MPI ranks, and after a SIGKILL and
+`--resume`; every `ok` global run is on its path (tracking at rounding) and below the local runs of
+its file; an [[optimize]] block takes global_spline's start angle as its variable, and its best point
+run as a plain study gives its objective.
 
 usage: /usr/bin/python3 test_path_global.py KINESWEEP_BINARY
 """
@@ -77,6 +79,65 @@ alpha1A = 4
 knots = [5, 10]
 """
 
+# A 7-DOF arm (studies/robots/arm7.urdf) on the first side of arm7_square's square, sampled every
+# 10 ms: its local run and global ones with joint coordinates and the URDF's limits (about 2 s).
+ARM7 = """
+[study]
+name = "pg_arm7"
+histories = "every=20"
+
+[robot]
+urdf = "{urdf}"
+base = "base_link"
+tip = "tool"
+gravity = [0, 0, -9.81]
+
+[task]
+vertices = [[0.5, -0.1, 0.4], [0.5, 0.1, 0.4]]
+durations = [2]
+integrator = "rk4"
+dt = 0.01
+
+[[block]]
+name = "local"
+kind = "trajectory"
+method = "local_weighted"
+K_N = 20
+K_L = 8
+q0_3 = 60
+q0_4 = -90
+
+[[block]]
+name = "global"
+kind = "trajectory"
+method = "global_spline"
+start_method = "local_weighted"
+K_N = 20
+K_L = 8
+q0_3 = 60
+q0_4 = -90
+[block.axes]
+knots = [4, 6]
+""".format(urdf=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "studies", "robots", "arm7.urdf"))
+
+# [[optimize]] over an outer parameter of global_spline: the start angle alpha1A of the seed's arm.
+OPTIMIZE = """
+[study]
+name = "pg_optimize"
+histories = "none"
+
+[[optimize]]
+name = "start_angle"
+method = "global_spline"
+global_start = "vertex"
+vertex_alpha = [13.30, 17.28, -12.44, -16.12]
+knots = 5
+variables = { alpha1A = [-24, -12] }
+[optimize.local]
+algorithm = "LN_BOBYQA"
+max_evals = 8
+"""
+
 
 def run(*args):
     return subprocess.run([KS, *args], capture_output=True, text=True, timeout=600)
@@ -100,7 +161,7 @@ class PathGlobal(TempDirTest):
                 same_histories(self, fa, fb)
 
     def test_threads_and_ranks_give_the_same_file(self):
-        for text, name in ((SEED, "seed"), (CHAIN, "chain")):
+        for text, name in ((SEED, "seed"), (CHAIN, "chain"), (ARM7, "arm7")):
             _, one = self.run_study(text, name + "1", "--threads", "1")
             _, two = self.run_study(text, name + "2", "--threads", "2")
             self.assert_same(one, two)
@@ -136,8 +197,29 @@ class PathGlobal(TempDirTest):
         self.assertTrue(0 < now < total, m.group(0))  # killed in the middle, resumed from what it kept
         self.assert_same(whole, out)
 
+    def test_optimize_block_over_an_outer_parameter(self):
+        _, out = self.run_study(OPTIMIZE, "optimize")
+        with h5py.File(out, "r") as f:
+            g = f["optimizations/start_angle"]
+            obj = g["evaluations/objective"][()]
+            status = [s.decode() if isinstance(s, bytes) else s for s in g["evaluations/status"][()]]
+            best, best_x = float(g.attrs["best_objective"]), float(np.ravel(g.attrs["best_x"])[0])
+        self.assertGreaterEqual(len(obj), 3)
+        self.assertTrue(all(s == "ok" for s in status), status)
+        self.assertEqual(best, obj.min())
+        self.assertTrue(-24 * np.pi / 180 - 1e-12 <= best_x <= -12 * np.pi / 180 + 1e-12, best_x)
+        # the best point, run as a plain study, gives the optimiser's objective (E)
+        plain = OPTIMIZE.split("[[optimize]]")[0] + (
+            '[[block]]\nname = "best"\nkind = "trajectory"\nmethod = "global_spline"\nglobal_start = "vertex"\n'
+            "vertex_alpha = [13.30, 17.28, -12.44, -16.12]\nknots = 5\nalpha1A = %.17g\n" % np.degrees(best_x))
+        _, again = self.run_study(plain, "plain")
+        E = float(np.asarray(runs_table(again)["E"], float)[0])
+        # (alpha1A written in degrees is a rounding away from the optimiser's radians, and SLSQP's path
+        # from it ends within its own tolerance of the same optimum)
+        self.assertAlmostEqual(E / best, 1.0, delta=1e-6)
+
     def test_ok_global_runs_are_on_their_path_and_below_the_local_runs(self):
-        for text, name in ((SEED, "seed"), (CHAIN, "chain")):
+        for text, name in ((SEED, "seed"), (CHAIN, "chain"), (ARM7, "arm7")):
             _, out = self.run_study(text, name)
             t = runs_table(out)
             block, status = np.asarray(t["block"]), np.asarray(t["status"])
