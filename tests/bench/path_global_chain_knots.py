@@ -6,6 +6,7 @@ study files themselves. Prints a markdown table: E, evaluations and time per kno
 change between the two finest counts.
 
 usage: /usr/bin/python3 path_global_chain_knots.py KINESWEEP_BINARY STUDIES_DIR [--knots 5,10,20,40] [--threads N]
+       [--arms 4R,5R,7-DOF]
 """
 import argparse
 import os
@@ -19,15 +20,18 @@ ARMS = (("4R", "path_global_4r.toml"), ("5R", "path_global_5r.toml"), ("7-DOF", 
 
 
 def global_study(path, knots):
-    """The study file with its global block's knots (and end state) replaced by the knot sweep."""
+    """The study file's global block alone, each of its other axes at its first value, over the knot sweep."""
     text = open(path).read()
-    text = re.sub(r'urdf = "([^"]+)"', lambda m: 'urdf = "%s"' % os.path.abspath(os.path.join(os.path.dirname(path), m.group(1))), text)
-    head, glob = text.split('name = "global"')
-    glob = glob.split("[block.axes]")[0]
-    glob = re.sub(r"^zip = .*$", "", glob, flags=re.M)
-    head = head.rsplit("[[block]]", 1)[0]
-    blocks = head.split("[[block]]")
-    return blocks[0] + '[[block]]\nname = "global"' + glob + "[block.axes]\nknots = [%s]\n" % knots
+    text = re.sub(r'urdf = "([^"]+)"',
+                  lambda m: 'urdf = "%s"' % os.path.abspath(os.path.join(os.path.dirname(path), m.group(1))), text)
+    head, glob = text.split('name = "global"\n')
+    glob = glob.split("[[block]]")[0]
+    fixed, axes = (glob.split("[block.axes]") + [""])[:2]
+    fixed = re.sub(r"^zip = .*$", "", fixed, flags=re.M)
+    firsts = "".join("%s = %s\n" % (m.group(1), m.group(2).strip())
+                     for m in re.finditer(r"^(\w+) = \[([^,\]]+)", axes, flags=re.M) if m.group(1) != "knots")
+    study = head.split("[[block]]")[0]
+    return study + '[[block]]\nname = "global"\n' + fixed + firsts + "[block.axes]\nknots = [%s]\n" % knots
 
 
 def main():
@@ -36,11 +40,14 @@ def main():
     ap.add_argument("studies")
     ap.add_argument("--knots", default="5,10,20,40")
     ap.add_argument("--threads", default="2")
+    ap.add_argument("--arms", default="4R,5R,7-DOF")
     a = ap.parse_args()
     knots = [int(k) for k in a.knots.split(",")]
     print("| arm | " + " | ".join(f"{k} knots: E, evaluations, time" for k in knots) + " | change between the two finest |")
     print("|---|" + "---|" * len(knots) + "---|")
     for arm, name in ARMS:
+        if arm not in a.arms.split(","):
+            continue
         runs = run_study(a.kinesweep, global_study(os.path.join(a.studies, name), a.knots), a.threads)
         row = {}
         for k, e, s, n, t in zip(np.asarray(runs["knots"]), np.asarray(runs["E"], float), np.asarray(runs["status"]),
