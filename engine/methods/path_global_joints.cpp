@@ -62,6 +62,7 @@ void JointExtensionProblem::accept(std::size_t i, const double (*z)[3], const Ch
     for (int d = 0; d < 3; ++d) accepted_z_[k][d] = z[k][d];
   accepted_state_ = state_;
   accepted_det_ = s.det;
+  accepted_alpha_ = s.alpha;
   accepted_lu_ = current_lu_;
   accepted_JC_ = current_JC_;
 }
@@ -77,6 +78,7 @@ void JointExtensionProblem::sample(std::size_t i, const double (*z)[3], ChainGlo
   if (same_q) {  // a perturbation of the accepted sample's rates: its joint path and Jacobians
     s.q = accepted_q_;
     s.det = accepted_det_;
+    s.alpha = accepted_alpha_;
   } else {
     s.q = accepted_q_;
     for (int k = 0; k < r; ++k) s.q[coordinate_joints_[k]] = z[k][0];
@@ -111,8 +113,8 @@ void JointExtensionProblem::sample(std::size_t i, const double (*z)[3], ChainGlo
     current_lu_.compute(JS);
     s.det = JS.determinant();
     s.violation = converged && std::isfinite(rn) ? 0.0 : (std::isfinite(rn) ? std::max(rn, kResidual) : 1.0);
+    s.alpha = m == 2 ? std::atan2(data_.tip.R(1, 0), data_.tip.R(0, 0)) : std::numeric_limits<double>::quiet_NaN();
   }
-  s.alpha = m == 2 ? std::atan2(data_.tip.R(1, 0), data_.tip.R(0, 0)) : std::numeric_limits<double>::quiet_NaN();
   // rates: J_S qd_S = xd - J_C zd; accelerations: J_S qdd_S = xdd - J_C zdd - (Jdot qd)
   const Eigen::PartialPivLU<SquareM>& lu = same_q ? accepted_lu_ : current_lu_;
   const JacobianC& JC = same_q ? accepted_JC_ : current_JC_;

@@ -55,7 +55,7 @@ class JointExtensionProblem final : public ChainGlobalProblem {
   mutable VecN accepted_q_, accepted_qd_;
   mutable double accepted_z_[kMaxJoints][3] = {};
   mutable ChainState accepted_state_;
-  mutable double accepted_det_ = 0;
+  mutable double accepted_det_ = 0, accepted_alpha_ = 0;
   mutable Eigen::PartialPivLU<SquareM> accepted_lu_, current_lu_;  // of J_S
   mutable JacobianC accepted_JC_, current_JC_;
 };
