@@ -27,7 +27,7 @@ def global_study(path, knots):
     head, glob = text.split('name = "global"\n')
     glob = glob.split("[[block]]")[0]
     fixed, axes = (glob.split("[block.axes]") + [""])[:2]
-    fixed = re.sub(r"^zip = .*$", "", fixed, flags=re.M)
+    fixed = re.sub(r"^(zip|knots) = .*$", "", fixed, flags=re.M)
     firsts = "".join("%s = %s\n" % (m.group(1), m.group(2).strip())
                      for m in re.finditer(r"^(\w+) = \[([^,\]]+)", axes, flags=re.M) if m.group(1) != "knots")
     study = head.split("[[block]]")[0]
