@@ -1,12 +1,17 @@
 """Local against path-global redundancy resolution as the seed's square is run faster or slower: for
 each total duration T (four equal sides), a local landscape (both local methods over alpha1A x k) and
 global_spline runs (self-motion chart, 20 knots, from case 4's alpha(t) and from four start angles,
-end at rest and free), each with the physical inertia. Prints a markdown table: the local runs'
-statuses, the best local run that stays within 1 mm of its path, and the best global run.
+end at rest and free), each with the physical inertia. With --robot 4R or 5R, the arm of
+studies/path_global_4r.toml or path_global_5r.toml instead (its [robot] table), its global runs from
+the local run at each start angle. Prints a markdown table: the local runs' statuses, the best local
+run that stays within 1 mm of its path, and the best global run.
 
 usage: /usr/bin/python3 path_global_durations.py KINESWEEP_BINARY [--durations 1,1.5,2,3,4] [--threads N]
+       [--robot 3R|4R|5R]
 """
 import argparse
+import os
+import re
 
 import numpy as np
 
@@ -44,15 +49,26 @@ end_state = ["rest", "free"]
 """
 
 
+def chain_study(robot):
+    """STUDY on the arm of studies/path_global_<robot>.toml: its [robot] table, global runs from local starts."""
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "studies",
+                        "path_global_%s.toml" % robot.lower())
+    table = re.search(r"^\[robot\]\n(?:(?:[^\[\n].*)?\n)*", open(path).read(), flags=re.M).group(0)
+    study = STUDY.replace("[task]", table.replace("{", "{{").replace("}", "}}") + "\n[task]")
+    return study.replace('global_start = "vertex"\nvertex_alpha = [13.30, 17.28, -12.44, -16.12]\n', "")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("kinesweep")
     ap.add_argument("--durations", default="1,1.5,2,3,4")
     ap.add_argument("--threads", default="2")
+    ap.add_argument("--robot", default="3R", choices=["3R", "4R", "5R"])
     a = ap.parse_args()
+    study = STUDY if a.robot == "3R" else chain_study(a.robot)
     rows = []
     for T in [float(x) for x in a.durations.split(",")]:
-        runs = run_study(a.kinesweep, STUDY.format(d=T / 4), a.threads, degrees=True)
+        runs = run_study(a.kinesweep, study.format(d=T / 4), a.threads, degrees=True)
         block = np.asarray(runs["block"])
         status = np.asarray(runs["status"])
         E = np.asarray(runs["E"], dtype=float)
