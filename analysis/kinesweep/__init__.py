@@ -12,7 +12,7 @@ Submodules (each importable alone):
     where       `kinesweep query --where` expressions on numpy columns
     solutions   clustering joint vectors into named IK solutions
     plotting    shared matplotlib helpers of the plot commands
-Commands (`/usr/bin/python3 -m kinesweep.NAME --help`; from a source tree, analysis/NAME.py is the same):
+Commands (`python3 -m kinesweep.NAME --help`; in a source tree, analysis/NAME.py is the same):
     plot_landscape, plot_histories, plot_cases, plot_basins, plot_convergence, plot_runs,
     compare_landscapes, importance, report, make_examples
 `python3 -m kinesweep` lists them. The former module names (ksread, kswhere, kshistory, kslive,

@@ -4,7 +4,7 @@
 minimum; cells without a value (a failed run) are left blank. Dims other than --x/--y must be fixed
 (--fix AXIS=VALUE), never reduced silently.
 
-    /usr/bin/python3 analysis/compare_landscapes.py results/redundancy_3r.h5 results/redundancy_4r.h5 \\
+    python3 -m kinesweep.compare_landscapes results/redundancy_3r.h5 results/redundancy_4r.h5 \\
         results/redundancy_5r.h5 --fix method=local_weighted -o redundancy.png
 """
 import argparse
@@ -18,7 +18,8 @@ from kinesweep import read as ksread  # noqa: E402
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(prog="python3 -m kinesweep.compare_landscapes", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("files", nargs="+", help="results files (.h5) written by `kinesweep run`")
     p.add_argument("-o", "--output", default="compare_landscapes.png", help="output picture (.png or .svg)")
     p.add_argument("--svg", action="store_true", help="write SVG instead of PNG")

@@ -19,7 +19,7 @@ the fit. The held-out R² is printed with the numbers; below 0.5 the output says
 and the importances are not to be trusted. Correlated parameters share importance unpredictably.
 
     /usr/bin/python3 -m kinesweep.importance results/examples_lhs.h5 --block local_lhs
-    /usr/bin/python3 analysis/importance.py results/examples_lhs.h5 --metric tau_inf --format json
+    python3 -m kinesweep.importance results/examples_lhs.h5 --metric tau_inf --format json
 
     from kinesweep.read import open_results
     r = open_results("results/examples_lhs.h5").importance(block="local_lhs")
@@ -240,7 +240,8 @@ def format_table(r):
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(prog="python3 -m kinesweep.importance", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("file", help="results file (.h5) written by `kinesweep run`")
     p.add_argument("--block", help="one block (default: every block that sweeps a parameter)")
     p.add_argument("--metric", help="metric column (default: the run kind's objective: E, IK iterations)")

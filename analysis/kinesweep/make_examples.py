@@ -1,12 +1,13 @@
 #!/usr/bin/python3
 """Regenerate results/examples/*.png (the pictures in the README's "Explore results").
 
-    /usr/bin/python3 analysis/make_examples.py [--kinesweep build/kinesweep] [--work /tmp/ks_examples]
+    python3 -m kinesweep.make_examples [--kinesweep build/kinesweep] [--work /tmp/ks_examples]
 
 Runs the small studies studies/examples_*.toml and studies/thesis_table4.toml (seconds), and the small
 optimisation study below (OPTIMIZATION_STUDY, written to the work directory), then every plot script at
-800x600 (basins 1200x500), dpi 100. results/examples/report.png (a screenshot of analysis/report.py's
-page, taken with headless Chromium) is not regenerated here: analysis/README.md says how it was taken.
+800x600 (basins 1200x500), dpi 100. results/examples/report.png (a screenshot of the page of
+kinesweep.report, taken with headless Chromium) is not regenerated here: the analysis README says how
+it was taken. It works in a kinesweep source tree only (it reads its studies/ and writes its results/).
 """
 import argparse
 import os
@@ -53,14 +54,16 @@ xtol_rel = 1e-10
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(prog="python3 -m kinesweep.make_examples", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--kinesweep", default=os.path.join(ROOT, "build", "kinesweep"))
     p.add_argument("--work", default="/tmp/ks_examples", help="where the .h5 files go")
     p.add_argument("--out", default=os.path.join(ROOT, "results", "examples"))
     a = p.parse_args()
     if not os.path.isdir(os.path.join(ROOT, "studies")):
         raise SystemExit("make_examples regenerates a source tree's results/examples from its studies/: run it "
-                         "from a kinesweep source tree (analysis/make_examples.py), not from an installed package")
+                         "from a kinesweep source tree (PYTHONPATH=analysis python3 -m kinesweep.make_examples), "
+                         "not from an installed package")
     os.makedirs(a.work, exist_ok=True)
     os.makedirs(a.out, exist_ok=True)
     h5 = {}

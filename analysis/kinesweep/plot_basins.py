@@ -7,7 +7,7 @@ panels): each cell is coloured by the solution its run converged to, shaded by i
 stalled) are drawn in their own colours. Solutions are named by their joints in the file's units
 (angles in degrees, prismatic joints in mm or m). A log-spaced axis is drawn on a log scale.
 
-    /usr/bin/python3 analysis/plot_basins.py results/ik_basins.h5 -o basins.png
+    python3 -m kinesweep.plot_basins results/ik_basins.h5 -o basins.png
 """
 import argparse
 import os
@@ -26,7 +26,8 @@ FAIL_COLOURS = dict(ksread.STATUS_COLOURS, **{"converged, other solution": ksrea
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(prog="python3 -m kinesweep.plot_basins", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     ksplot.add_output_args(p, default_size=DEFAULT_SIZE)
     p.add_argument("--block", help="IK landscape (block) name (default: the first in file order with two swept initial-guess axes)")
     p.add_argument("--x", help="initial-guess axis on x (default: the block's first swept q0_ axis, e.g. q0_1)")

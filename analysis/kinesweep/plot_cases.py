@@ -3,8 +3,8 @@
 
 Reads the rows of a study with a `preset` column (e.g. studies/thesis_table4.toml).
 
-    /usr/bin/python3 analysis/plot_cases.py results/thesis_table4.h5
-    /usr/bin/python3 analysis/plot_cases.py results/thesis_table4.h5 --metric tau1_inf --cases 1a,1b,1c,1d --log
+    python3 -m kinesweep.plot_cases results/thesis_table4.h5
+    python3 -m kinesweep.plot_cases results/thesis_table4.h5 --metric tau1_inf --cases 1a,1b,1c,1d --log
 """
 import argparse
 import os
@@ -20,7 +20,8 @@ LABELS = {"E": "E (mean ‖τ‖)", "tau1_inf": "‖τ1‖∞", "tau2_inf": "‖
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(prog="python3 -m kinesweep.plot_cases", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     ksplot.add_output_args(p)
     p.add_argument("--metric", default="E", choices=list(THESIS_INDEX), help="default %(default)s")
     p.add_argument("--cases", help="cases to show, comma-separated (default: every preset in the file)")

@@ -9,7 +9,7 @@ a method and λ get a colour each. Runs whose ‖F_k‖ histories are bitwise id
 (identical)"), with a note on stderr; --print-data lists the drawn lines ("lines": each one's runs,
 label and plotted data) and, per run, the line it is drawn as.
 
-    /usr/bin/python3 analysis/plot_convergence.py results/ik_scara.h5 --start 60,45
+    python3 -m kinesweep.plot_convergence results/ik_scara.h5 --start 60,45
 """
 import argparse
 import os
@@ -24,7 +24,8 @@ LAMBDA_METHODS = {"lm", "lm_adaptive"}
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(prog="python3 -m kinesweep.plot_convergence", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     ksplot.add_output_args(p)
     p.add_argument("--runs", help="run ids, comma-separated")
     p.add_argument("--start", help="initial guess q0_1,q0_2 in degrees: per (method, lambda) the nearest run")
@@ -97,7 +98,7 @@ def main(argv=None):
     for g in groups:
         if len(g) > 1:
             notes.append(f"runs {','.join(map(str, g))} have identical ‖F_k‖ histories: drawn as one line")
-            print(f"plot_convergence.py: note: {notes[-1]}", file=sys.stderr)
+            print(f"kinesweep.plot_convergence: note: {notes[-1]}", file=sys.stderr)
     # One line per (method, lambda) gets that pair's colour and style; when two drawn lines share the
     # pair (runs from other starts), each line gets its own colour instead.
     def key(r):

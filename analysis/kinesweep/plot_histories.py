@@ -3,8 +3,8 @@
 
 One row of panels per quantity, one column per joint, one line per run.
 
-    /usr/bin/python3 analysis/plot_histories.py results/thesis_table4.h5 --preset 1a,1c,1e
-    /usr/bin/python3 analysis/plot_histories.py results/thesis_table4.h5 --runs 0,2 --what tau,q,qd
+    python3 -m kinesweep.plot_histories results/thesis_table4.h5 --preset 1a,1c,1e
+    python3 -m kinesweep.plot_histories results/thesis_table4.h5 --runs 0,2 --what tau,q,qd
 """
 import argparse
 import os
@@ -20,7 +20,8 @@ MAX_COLS = 4  # panels per row of one array's components
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(prog="python3 -m kinesweep.plot_histories", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     ksplot.add_output_args(p)
     p.add_argument("--runs", help="run ids, comma-separated")
     p.add_argument("--preset", help="Table 4 cases (the preset column), comma-separated, e.g. 1a,1c,1e")

@@ -9,9 +9,9 @@ are fixed (--fix AXIS=VALUE), reduced (--reduce min|mean over them; the title sa
 categorical dim remains (method), drawn as small multiples: one panel per value, one colour scale.
 A log-spaced numeric axis (lambda from 1e-3 to 100) is drawn on a log scale; --log is the colour scale.
 
-    /usr/bin/python3 analysis/plot_landscape.py results/landscape_alpha_k.h5 --fix method=local_weighted --log --thesis
-    /usr/bin/python3 analysis/plot_landscape.py results/ik_basins.h5 --metric convergence --x q0_1 --y q0_2
-    /usr/bin/python3 analysis/plot_landscape.py results/optimize_polish.h5 --block alpha_k_1h --optimization 1h_polish --log
+    python3 -m kinesweep.plot_landscape results/landscape_alpha_k.h5 --fix method=local_weighted --log --thesis
+    python3 -m kinesweep.plot_landscape results/ik_basins.h5 --metric convergence --x q0_1 --y q0_2
+    python3 -m kinesweep.plot_landscape results/optimize_polish.h5 --block alpha_k_1h --optimization 1h_polish --log
 """
 import argparse
 import os
@@ -28,7 +28,8 @@ STATUS_COLOURS = ksread.STATUS_COLOURS
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(prog="python3 -m kinesweep.plot_landscape", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     ksplot.add_output_args(p)
     p.add_argument("--block", help="landscape (block) name (default: the first in file order with two swept "
                    "numeric axes)")
@@ -122,7 +123,7 @@ def choose_block(res, block):
     axes = "; ".join(f"{b}: {', '.join(a.name for a in res.landscape(b).axes) or 'no axis'}" for b in names)
     raise SystemExit(f"plot_landscape: {res.path}: no landscape has two swept numeric axes to plot ({axes}); "
                      "a dimension of sampled points (LHS, zipped random draws, Saltelli) is not a grid axis: "
-                     "analysis/plot_runs.py draws such runs as points")
+                     "python3 -m kinesweep.plot_runs draws such runs as points")
 
 
 def reduce_grid(ls, args):

@@ -12,9 +12,9 @@ Failed runs (status other than ok / converged) are grey markers (grey lines in p
 never part of the colour scale; runs with no value of the metric sit on the bottom edge. Parameters
 spread evenly over decades (e.g. lambda = 1e-3 .. 100) get log axes. Angles are shown in degrees.
 
-    /usr/bin/python3 analysis/plot_runs.py results/study.h5 --view slice
-    /usr/bin/python3 analysis/plot_runs.py results/study.h5 --x alpha1A --y k --where "E<60 | status=diverged"
-    /usr/bin/python3 analysis/plot_runs.py results/ik.h5 --view parcoords --params method,lambda,q0_1
+    python3 -m kinesweep.plot_runs results/study.h5 --view slice
+    python3 -m kinesweep.plot_runs results/study.h5 --x alpha1A --y k --where "E<60 | status=diverged"
+    python3 -m kinesweep.plot_runs results/ik.h5 --view parcoords --params method,lambda,q0_1
 """
 import argparse
 import os
@@ -34,7 +34,8 @@ OK_COLOUR = "#1f77b4"
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(prog="python3 -m kinesweep.plot_runs", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     ksplot.add_output_args(p, default_size="900x600")
     p.add_argument("--view", default="scatter", choices=VIEWS, help="default %(default)s")
     p.add_argument("--block", help="block to plot (default: the first block of the file)")
@@ -62,7 +63,7 @@ def parse_args(argv=None):
 
 
 def fail(msg, code=2):
-    print(f"plot_runs.py: {msg}", file=sys.stderr)
+    print(f"kinesweep.plot_runs: {msg}", file=sys.stderr)
     raise SystemExit(code)
 
 
@@ -395,7 +396,7 @@ def main(argv=None):
 
     try:
         for note in kswhere.unheld_value_notes(runs, args.where):
-            print(f"plot_runs.py: note: {note}", file=sys.stderr)
+            print(f"kinesweep.plot_runs: note: {note}", file=sys.stderr)
         rows = inblock & kswhere.select(runs, args.where, degrees=True)
     except kswhere.WhereError as e:
         fail(str(e))

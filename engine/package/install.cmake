@@ -3,7 +3,7 @@
 #   lib/libks_*.a, include/kinesweep/<part>/*.hpp, lib/cmake/kinesweep/ (find_package(kinesweep))
 #   share/kinesweep/studies/, share/doc/kinesweep/analysis.md
 #   lib/python3.X/dist-packages/kinesweep/ (the Python package: `python3 -m kinesweep.plot_cases FILE`)
-#   share/man/man1/kinesweep.1 (help2man, when installed), share/bash-completion/completions/kinesweep
+#   share/man/man1/kinesweep.1 (package/man_page.py, when Python 3 is found), share/bash-completion/completions/kinesweep
 include(CMakePackageConfigHelpers)
 
 set_target_properties(kinesweep_engine PROPERTIES EXPORT_NAME engine)
@@ -59,19 +59,19 @@ install(FILES ${PROJECT_SOURCE_DIR}/engine/store/FORMAT.md ${PROJECT_SOURCE_DIR}
         DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/kinesweep)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/studies/ DESTINATION ${CMAKE_INSTALL_DATADIR}/kinesweep/studies)
 
-# Man page from --help of the program and of each subcommand.
-find_program(HELP2MAN help2man)
-if(HELP2MAN)
+# Man page from --help of the program and of each subcommand (package/man_page.py, standard library only).
+find_package(Python3 COMPONENTS Interpreter)
+if(Python3_Interpreter_FOUND)
   set(KS_MAN ${PROJECT_BINARY_DIR}/kinesweep.1)
   add_custom_command(OUTPUT ${KS_MAN}
-                     COMMAND ${CMAKE_COMMAND} -DKINESWEEP=$<TARGET_FILE:kinesweep> -DHELP2MAN=${HELP2MAN}
-                             -DOUT=${KS_MAN} -P ${CMAKE_CURRENT_SOURCE_DIR}/package/man_page.cmake
-                     DEPENDS kinesweep ${CMAKE_CURRENT_SOURCE_DIR}/package/man_page.cmake
-                     COMMENT "Man page kinesweep.1 (help2man)")
+                     COMMAND ${Python3_EXECUTABLE} ${CMAKE_CURRENT_SOURCE_DIR}/package/man_page.py
+                             --kinesweep $<TARGET_FILE:kinesweep> --out ${KS_MAN} --source-dir ${PROJECT_SOURCE_DIR}
+                     DEPENDS kinesweep ${CMAKE_CURRENT_SOURCE_DIR}/package/man_page.py
+                     COMMENT "Man page kinesweep.1")
   add_custom_target(kinesweep_man ALL DEPENDS ${KS_MAN})
   install(FILES ${KS_MAN} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
 else()
-  message(STATUS "kinesweep: help2man not found: no man page")
+  message(STATUS "kinesweep: no Python 3 interpreter found: no man page")
 endif()
 install(FILES ${CMAKE_CURRENT_SOURCE_DIR}/package/kinesweep.bash-completion
         DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions RENAME kinesweep)

@@ -422,7 +422,7 @@ class PlotStudiesTest(unittest.TestCase):
             norm_f = {r: {a: v for a, v, _ in hist.read(r)}["norm_F"][:, 0] for ln in lines for r in ln["runs"]}
         for ln in grouped:
             self.assertIn("runs " + ",".join(map(str, ln["runs"])) + " (identical)", ln["label"])
-            self.assertIn(f"plot_convergence.py: note: runs {','.join(map(str, ln['runs']))} have identical", err)
+            self.assertIn(f"kinesweep.plot_convergence: note: runs {','.join(map(str, ln['runs']))} have identical", err)
             self.assertTrue(all(method[r] == "lm_adaptive" for r in ln["runs"]), ln["runs"])
             for r in ln["runs"]:
                 self.assertEqual(norm_f[r].tobytes(), norm_f[ln["runs"][0]].tobytes())
