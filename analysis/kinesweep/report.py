@@ -3,7 +3,8 @@
 
 Sections (those that do not apply are left out; the contents list what is there): the study text
 and file metadata, status counts per block, the best runs of each block, interactive landscapes,
-IK basins, Sobol' indices of the blocks run as a Saltelli design, the permutation importance of the
+IK basins, the runs of sampled blocks (Latin hypercubes, random draws, Saltelli designs) against each
+parameter and in parallel coordinates, Sobol' indices of the blocks run as a Saltelli design, the permutation importance of the
 other blocks' swept parameters (a random-forest fit; needs python3-sklearn), the histories of the best
 runs, and the optimisation traces. Plotly's JavaScript is
 embedded (Debian's python3-plotly, minified by esbuild when installed) and, with the figures' data,
@@ -11,13 +12,14 @@ gzip-compressed (inflated by the browser), so the page works offline and can be 
 Reads files a sweep is still writing (done rows only). Big grids and long traces are subsampled so
 that the page stays small (the captions say where).
 
-    /usr/bin/python3 analysis/report.py results/examples_landscape.h5 -o report.html
+    python3 -m kinesweep.report results/examples_landscape.h5 -o report.html
 
 Open a single section with report.html#only=SECTION (study, status, best, landscapes, basins,
-sensitivity, importance, histories, optimizations).
+samples, sensitivity, importance, histories, optimizations).
 """
 import argparse
 import datetime
+import math
 import os
 import sys
 
@@ -25,6 +27,7 @@ from kinesweep import read as ksread  # noqa: E402
 from kinesweep.report_basins import basins_figure  # noqa: E402
 from kinesweep.report_grids import landscape_figure  # noqa: E402
 from kinesweep.report_page import esc, figure, page  # noqa: E402
+from kinesweep.report_samples import sampled_section  # noqa: E402
 from kinesweep.report_tables import RunsView, best_section, metadata_section, status_section  # noqa: E402
 from kinesweep.report_traces import best_with_history, history_figure, history_ids, optimization_figure  # noqa: E402
 
@@ -35,7 +38,8 @@ MAX_IMPORTANCE_FIGURES = 12
 
 
 def parse_args(argv=None):
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(prog="python3 -m kinesweep.report", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("file", help="results file (.h5) written by `kinesweep run`")
     p.add_argument("-o", "--output", help="output page (default: FILE's name with _report.html)")
     p.add_argument("--best", type=int, default=5, help="rows per block in the best-runs table (default %(default)s)")
@@ -93,9 +97,11 @@ def plotly_js():
 
 
 def grid_sections(res, cap_total):
-    """The landscapes and basins sections' html ("" when none)."""
+    """The landscapes and basins sections' html ("" when none), and the blocks whose landscape has a
+    dimension of sampled points (drawn as points in the sampled-runs section)."""
     names = res.landscapes()
     lss = [res.landscape(b, degrees=True) for b in names]
+    sampled = [ls.block for ls in lss if _sampled_note(ls)]
     ik = [ls for ls in lss if ls.kind == "ik"]
     n_fig = len(lss) + len(ik)
     cap = max(min(500, cap_total), cap_total // max(1, n_fig))
@@ -108,7 +114,7 @@ def grid_sections(res, cap_total):
         if out is not None:
             fig, caption, _ = out
             basins.append(figure(f"basins-{i}", fig, caption, title=f"Block {ls.block}"))
-    return land, "".join(basins)
+    return land, "".join(basins), sampled
 
 
 def _sampled_note(ls):
@@ -119,8 +125,9 @@ def _sampled_note(ls):
     return (f"<h3>Block {esc(ls.block)} ({esc(ls.kind)})</h3><p class=\"caption\">No landscape: its dimension "
             f"{esc(', '.join(sampled))} holds sampled points (a Latin hypercube, zipped random draws or a Saltelli "
             "design), "
-            "not grid lines. analysis/plot_runs.py draws such runs as points; a Saltelli design's indices are in "
-            "the sensitivity section, the other blocks' parameters are ranked in the importance section.</p>")
+            "not grid lines: the section on sampled runs draws them as points (as does python3 -m kinesweep.plot_runs); "
+            "a Saltelli design's indices are in the sensitivity section, the other blocks' parameters are ranked in "
+            "the importance section.</p>")
 
 
 def _landscape_html(i, ls, cap):
@@ -163,29 +170,64 @@ def optimizations_section(res):
     return "".join(parts)
 
 
+def sobol_figure(r):
+    """Two panels, first-order S1 and total ST: one bar per factor with its bootstrap interval, its
+    number printed above it (an annotation over the whisker) and a marker at its value (a bar of a small index is a few pixels high;
+    the marker and the number show it all the same). The value axes are shared, from min(0, lowest
+    interval end) to above the highest."""
+    data, lows, highs, numbers = [], [0.0], [0.0], []
+    panels = (("first", "first order S1", "#1f77b4", "x", "y"), ("total", "total ST", "#ff7f0e", "x2", "y2"))
+    for key, name, colour, xa, ya in panels:
+        v, lo, hi = (list(map(float, r[k])) for k in (key, key + "_lo", key + "_hi"))
+        data.append({"type": "bar", "name": name, "x": r["factors"], "y": v, "xaxis": xa, "yaxis": ya,
+                     "marker": {"color": colour, "line": {"color": "#1d2330", "width": 1}},
+                     "text": [f"{x:.3g}" for x in v], "textposition": "none",
+                     "hovertemplate": f"{name} of %{{x}}: %{{y:.4g}}<extra></extra>",
+                     "error_y": {"type": "data", "symmetric": False, "color": "#444",
+                                 "array": [h - x for h, x in zip(hi, v)],
+                                 "arrayminus": [x - lo_ for x, lo_ in zip(v, lo)]}})
+        lows += [x for x in lo + v if math.isfinite(x)]
+        highs += [x for x in hi + v if math.isfinite(x)]
+        # each number just above the top of its bar's whisker (or of the bar), clear of both
+        for f, x, h in zip(r["factors"], v, hi):
+            numbers.append({"text": f"{x:.3g}", "x": f, "y": max(x, h) if math.isfinite(h) else x, "xref": xa,
+                            "yref": ya, "yanchor": "bottom", "yshift": 3, "showarrow": False,
+                            "font": {"size": 13, "color": "#1d2330"}})
+    for (key, name, colour, xa, ya), bars in zip(panels, list(data)):
+        data.append({"type": "scatter", "mode": "markers", "name": name + " (value)", "showlegend": False,
+                     "x": r["factors"], "y": bars["y"], "xaxis": xa, "yaxis": ya, "hoverinfo": "skip",
+                     "marker": {"symbol": "diamond", "size": 10, "color": colour,
+                                "line": {"color": "#1d2330", "width": 1.5}}})
+    top = max(highs)
+    span = max(top - min(lows), 0.05)
+    rng = [min(lows) - 0.04 * span, top + 0.18 * span]
+    title = f"Sobol' index of {r['metric']}"
+    layout = {"height": 380, "margin": {"t": 40}, "grid": {"rows": 1, "columns": 2, "pattern": "independent"},
+              "showlegend": False, "bargap": 0.35,
+              "yaxis": {"title": {"text": title}, "range": rng, "zeroline": True, "zerolinecolor": "#1d2330"},
+              "yaxis2": {"range": rng, "zeroline": True, "zerolinecolor": "#1d2330", "matches": "y"},
+              "annotations": [{"text": f"<b>{name}</b>", "xref": f"{xa} domain", "yref": "paper", "x": 0.5,
+                               "y": 1.0, "yanchor": "bottom", "showarrow": False, "font": {"size": 14}}
+                              for _, name, _, xa, _ in panels] + numbers}
+    return {"data": data, "layout": layout}
+
+
 def sensitivity_section(res, limit=MAX_SENSITIVITY_FIGURES):
-    """One bar chart per block run as a Saltelli design (and combination of its other axes): each
-    factor's first-order and total Sobol' index of the kind's objective, with bootstrap intervals."""
+    """One chart per block run as a Saltelli design (and combination of its other axes): each factor's
+    first-order and total Sobol' index of the kind's objective, with bootstrap intervals, side by side."""
     parts = []
     results = res.sensitivity()
     for i, r in enumerate(results[:limit]):
-        bars = []
-        for key, name, colour in (("first", "first order S1", "#1f77b4"), ("total", "total ST", "#ff7f0e")):
-            v, lo, hi = (list(map(float, r[k])) for k in (key, key + "_lo", key + "_hi"))
-            bars.append({"type": "bar", "name": name, "x": r["factors"], "y": v, "marker": {"color": colour},
-                         "error_y": {"type": "data", "symmetric": False, "array": [h - x for h, x in zip(hi, v)],
-                                     "arrayminus": [x - lo_ for x, lo_ in zip(v, lo)]}})
-        fig = {"data": bars, "layout": {"barmode": "group", "height": 340, "margin": {"t": 20},
-                                        "yaxis": {"title": {"text": f"Sobol' index of {r['metric']}"}},
-                                        "legend": {"orientation": "h"}}}
         at = ", ".join(f"{k}={v}" for k, v in r["at"].items())
         failed = ", ".join(f"{s} {c}" for s, c in r["failed_runs"].items())
+        numbers = "; ".join(f"{esc(f)} S1 {float(a):.3g}, ST {float(b):.3g}"
+                            for f, a, b in zip(r["factors"], r["first"], r["total"]))
         caption = (f"{esc(r['metric'])}{' at ' + esc(at) if at else ''}: {r['samples']} of {r['base_samples']} samples "
                    f"used" + (f" ({r['dropped']} left out: a run failed or is not done; {esc(failed)})" if r["dropped"] else "")
-                   + "; bars: Saltelli 2010 (S1) and Jansen (ST) estimators; whiskers: 95 % percentile bootstrap "
-                   "intervals. An index is the share of the metric's variance a factor explains alone (S1) or "
-                   "with its interactions (ST).")
-        parts.append(figure(f"sensitivity-{i}", fig, caption, title=f"Block {r['block']} ({r['kind']})"))
+                   + f"; indices: {numbers}. Bars and diamonds: Saltelli 2010 (S1) and Jansen (ST) estimators; "
+                   "whiskers: 95 % percentile bootstrap intervals. An index is the share of the metric's variance a "
+                   "factor explains alone (S1) or with its interactions (ST).")
+        parts.append(figure(f"sensitivity-{i}", sobol_figure(r), caption, title=f"Block {r['block']} ({r['kind']})"))
     if len(results) > limit:
         parts.append(f"<p class=\"caption\">{len(results) - limit} more (kinesweep sensitivity FILE lists all).</p>")
     return "".join(parts)
@@ -257,11 +299,14 @@ def build(path, best=5, max_cells=CELL_BUDGET, title=None):
         b = best_section(view, best)
         if b:
             sections.append(("best", "Best runs per block", b))
-        land, basins = grid_sections(res, max_cells)
+        land, basins, sampled = grid_sections(res, max_cells)
         if land:
             sections.append(("landscapes", "Landscapes", land))
         if basins:
             sections.append(("basins", "IK basins of attraction", basins))
+        samples = sampled_section(view, sampled)
+        if samples:
+            sections.append(("samples", "Sampled runs", samples))
         sens = sensitivity_section(res)
         if sens:
             sections.append(("sensitivity", "Which parameter matters: Sobol' indices", sens))

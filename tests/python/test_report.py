@@ -68,9 +68,37 @@ q0_1 = { from = -180, to = 180, count = 11 }
 q0_2 = { from = -180, to = 180, count = 9 }
 """
 
+# A Latin hypercube of (alpha1A, k) for both local methods (alpha1A below -20 deg is unreachable: failed
+# runs) and a Saltelli design of (alpha1A, k, K_N): blocks of sampled points, no grid.
+SAMPLED = """
+[study]
+name = "report_sampled"
+histories = "none"
+[robot]
+inertia = "thesis_m11"
+[[block]]
+name = "lhs"
+kind = "trajectory"
+lhs = { count = 30, seed = 11 }
+[block.axes]
+method = ["local_weighted", "local_unweighted"]
+alpha1A = { lhs = { from = -30, to = 35 } }
+k = { lhs = { from = 0, to = 1 } }
+[[block]]
+name = "design"
+kind = "trajectory"
+method = "local_weighted"
+saltelli = { count = 64, seed = 1 }
+[block.axes]
+alpha1A = { saltelli = { from = -20, to = 30 } }
+k = { saltelli = { from = 0, to = 0.2 } }
+K_N = { saltelli = { from = 5, to = 40 } }
+"""
+
 SECTIONS = {"trajectory": ["study", "status", "best", "landscapes", "histories"],
             "basins": ["study", "status", "best", "landscapes", "basins", "importance", "histories"],
-            "optimize": ["study", "status", "best", "landscapes", "optimizations"]}
+            "optimize": ["study", "status", "best", "landscapes", "optimizations"],
+            "sampled": ["study", "status", "best", "landscapes", "samples", "sensitivity", "importance"]}
 GOOD = {"trajectory": ("ok", ["E"]), "ik": ("converged", ["iterations", "error"])}
 
 
@@ -170,7 +198,8 @@ class ReportTest(unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.h5, cls.html, cls.pages = {}, {}, {}
-        for name, text in (("trajectory", TRAJECTORY), ("basins", BASINS), ("optimize", OPTIMIZE)):
+        for name, text in (("trajectory", TRAJECTORY), ("basins", BASINS), ("optimize", OPTIMIZE),
+                           ("sampled", SAMPLED)):
             out = cls.h5[name] = run_study_text(KS, cls.tmp.name, name, text)
             cls.html[name] = cls.report(out)
             with open(cls.html[name], encoding="utf-8") as f:
@@ -374,6 +403,87 @@ max_evaluations = 3
         with h5py.File(self.h5["basins"], "r") as f:
             full = f["landscapes"]["basins"]["status_code"].size
         self.assertLess(cells, full)
+
+    # --- sampled runs and Sobol' indices ---------------------------------------------------------------
+    def test_sampled_runs_views_equal_h5py(self):
+        """Each sampled block has a slice figure (E against each swept parameter: every done run's
+        (run id, value, E) as h5py reads them, good runs and failed runs apart) and parallel
+        coordinates (one line per good run, a dimension per parameter and E)."""
+        p = self.pages["sampled"]
+        with h5py.File(self.h5["sampled"], "r") as f:
+            g = f["runs"]
+            block, status = runs_column(g["block"]), runs_column(g["status"])
+            done = g["done"][()] == 1
+            E = g["E"][()]
+            order = [c.decode() if isinstance(c, bytes) else c for c in g.attrs["columns"]]
+            for i, (b, swept) in enumerate((("lhs", {"method", "alpha1A", "k"}), ("design", {"alpha1A", "k", "K_N"}))):
+                params = [c for c in order if c in swept]  # in the file's column order
+                values = {c: runs_column(g[c]) if is_text(g[c]) else g[c][()] * (D if s(g[c].attrs["unit"]) == "rad" else 1)
+                          for c in params}
+                rows = np.flatnonzero((block == b) & done)
+                good = rows[(status[rows] == "ok") & np.isfinite(E[rows])]
+                failed = rows[(status[rows] != "ok") & np.isfinite(E[rows])]
+                fig = json.loads(p.islands[f"samples-{i}-data"])
+                titles = [fig["layout"]["xaxis" + ("" if j == 0 else str(j + 1))]["title"]["text"].split(" [")[0]
+                          for j in range(len(params))]
+                self.assertEqual(titles, params, b)
+                for j, c in enumerate(params):
+                    ax = "x" + ("" if j == 0 else str(j + 1))
+                    traces = [t for t in fig["data"] if t["xaxis"] == ax]
+                    for t, want in zip(traces, (good, failed)):
+                        self.assertEqual(t["customdata"], [int(r) for r in want], f"{b} {c} {t['name']}")
+                        for r, x, y in zip(t["customdata"], t["x"], t["y"]):
+                            if is_text(g[c]):
+                                self.assertEqual(x, values[c][r])
+                            else:
+                                self.assertAlmostEqual(x, values[c][r], delta=1e-6 * max(1, abs(values[c][r])))
+                            self.assertAlmostEqual(y, E[r], delta=1e-6 * abs(E[r]))
+                    self.assertEqual(len(traces), 1 + (len(failed) > 0), f"{b} {c}")
+                pc = json.loads(p.islands[f"parcoords-{i}-data"])["data"][0]
+                self.assertEqual(pc["type"], "parcoords")
+                self.assertEqual([d["label"].split(" [")[0] for d in pc["dimensions"]], params + ["E"])
+                self.assertEqual(pc["customdata"], [int(r) for r in good])
+                for d, c in zip(pc["dimensions"], params + ["E"]):
+                    if c == "method":
+                        self.assertEqual([d["ticktext"][v] for v in d["values"]], [values[c][r] for r in good])
+                    else:
+                        want = E[good] if c == "E" else values[c][good]
+                        np.testing.assert_allclose(d["values"], want, rtol=1e-6)
+        self.assertNotIn("samples-2-data", p.islands)  # no other block is sampled
+
+    def test_sobol_chart_shows_every_index_with_its_number(self):
+        """The Sobol' chart: for each of S1 and ST a bar per factor, its number printed above it and a
+        marker at its value (small indices stay visible), the numbers those of `kinesweep sensitivity`
+        (the engine's own estimator) to the 3 digits printed."""
+        r = subprocess.run([KS, "sensitivity", self.h5["sampled"], "--format", "json"], capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        res = json.loads(r.stdout)["results"][0]
+        names = [x["name"] for x in res["factors"]]
+        self.assertEqual(names, ["alpha1A", "k", "K_N"])
+        fig = json.loads(self.pages["sampled"].islands["sensitivity-0-data"])
+        bars = [t for t in fig["data"] if t["type"] == "bar"]
+        marks = [t for t in fig["data"] if t["type"] == "scatter"]
+        self.assertEqual(len(bars), 2)
+        self.assertEqual(len(marks), 2)
+        caption = self.page_text("sampled")
+        for bar, mark, key in zip(bars, marks, ("first", "total")):
+            self.assertEqual(bar["x"], names)
+            self.assertEqual(mark["x"], names)
+            self.assertEqual(mark["xaxis"], bar["xaxis"])
+            numbers = {a["x"]: a for a in fig["layout"]["annotations"] if a.get("xref") == bar["xaxis"]}
+            for i, fac in enumerate(res["factors"]):
+                v = fac[key]
+                self.assertAlmostEqual(float(bar["text"][i]), v, delta=5e-3 * abs(v) + 1e-9, msg=f"{key} {names[i]}")
+                shown = numbers[names[i]]  # printed above the bar and its whisker
+                self.assertEqual(shown["text"], bar["text"][i])
+                self.assertGreaterEqual(shown["y"], bar["y"][i])
+                self.assertGreaterEqual(shown["y"], bar["y"][i] + bar["error_y"]["array"][i] - 1e-5)  # 7 digits kept
+                self.assertAlmostEqual(mark["y"][i], bar["y"][i], delta=1e-12)
+                self.assertIn(bar["text"][i], caption)
+            # the value axis shows every bar, whisker and number: from below min(0, lows) to above the highs
+            lo, hi = fig["layout"]["yaxis"]["range"]
+            self.assertLessEqual(lo, min([0.0] + [fac[key + "_lo"] for fac in res["factors"]]) + 0.01)
+            self.assertGreater(hi, max(fac[key + "_hi"] for fac in res["factors"]))
 
     # --- in a browser -----------------------------------------------------------------------------
     def test_browser(self):
