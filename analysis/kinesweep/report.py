@@ -3,10 +3,10 @@
 
 Sections (those that do not apply are left out; the contents list what is there): the study text
 and file metadata, status counts per block, the best runs of each block, interactive landscapes,
-IK basins, the runs of sampled blocks (Latin hypercubes, random draws, Saltelli designs) against each
-parameter and in parallel coordinates, Sobol' indices of the blocks run as a Saltelli design, the permutation importance of the
-other blocks' swept parameters (a random-forest fit; needs python3-sklearn), the histories of the best
-runs, and the optimisation traces. Plotly's JavaScript is
+IK basins, the runs of sampled blocks (Latin hypercubes, random draws, Saltelli designs) against
+each parameter and in parallel coordinates, Sobol' indices of the blocks run as a Saltelli design, the
+permutation importance of the other blocks' swept parameters (a random-forest fit; needs
+python3-sklearn), the histories of the best runs, and the optimisation traces. Plotly's JavaScript is
 embedded (Debian's python3-plotly, minified by esbuild when installed) and, with the figures' data,
 gzip-compressed (inflated by the browser), so the page works offline and can be mailed as one file.
 Reads files a sweep is still writing (done rows only). Big grids and long traces are subsampled so
@@ -125,7 +125,8 @@ def _sampled_note(ls):
     return (f"<h3>Block {esc(ls.block)} ({esc(ls.kind)})</h3><p class=\"caption\">No landscape: its dimension "
             f"{esc(', '.join(sampled))} holds sampled points (a Latin hypercube, zipped random draws or a Saltelli "
             "design), "
-            "not grid lines: the section on sampled runs draws them as points (as does python3 -m kinesweep.plot_runs); "
+            "not grid lines: the section on sampled runs draws them as points (as does "
+            "python3 -m kinesweep.plot_runs); "
             "a Saltelli design's indices are in the sensitivity section, the other blocks' parameters are ranked in "
             "the importance section.</p>")
 
@@ -172,9 +173,9 @@ def optimizations_section(res):
 
 def sobol_figure(r):
     """Two panels, first-order S1 and total ST: one bar per factor with its bootstrap interval, its
-    number printed above it (an annotation over the whisker) and a marker at its value (a bar of a small index is a few pixels high;
-    the marker and the number show it all the same). The value axes are shared, from min(0, lowest
-    interval end) to above the highest."""
+    number printed above it (an annotation over the whisker) and a marker at its value (a bar of a
+    small index is a few pixels high; the marker and the number show it all the same). The value axes
+    are shared, from min(0, lowest interval end) to above the highest."""
     data, lows, highs, numbers = [], [0.0], [0.0], []
     panels = (("first", "first order S1", "#1f77b4", "x", "y"), ("total", "total ST", "#ff7f0e", "x2", "y2"))
     for key, name, colour, xa, ya in panels:

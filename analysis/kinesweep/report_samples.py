@@ -1,7 +1,7 @@
 """Figures of kinesweep.report for blocks of sampled runs (Latin hypercubes, zipped random draws,
-Saltelli designs: a landscape dimension of points that are not grid lines, so no heatmap is drawn): the metric against each swept
-parameter (one panel per parameter, as Optuna's slice plot) and parallel coordinates over the
-parameters and the metric. Angles in degrees. Run with /usr/bin/python3."""
+Saltelli designs: a landscape dimension of points that are not grid lines, so no heatmap is drawn):
+the metric against each swept parameter (one panel per parameter, as Optuna's slice plot) and
+parallel coordinates over the parameters and the metric. Angles in degrees. Run with /usr/bin/python3."""
 import numpy as np
 
 from kinesweep.plotting import is_log_spaced

@@ -225,7 +225,9 @@ class Install(unittest.TestCase):
         version = run([ks, "--version"]).stdout.strip()  # kinesweep 0.1.0 (<git describe>)
         m = re.match(r"kinesweep (\S+)(?: \((?:.*-g)?([0-9a-f]{40})(-dirty)?\))?$", version)
         self.assertIsNotNone(m, version)
-        source = f"kinesweep {m.group(1)}" + (f" (commit {m.group(2)[:7]}{'+' if m.group(3) else ''})" if m.group(2) else "")
+        source = f"kinesweep {m.group(1)}"
+        if m.group(2):  # a build of a modified tree (git's -dirty) is marked '+'
+            source += f" (commit {m.group(2)[:7]}{'+' if m.group(3) else ''})"
         footer = re.match(r"^(.*\S)\s+(\S+)\s+KINESWEEP\(1\)$", lines[-1])
         self.assertIsNotNone(footer, lines[-1])
         self.assertEqual(footer.group(1), source)

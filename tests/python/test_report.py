@@ -418,8 +418,8 @@ max_evaluations = 3
             order = [c.decode() if isinstance(c, bytes) else c for c in g.attrs["columns"]]
             for i, (b, swept) in enumerate((("lhs", {"method", "alpha1A", "k"}), ("design", {"alpha1A", "k", "K_N"}))):
                 params = [c for c in order if c in swept]  # in the file's column order
-                values = {c: runs_column(g[c]) if is_text(g[c]) else g[c][()] * (D if s(g[c].attrs["unit"]) == "rad" else 1)
-                          for c in params}
+                values = {c: runs_column(g[c]) if is_text(g[c])
+                          else g[c][()] * (D if s(g[c].attrs["unit"]) == "rad" else 1) for c in params}
                 rows = np.flatnonzero((block == b) & done)
                 good = rows[(status[rows] == "ok") & np.isfinite(E[rows])]
                 failed = rows[(status[rows] != "ok") & np.isfinite(E[rows])]
