@@ -46,6 +46,11 @@ ReadView read_view(const std::string& results_path);
 /// plain): the file must then not be read as it is on disk.
 bool journal_has_pending_commit(const std::string& results_path);
 
+/// True when a journal lies beside `results_path` and a writer's open would act on it: recover the
+/// file from it, or refuse the file because of it (journal::recovery_plan). False when there is no
+/// journal or it holds nothing of the file as it is. Read-only: nothing is locked or written.
+bool journal_acts_on_open(const std::string& results_path);
+
 /// A token that changes whenever the committed state of the file may have changed: while a journal
 /// exists, its header (commit sequence, writer-session id), its size and its last bytes (records
 /// being written or applied change them); else the file's size and mtime. Empty when the file does
