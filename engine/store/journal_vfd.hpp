@@ -22,6 +22,10 @@ hid_t make_journal_fapl(bool durable);
 /// (the next writer recovers it). Nothing for a file of another driver.
 void abandon_journal_file(hid_t file);
 
+/// The open file `file` (of this driver) was renamed to `new_path`, its journal to
+/// journal_path(new_path): the driver's messages and its close (which deletes the journal) use them.
+void rename_journal_file(hid_t file, const std::string& new_path);
+
 /// Path of the journal file that belongs to `results_path`.
 std::string journal_path(const std::string& results_path);
 

@@ -86,6 +86,15 @@ struct ResultsWriter::Impl {
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false, broken = false;
   bool touched = false;  ///< this writer created the file or wrote into it (close() then records when)
+  bool content = false;  ///< runs or optimizations were written (a file written aside is then placed)
+  /// A file created over an existing one (overwrite) is written aside, under this temporary name in
+  /// the same folder, with its own journal, while `path` keeps the previous file and `place_lock`
+  /// holds the writer lock of path's journal; the first commit after `content` (or at close())
+  /// renames it into place. Empty once placed (or for any other writer).
+  std::string aside;
+  int place_lock = -1;
+  void place_aside();   ///< journal then file renamed over path's (writer.cpp)
+  void drop_aside();    ///< the aside file and its journal removed, the lock released (a failed writer)
 
   /// Marks the writer broken and throws StoreError: the file keeps its last commit (the journal
   /// driver commits nothing more: abandon_journal_file; close() leaves the file as that commit left it).
