@@ -243,7 +243,7 @@ SensitivityArgs& add_sensitivity_command(CLI::App& app) {
   s->add_option("--format", a.format, "table (default) or json")->check(CLI::IsMember({"table", "json"}));
   s->add_option("--bootstrap", a.bootstrap, "bootstrap resamples for the intervals (default 1000; 0: none)");
   s->add_option("--confidence", a.confidence, "the intervals' level (default 0.95)");
-  s->add_option("--seed", a.seed, "seed of the resampling (default 1)");
+  s->add_option("--seed", a.seed, "seed of the resampling (default 1)")->check(CLI::NonNegativeNumber);
   return a;
 }
 
