@@ -108,7 +108,9 @@ def sensitivity(res, block=None, metric=None, bootstrap=1000, confidence=0.95, s
     """Indices of every block with a design (or `block`) for `metric` (default: the kind's ranking
     objective), one dict per combination of the block's other dimensions: block, kind, metric, unit,
     at ({axis: value} of the other dimensions), base_samples, factors (names), failed_runs ({status:
-    count}), not_done, and indices()'s entries."""
+    count}), not_done, not_done_samples (sample rows with a run not done), failed_samples (the other
+    sample rows with a failed run: the indices are conditional on success, good_status), and
+    indices()'s entries."""
     f = res.f
     out = []
     for name, d in designs(f).items():
@@ -142,7 +144,11 @@ def sensitivity(res, block=None, metric=None, bootstrap=1000, confidence=0.95, s
                     at[axis] = v.item() if hasattr(v, "item") else v
             r = {"block": name, "kind": d["kind"], "metric": m, "unit": _s(f["runs"][m].attrs.get("unit", "")), "at": at,
                  "base_samples": n, "factors": d["factors"], "not_done": int((~dn).sum()),
-                 "failed_runs": {s: int(c) for s, c in zip(*np.unique(st[failed], return_counts=True))}}
+                 "failed_runs": {s: int(c) for s, c in zip(*np.unique(st[failed], return_counts=True))},
+                 "good_status": good}
+            rows_not_done = (~dn).reshape(k + 2, n).any(axis=0)  # points A, B, AB_0.. of each sample row
+            r["not_done_samples"] = int(rows_not_done.sum())
+            r["failed_samples"] = int((failed.reshape(k + 2, n).any(axis=0) & ~rows_not_done).sum())
             r.update(indices(values[:n], values[n:2 * n], values[2 * n:].reshape(k, n), bootstrap, confidence, seed))
             out.append(r)
     return out

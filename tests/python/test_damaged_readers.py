@@ -255,6 +255,12 @@ class IntegerMetrics(TempDirTest):
         r = run("sensitivity", out, "--bootstrap", "0", "--metric", "iterations")
         self.assertIn(f"failed samples {failed_samples} of {n}", r.stdout)
         self.assertIn("conditional on success", r.stdout)
+        with python_package()(out) as res:  # kinesweep.read: the same counts for the integer metric
+            py = res.sensitivity(metric="iterations", bootstrap=0)
+        self.assertEqual([(p["failed_samples"], p["not_done_samples"], p["good_status"]) for p in py],
+                         [(failed_samples, 0, good)])
+        cli_first = got[metrics.index("iterations")]["factors"][0]["first"]
+        self.assertAlmostEqual(py[0]["first"][0], cli_first, delta=1e-5 * max(1, abs(cli_first)))
 
 
 class MinorRefusals(TempDirTest):
