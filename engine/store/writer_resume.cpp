@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "store/h5util.hpp"
+#include "store/journal_format.hpp"
 #include "store/journal_vfd.hpp"
 #include "store/label_columns.hpp"
 #include "store/runs_read.hpp"
@@ -93,6 +94,7 @@ ResultsWriter::Resumed ResultsWriter::open_for_resume(const std::string& path, c
   if (::stat(path.c_str(), &st) != 0) throw StoreError(path, std::string("cannot resume: ") + std::strerror(errno));
   if (!journal_has_pending_commit(path)) check_format_read_only(path);
   auto impl = open_writer_impl(path, options);
+  journal::remove_orphans(path);  // a killed creation's or overwrite's temporary file (its process is gone)
   hid_t f = impl->file;
   require_resumable_format(path, read_format_stamp(f));
   const std::string sha = read_str_attr(f, "study_sha256");

@@ -163,7 +163,8 @@ class Overwrite(TempDirTest):
     def setUp(self):
         super().setUp()
         self.out = os.path.join(self.dir, "r.h5")
-        r = run("run", self.write("small.toml", SMALL), "-o", self.out, "-q")
+        self.small = self.write("small.toml", SMALL)
+        r = run("run", self.small, "-o", self.out, "-q")
         self.assertEqual(r.returncode, 0, r.stderr)
         self.previous = digest(self.out)
         self.other = self.write("other.toml", OTHER)
@@ -200,6 +201,11 @@ class Overwrite(TempDirTest):
         r = run("info", self.out)
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertIn("small", r.stdout)
+        # the killed writer's aside file and journal: removed by the next writer of the path
+        self.assertNotEqual([n for n in os.listdir(self.dir) if n.startswith(".r.h5.tmp-")], [])
+        r = run("run", self.small, "-o", self.out, "--resume", "-q")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual([n for n in os.listdir(self.dir) if n.startswith(".r.h5.tmp-")], [])
 
     def test_killed_at_once(self):
         p = self.start()
