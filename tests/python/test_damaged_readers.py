@@ -157,6 +157,14 @@ class DamagedFiles(TempDirTest):
                 with python_package()(out) as res:
                     with self.assertRaisesRegex(ValueError, "/designs/local"):
                         res.sensitivity(bootstrap=10)
+        # the report (which lists the designs) refuses the file as well: exit 1, the object named
+        out = os.path.join(self.dir, f"fr{self.first_run + 1}.h5")
+        r = subprocess.run([sys.executable, "-m", "kinesweep.report", out, "-o", os.path.join(self.dir, "r.html")],
+                           capture_output=True, text=True, timeout=300,
+                           env=dict(os.environ, PYTHONPATH=os.path.join(SOURCE, "analysis")))
+        self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+        self.assertIn("/designs/local", r.stderr)
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "r.html")))
 
     def test_design_sizes_past_runs(self):
         for sizes in ([16 * 4 * 1000], [0], [-64], [2 ** 40 * 64]):
