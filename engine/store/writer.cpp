@@ -119,28 +119,6 @@ void ResultsWriter::Impl::count_chunk_done() {
     if (done[id]) ++chunk_done[id / cr];
 }
 
-namespace {
-/// The writer of a new file `tmp` (its skeleton written) that is to replace the existing file `path`:
-/// the previous file stays until the new one holds runs (Impl::aside). Takes the writer lock of
-/// path's journal now, so that no other writer starts on the previous file meanwhile.
-std::unique_ptr<ResultsWriter::Impl> open_aside(const std::string& path, const std::string& tmp,
-                                                const StoreOptions& options) {
-  const int lock = journal::acquire_lock(journal_path(path), [](int) { return true; });
-  if (lock < 0) throw StoreError(path, journal_last_error());
-  std::unique_ptr<ResultsWriter::Impl> impl;
-  try {
-    impl = open_writer_impl(tmp, options);
-  } catch (...) {
-    ::close(lock);
-    throw;
-  }
-  impl->path = path;
-  impl->aside = tmp;
-  impl->place_lock = lock;
-  return impl;
-}
-}  // namespace
-
 std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, const StoreMeta& meta,
                                                      const std::vector<ColumnSpec>& columns, std::int64_t n_runs,
                                                      const StoreOptions& options) {
@@ -190,7 +168,7 @@ std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, co
     if (H5Fclose(f.release()) < 0) throw StoreError(path, "cannot write " + tmp + ": " + h5_error_text());
     if (options.durable) fsync_path(tmp, false);  // against power loss only: a killed process loses nothing
     if (replaces && options.overwrite) {
-      auto impl = open_aside(path, tmp, options);
+      auto impl = open_aside(path, tmp, options);  // writer_aside.cpp
       impl->columns = columns;
       impl->n_runs = n_runs;
       impl->done.assign(static_cast<std::size_t>(n_runs), false);
@@ -505,36 +483,6 @@ void ResultsWriter::close() {
     std::string cause = "close failed: " + h5_error_text();
     throw StoreError(m.path, cause);
   }
-}
-
-void ResultsWriter::Impl::place_aside() {
-  // The journal first (it replaces the previous file's, whose lock this writer holds), then the file:
-  // a kill in between leaves the previous file with a journal of another file holding no commit,
-  // which the next writer replaces.
-  const std::string jp = journal_path(path), aside_jp = journal_path(aside);
-  if (::rename(aside_jp.c_str(), jp.c_str()) != 0) fail("cannot rename journal " + aside_jp + " to " + jp);
-  if (::rename(aside.c_str(), path.c_str()) != 0) {
-    const int e = errno;
-    ::rename(jp.c_str(), aside_jp.c_str());
-    errno = e;
-    fail("cannot rename " + aside + " over " + path + ": " + std::strerror(e));
-  }
-  rename_journal_file(file, path);
-  if (opt.durable) {
-    const std::string dir = std::filesystem::path(path).parent_path().string();
-    fsync_path(dir.empty() ? "." : dir, true);
-  }
-  ::close(place_lock);
-  place_lock = -1;
-  aside.clear();
-}
-
-void ResultsWriter::Impl::drop_aside() {
-  ::unlink(journal_path(aside).c_str());
-  ::unlink(aside.c_str());
-  if (place_lock >= 0) ::close(place_lock);
-  place_lock = -1;
-  aside.clear();
 }
 
 }  // namespace ks::store

@@ -134,6 +134,12 @@ void validate_name(const std::string& path, const std::string& name, const std::
 void set_format(hid_t fapl);
 /// A file-space selection of `dset`'s rows `ids` (sorted, unique) as a union of hyperslabs.
 Hid select_rows(hid_t dset, const std::vector<hsize_t>& ids);
+/// The writer of a new file `tmp` (its skeleton written) that is to replace the existing file `path`
+/// (overwrite): the previous file stays until the new one holds runs (Impl::aside). Takes the writer
+/// lock of path's journal at once, so that no other writer starts on the previous file meanwhile.
+/// Only path, opt, file, aside and place_lock are set. Throws StoreError (writer_aside.cpp).
+std::unique_ptr<ResultsWriter::Impl> open_aside(const std::string& path, const std::string& tmp,
+                                                const StoreOptions& opt);
 /// Opens an existing results file for writing through the journal driver (which recovers it first
 /// after a crash). Only path, opt and file are set. Throws StoreError.
 std::unique_ptr<ResultsWriter::Impl> open_writer_impl(const std::string& path, const StoreOptions& opt);
