@@ -411,7 +411,11 @@ class Results:
             axes.append(Axis(a, unit, vals, labels))
         units, desc, shown = {}, {}, {}
         names = [_s(x) for x in g.attrs["metrics"]]
+        shape = tuple(len(a.values) for a in axes)
         for m in names:
+            if m not in g or g[m].shape != shape:
+                raise ValueError(f"{self.path}: /landscapes/{block}/{m} has shape "
+                                 f"{g[m].shape if m in g else 'none (absent)'}; its axes make {shape}")
             units[m] = _s(g[m].attrs.get("unit", ""))
             desc[m] = _s(g[m].attrs.get("description", ""))
             shown[m] = display_name(g[m], m)

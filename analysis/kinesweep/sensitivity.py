@@ -16,7 +16,8 @@ from kinesweep.kinds import _s, text_values
 
 
 def designs(f):
-    """The /designs groups of an open h5py file: block -> dict of its attributes (FORMAT.md)."""
+    """The /designs groups of an open h5py file: block -> dict of its attributes (FORMAT.md). Raises
+    ValueError naming the group when a design does not fit /runs (check_design)."""
     if "designs" not in f:
         return {}
     out = {}
@@ -25,7 +26,46 @@ def designs(f):
         out[block] = {"kind": _s(a["kind"]), "design": _s(a["design"]), "factors": [_s(x) for x in a["factors"]],
                       "base_samples": int(a["base_samples"]), "first_run": int(a["first_run"]),
                       "dims": [_s(x) for x in a["dims"]], "sizes": [int(x) for x in a["sizes"]], "dim": int(a["dim"])}
+        check_design(f, block, out[block])
     return out
+
+
+def check_design(f, block, d):
+    """Raises ValueError ("FILE: /designs/BLOCK: ...") unless design `d` of `block` is consistent and its
+    rows [first_run, first_run + prod(sizes)) lie inside /runs and are its block's rows: run_id equal
+    to the row at both ends, the block column equal to the block's name at both ends and different
+    just outside them (as `kinesweep sensitivity` checks)."""
+    where = f"{f.filename}: /designs/{block}"
+    sizes, dim, n_rows = d["sizes"], d["dim"], len(f["runs"]["done"])
+    if (len(d["dims"]) != len(sizes) or not 0 <= dim < len(sizes) or d["base_samples"] < 1 or min(sizes) < 1
+            or sizes[dim] != d["base_samples"] * (len(d["factors"]) + 2)):
+        raise ValueError(f"{where} is inconsistent (dims, sizes, dim, base_samples, factors)")
+    runs = 1
+    for s in sizes:
+        runs *= s
+    first, last = d["first_run"], d["first_run"] + runs - 1
+    if first < 0 or last >= n_rows:
+        raise ValueError(f"{where}: rows {first}..{last} (first_run, sizes) lie outside the {n_rows} rows of /runs")
+    runs_g = f["runs"]
+    if "run_id" in runs_g:
+        for row in (first, last):
+            if int(runs_g["run_id"][row]) != row:
+                raise ValueError(f"{where}: /runs/run_id of row {row} is not {row}")
+    if "block" not in runs_g:
+        return
+    col = runs_g["block"]
+
+    def block_at(row):
+        return str(text_values(col, col[row:row + 1])[0])
+
+    for row in (first, last):
+        if block_at(row) != block:
+            raise ValueError(f"{where}: row {row} of /runs belongs to block {block_at(row)!r}, not to the design's "
+                             f"block (first_run {first})")
+    for row in (first - 1, last + 1):
+        if 0 <= row < n_rows and block_at(row) == block:
+            raise ValueError(f"{where}: row {row} of /runs also belongs to block {block!r}: the design (first_run "
+                             f"{first}, {runs} rows) does not cover its block's rows")
 
 
 def indices(a, b, ab, bootstrap=1000, confidence=0.95, seed=1):
@@ -68,7 +108,9 @@ def sensitivity(res, block=None, metric=None, bootstrap=1000, confidence=0.95, s
     """Indices of every block with a design (or `block`) for `metric` (default: the kind's ranking
     objective), one dict per combination of the block's other dimensions: block, kind, metric, unit,
     at ({axis: value} of the other dimensions), base_samples, factors (names), failed_runs ({status:
-    count}), not_done, and indices()'s entries."""
+    count}), not_done, not_done_samples (sample rows with a run not done), failed_samples (the other
+    sample rows with a failed run: the indices are conditional on success, good_status), and
+    indices()'s entries."""
     f = res.f
     out = []
     for name, d in designs(f).items():
@@ -102,7 +144,11 @@ def sensitivity(res, block=None, metric=None, bootstrap=1000, confidence=0.95, s
                     at[axis] = v.item() if hasattr(v, "item") else v
             r = {"block": name, "kind": d["kind"], "metric": m, "unit": _s(f["runs"][m].attrs.get("unit", "")), "at": at,
                  "base_samples": n, "factors": d["factors"], "not_done": int((~dn).sum()),
-                 "failed_runs": {s: int(c) for s, c in zip(*np.unique(st[failed], return_counts=True))}}
+                 "failed_runs": {s: int(c) for s, c in zip(*np.unique(st[failed], return_counts=True))},
+                 "good_status": good}
+            rows_not_done = (~dn).reshape(k + 2, n).any(axis=0)  # points A, B, AB_0.. of each sample row
+            r["not_done_samples"] = int(rows_not_done.sum())
+            r["failed_samples"] = int((failed.reshape(k + 2, n).any(axis=0) & ~rows_not_done).sum())
             r.update(indices(values[:n], values[n:2 * n], values[2 * n:].reshape(k, n), bootstrap, confidence, seed))
             out.append(r)
     return out

@@ -1,9 +1,11 @@
 #include "cli/robot_command.hpp"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -243,6 +245,15 @@ void print_json(const RobotView& v, std::ostream& os) {
      << ", \"redundancy\": " << c.dof() - v.task_rows << "}}\n";
 }
 
+/// True when `file` starts with the HDF5 signature (a results file given where a study or URDF is
+/// expected).
+bool is_hdf5(const std::string& file) {
+  static constexpr char kSignature[8] = {'\x89', 'H', 'D', 'F', '\r', '\n', '\x1a', '\n'};
+  char head[8] = {};
+  std::ifstream in(file, std::ios::binary);
+  return in.read(head, sizeof head) && std::equal(head, head + 8, kSignature);
+}
+
 bool is_urdf(const std::string& file) {
   const std::string ext = std::filesystem::path(file).extension().string();
   return ext == ".urdf" || ext == ".xml";
@@ -265,6 +276,11 @@ RobotArgs& add_robot_command(CLI::App& app) {
 
 int robot_command(const RobotArgs& a, std::ostream& out, std::ostream& err) {
   RobotView v;
+  if (is_hdf5(a.file)) {
+    err << "kinesweep robot: " << a.file << ": an HDF5 file (a results file?), not a robot description; expected a "
+        << "study (TOML) or a URDF file (.urdf, .xml); kinesweep info FILE describes a results file\n";
+    return 2;
+  }
   if (is_urdf(a.file)) {
     if (a.base.empty() || a.tip.empty()) {
       err << "kinesweep robot: " << a.file << " is a URDF file; expected --base LINK and --tip LINK (the chain's links)\n";

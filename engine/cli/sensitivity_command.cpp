@@ -22,6 +22,9 @@ struct Result {
   std::string metric, unit, at;  ///< at: "method=local_weighted" (the other axes' values), "" when none
   std::map<std::string, std::uint64_t> failed;  ///< status -> runs of the design (not the good status)
   std::uint64_t not_done = 0;
+  std::string good;                   ///< the kind's good status: the indices are conditional on it
+  std::uint64_t failed_samples = 0;   ///< sample rows left out because a run of theirs failed (all done)
+  std::uint64_t not_done_samples = 0; ///< sample rows left out because a run of theirs is not done
   SobolIndices s;
 };
 
@@ -35,6 +38,21 @@ BlockKind kind_of(const std::string& name) {
   for (BlockKind k : block_kinds())
     if (to_string(k) == name) return k;
   throw std::runtime_error("unknown run kind '" + name + "' in /designs");
+}
+
+/// Runs of the design with a status other than the good one.
+std::uint64_t failed_runs(const Result& r) {
+  std::uint64_t n = 0;
+  for (const auto& [status, k] : r.failed) n += k;
+  return n;
+}
+
+/// `count` values of the numeric /runs column `c` from row `first`, as doubles (an i64 column converted).
+std::vector<double> read_numbers(store::ResultsReader& reader, const ColumnSpec& c, std::int64_t first,
+                                 std::int64_t count) {
+  if (c.type == CellType::f64) return reader.read_f64(c.name, first, count);
+  const std::vector<std::int64_t> v = reader.read_i64(c.name, first, count);
+  return std::vector<double>(v.begin(), v.end());
 }
 
 /// The indices of every metric for every combination of the design block's other dimensions.
@@ -54,7 +72,7 @@ void analyse(store::ResultsReader& reader, const store::DesignMeta& d, const std
   const std::int64_t n = d.base_samples, f = static_cast<std::int64_t>(d.factors.size());
   for (const std::string& metric : metrics) {
     const auto it = std::find_if(cols.begin(), cols.end(), [&](const ColumnSpec& c) { return c.name == metric; });
-    const std::vector<double> y = reader.read_f64(metric, d.first_run, runs);
+    const std::vector<double> y = read_numbers(reader, *it, d.first_run, runs);
     for (std::int64_t c = 0; c < combos; ++c) {
       // the local index of point 0 of the design at combination c of the other dimensions
       std::int64_t base = 0, rest = c;
@@ -65,6 +83,7 @@ void analyse(store::ResultsReader& reader, const store::DesignMeta& d, const std
       }
       Result r;
       r.design = &d;
+      r.good = good;
       r.metric = metric;
       r.unit = it->unit;
       const Record row = nd > 1 ? reader.read_record(d.first_run + base) : Record{};  // the other axes' values
@@ -85,9 +104,12 @@ void analyse(store::ResultsReader& reader, const store::DesignMeta& d, const std
       std::vector<double> a(n), b(n);
       std::vector<std::vector<double>> ab(f, std::vector<double>(n));
       for (std::int64_t j = 0; j < n; ++j) {
+        const std::uint64_t not_done = r.not_done, failed = failed_runs(r);
         a[j] = value(j);
         b[j] = value(n + j);
         for (std::int64_t m = 0; m < f; ++m) ab[m][j] = value((2 + m) * n + j);
+        if (r.not_done != not_done) ++r.not_done_samples;
+        else if (failed_runs(r) != failed) ++r.failed_samples;
       }
       std::vector<std::span<const double>> spans(ab.begin(), ab.end());
       r.s = sobol_indices(a, b, spans, opt);
@@ -112,6 +134,11 @@ void print_table(const std::vector<Result>& results, double confidence, std::ost
       os << " runs)";
     }
     os << "\n";
+    if (r.failed_samples)
+      os << "  failed samples " << r.failed_samples << " of " << d.base_samples
+         << ": the indices are conditional on success (computed over the samples whose runs all ended " << r.good
+         << ")\n";
+    if (r.not_done_samples) os << "  samples not done " << r.not_done_samples << " of " << d.base_samples << "\n";
     const int pct = static_cast<int>(std::lround(confidence * 100));
     std::snprintf(line, sizeof line, "  %-22s %9s  %-21s %9s  %-21s\n", "factor", "S1", (std::to_string(pct) + "% interval").c_str(),
                   "ST", (std::to_string(pct) + "% interval").c_str());
@@ -136,7 +163,10 @@ void print_json(const std::string& file, const std::vector<Result>& results, con
     os << (k ? "," : "") << "\n {\"block\": " << json_string(d.block) << ", \"kind\": " << json_string(d.kind)
        << ", \"metric\": " << json_string(r.metric) << ", \"unit\": " << json_string(r.unit)
        << ", \"at\": " << json_string(r.at) << ", \"base_samples\": " << d.base_samples
-       << ", \"samples\": " << r.s.samples << ", \"dropped\": " << r.s.dropped << ", \"not_done\": " << r.not_done
+       << ", \"samples\": " << r.s.samples << ", \"dropped\": " << r.s.dropped << ", \"failed_samples\": "
+       << r.failed_samples << ", \"not_done_samples\": " << r.not_done_samples
+       << ", \"conditional_on_success\": " << (r.failed_samples ? "true" : "false")
+       << ", \"good_status\": " << json_string(r.good) << ", \"not_done\": " << r.not_done
        << ", \"failed_runs\": {";
     bool first = true;
     for (const auto& [st, c] : r.failed) os << (first ? "" : ", ") << json_string(st) << ": " << c, first = false;
@@ -213,7 +243,7 @@ SensitivityArgs& add_sensitivity_command(CLI::App& app) {
   s->add_option("--format", a.format, "table (default) or json")->check(CLI::IsMember({"table", "json"}));
   s->add_option("--bootstrap", a.bootstrap, "bootstrap resamples for the intervals (default 1000; 0: none)");
   s->add_option("--confidence", a.confidence, "the intervals' level (default 0.95)");
-  s->add_option("--seed", a.seed, "seed of the resampling (default 1)");
+  s->add_option("--seed", a.seed, "seed of the resampling (default 1)")->check(CLI::NonNegativeNumber);
   return a;
 }
 

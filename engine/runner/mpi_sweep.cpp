@@ -38,26 +38,6 @@ bool env_set(const char* name) {
   return v && *v;
 }
 
-/// Shards of `output` that exist, by rank: `<out>.rank<digits>.h5`.
-std::vector<std::string> find_shards(const std::string& output) {
-  const fs::path p(output);
-  const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
-  const std::string prefix = p.filename().string() + ".rank";
-  std::vector<std::pair<long, std::string>> found;
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator(dir, ec)) {
-    const std::string name = e.path().filename().string();
-    if (name.size() <= prefix.size() + 3 || name.rfind(prefix, 0) != 0 || !name.ends_with(".h5")) continue;
-    const std::string digits = name.substr(prefix.size(), name.size() - prefix.size() - 3);
-    if (digits.empty() || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
-      continue;
-    found.emplace_back(std::stol(digits), (p.parent_path() / name).string());
-  }
-  std::sort(found.begin(), found.end());
-  std::vector<std::string> out;
-  for (auto& [r, path] : found) out.push_back(std::move(path));
-  return out;
-}
 
 /// Rank 0 after the sweep: final file (or a new one) + every shard -> the final file, in run-id
 /// order; then landscapes via run_sweep (which computes nothing, every run being done); then the

@@ -1,7 +1,12 @@
 // One "run a study" path (see run_study.hpp) and the local backend (this process's threads).
 #include "runner/run_study.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
@@ -167,8 +172,36 @@ std::uint64_t skeleton_bytes(const StudySchema& schema, std::uint64_t runs) {
 
 }  // namespace
 
+std::vector<std::string> find_shards(const std::string& output) {
+  const fs::path p(output);
+  const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+  const std::string prefix = p.filename().string() + ".rank";
+  std::vector<std::pair<long, std::string>> found;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() <= prefix.size() + 3 || name.rfind(prefix, 0) != 0 || !name.ends_with(".h5")) continue;
+    const std::string digits = name.substr(prefix.size(), name.size() - prefix.size() - 3);
+    if (digits.empty() || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      continue;
+    found.emplace_back(std::stol(digits), (p.parent_path() / name).string());
+  }
+  std::sort(found.begin(), found.end());
+  std::vector<std::string> out;
+  for (auto& [r, path] : found) out.push_back(std::move(path));
+  return out;
+}
+
 void check_free_space(const std::string& out, const StudySchema& schema, std::uint64_t runs, int files) {
   const fs::path dir = fs::path(out).parent_path().empty() ? fs::path(".") : fs::path(out).parent_path();
+  {  // a folder no file can be created in (read-only, no permission) is no free-space problem
+    const std::string probe = (dir / ("." + fs::path(out).filename().string() + ".probe-" + std::to_string(::getpid()))).string();
+    const int fd = ::open(probe.c_str(), O_CREAT | O_EXCL | O_WRONLY | O_CLOEXEC, 0600);
+    if (fd < 0 && errno != EEXIST)
+      throw store::StoreError(out, "cannot create a file in directory '" + dir.string() + "': " + std::strerror(errno) +
+                                       "; expected a folder this user can write to");
+    if (fd >= 0) ::close(fd), ::unlink(probe.c_str());
+  }
   std::error_code ec;
   const fs::space_info sp = fs::space(dir, ec);
   if (ec) return;  // unknown: the writer reports a full disk as it happens
@@ -258,6 +291,17 @@ class LocalBackend final : public SweepBackend {
     const bool exists = fs::exists(out);
     if (const std::string why = refuse_existing(out, exists, "exists", r); !why.empty()) {
       err << "kinesweep run: " << why << '\n';
+      return 1;
+    }
+    // Shards of a distributed run hold runs of `out` that this process would not see: refused
+    // before anything is written (an MPI launch of one rank merges them).
+    if (const std::vector<std::string> shards = find_shards(out); !shards.empty() && !r.overwrite) {
+      std::string names;
+      for (const auto& s : shards) names += (names.empty() ? "" : ", ") + s;
+      err << "kinesweep run: " << out << " has shards of an unfinished distributed run (" << names
+          << "); nothing was written. Resume it with: mpirun -np 1 " << r.program << " run " << shell_word(r.study_arg)
+          << " -o " << shell_word(out) << " --resume (the launch merges the shards), or delete the shards to "
+          << (exists ? "resume " + out + " alone" : "start afresh") << '\n';
       return 1;
     }
     store::StoreOptions so;  // commits every second (see StoreOptions)

@@ -69,6 +69,9 @@ OpenedResults open_results(const Study& study, const StudySchema& schema, const 
                            const store::StoreOptions& options, const HistoryPolicy& histories,
                            bool adopt_recorded);
 
+/// The shards of a distributed run of `output` that exist (`<out>.rank<digits>.h5`), by rank.
+std::vector<std::string> find_shards(const std::string& output);
+
 /// Throws store::StoreError when `files` new results files (a file and its shards) of `runs` rows
 /// would not fit, before any run, in the free space of `out`'s directory.
 void check_free_space(const std::string& out, const StudySchema& schema, std::uint64_t runs, int files);

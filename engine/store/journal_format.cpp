@@ -174,45 +174,61 @@ std::string mismatch(const Parsed& p, int fd) {
   return {};
 }
 
-bool recover_locked(int fd, int jfd, std::uint64_t dev, std::uint64_t ino, std::string* why) {
+Plan recovery_plan(int fd, int jfd, std::uint64_t dev, std::uint64_t ino, std::string* why) {
   why->clear();
   Parsed p = parse_journal(jfd);
   if (p.version == 0) {
     // Empty, or shorter than a header and either zeros or the start of one (a writer stopped while
     // writing its header): nothing to recover. Anything else is not a kinesweep journal.
     struct stat js{};
-    if (::fstat(jfd, &js) != 0) return false;
+    if (::fstat(jfd, &js) != 0) return Plan::refuse;
     const std::size_t n = static_cast<std::size_t>(js.st_size);
-    if (n == 0) return true;
+    if (n == 0) return Plan::nothing;
     if (n < kHeadSize) {
       unsigned char b[kHeadSize] = {};
-      if (!read_all(jfd, b, n, 0)) return false;
+      if (!read_all(jfd, b, n, 0)) return Plan::refuse;
       bool zeros = true;
       for (std::size_t i = 0; i < n; ++i) zeros = zeros && b[i] == 0;
       const std::size_t m = std::min<std::size_t>(n, 7);  // "KSJRNL0" of either version
-      if (zeros || std::memcmp(b, kHeadMagic, m) == 0) return true;
+      if (zeros || std::memcmp(b, kHeadMagic, m) == 0) return Plan::nothing;
     }
     *why = "the journal is not a kinesweep journal (no KSJRNL header)";
-    return false;
+    return Plan::refuse;
   }
   if (p.dev != dev || p.ino != ino) {
-    if (!p.commit_ok) return true;  // another file's journal with nothing committed: nothing of this file
+    if (!p.commit_ok) return Plan::nothing;  // another file's journal with nothing committed: nothing of this file
     *why = "the journal holds a commit for another file (device/inode differ: the file was replaced after its "
            "writer stopped)";
-    return false;
+    return Plan::refuse;
   }
   // Every results file is larger than an HDF5 superblock: a journal committing fewer bytes was not
   // written for this file (recovery would truncate it)
   if (p.committed < kMinCommittedSize) {
     *why = "the journal claims a committed size of " + std::to_string(p.committed) +
            " bytes, less than any results file (not a journal of this file)";
-    return false;
+    return Plan::refuse;
+  }
+  if (p.version == 1) {
+    *why = "the journal has a version 1 header (KSJRNL01, kinesweep before the fingerprint): nothing in it shows "
+           "that it belongs to the file as it is; recover it with the kinesweep that wrote it";
+    return Plan::refuse;
   }
   *why = mismatch(p, fd);
   if (!why->empty()) {
     *why += "; the file was changed after its writer stopped";
-    return false;
+    return Plan::refuse;
   }
+  struct stat st{};
+  if (::fstat(fd, &st) != 0) return Plan::refuse;
+  if (p.commit_ok || static_cast<std::uint64_t>(st.st_size) > p.committed) return Plan::recover;
+  return Plan::nothing;
+}
+
+bool recover_locked(int fd, int jfd, std::uint64_t dev, std::uint64_t ino, std::string* why) {
+  const Plan plan = recovery_plan(fd, jfd, dev, ino, why);
+  if (plan == Plan::refuse) return false;
+  if (plan == Plan::nothing) return true;
+  const Parsed p = parse_journal(jfd);
   struct stat st{};
   if (::fstat(fd, &st) != 0) return false;
   const std::uint64_t size = static_cast<std::uint64_t>(st.st_size);
@@ -281,6 +297,22 @@ std::string consistency_stamp(const std::string& results_path) {
 
 bool journal_has_pending_commit(const std::string& results_path) {
   return read_view(results_path).kind != ReadView::plain;
+}
+
+bool journal_acts_on_open(const std::string& results_path) {
+  const int jfd = ::open(journal_path(results_path).c_str(), O_RDONLY | O_CLOEXEC);
+  if (jfd < 0) return false;
+  const int fd = ::open(results_path.c_str(), O_RDONLY | O_CLOEXEC);
+  struct stat st{};
+  bool acts = true;  // a file that cannot be examined: the writer's open reports it
+  if (fd >= 0 && ::fstat(fd, &st) == 0) {
+    std::string why;
+    acts = recovery_plan(fd, jfd, static_cast<std::uint64_t>(st.st_dev), static_cast<std::uint64_t>(st.st_ino),
+                         &why) != Plan::nothing;
+  }
+  if (fd >= 0) ::close(fd);
+  ::close(jfd);
+  return acts;
 }
 
 }  // namespace ks::store::detail

@@ -74,6 +74,16 @@ Parsed parse_journal(int jfd);
 /// of the difference. Version 1 journals carry no fingerprint: their sizes alone are checked.
 std::string mismatch(const Parsed& p, int fd);
 
+/// What a writer's open does with journal `jfd` of the data file fd (identity dev/ino), decided
+/// without writing: nothing (the journal holds nothing of the file as it is: empty, cut within its
+/// header, another file's without a commit, or committing the file's present size), recover (replay
+/// a commit, or drop the bytes appended after the last one) or refuse (*why says what was found, or
+/// is empty after an I/O error). A version 1 journal of this file is refused: without a fingerprint
+/// nothing shows that it belongs to the file as it is (its committed size alone may cut a finished
+/// file).
+enum class Plan { nothing, recover, refuse };
+Plan recovery_plan(int fd, int jfd, std::uint64_t dev, std::uint64_t ino, std::string* why);
+
 /// With the journal locked: bring the data file to its last committed state (replay a commit, or
 /// drop the bytes appended after the last one) when the journal belongs to it. Returns false on an
 /// I/O error or when the journal does not belong to the file (then nothing was written; *why says

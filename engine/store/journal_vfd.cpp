@@ -488,6 +488,17 @@ void abandon_journal_file(hid_t file) {
   if (it != g_open.end()) it->second->abandoned = true;
 }
 
+void rename_journal_file(hid_t file, const std::string& new_path) {
+  void* handle = nullptr;
+  if (H5Fget_vfd_handle(file, H5P_DEFAULT, &handle) < 0 || !handle) {
+    H5Eclear2(H5E_DEFAULT);
+    return;
+  }
+  std::lock_guard<std::mutex> lk(g_open_mutex);
+  const auto it = g_open.find(static_cast<const int*>(handle));
+  if (it != g_open.end()) it->second->path = new_path;
+}
+
 hid_t make_journal_read_fapl() {
   hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
   JFapl fa{0, 1};

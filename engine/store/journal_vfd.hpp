@@ -22,6 +22,10 @@ hid_t make_journal_fapl(bool durable);
 /// (the next writer recovers it). Nothing for a file of another driver.
 void abandon_journal_file(hid_t file);
 
+/// The open file `file` (of this driver) was renamed to `new_path`, its journal to
+/// journal_path(new_path): the driver's messages and its close (which deletes the journal) use them.
+void rename_journal_file(hid_t file, const std::string& new_path);
+
 /// Path of the journal file that belongs to `results_path`.
 std::string journal_path(const std::string& results_path);
 
@@ -45,6 +49,11 @@ ReadView read_view(const std::string& results_path);
 /// True when the journal holds a complete commit for this file, not yet applied (read_view() is not
 /// plain): the file must then not be read as it is on disk.
 bool journal_has_pending_commit(const std::string& results_path);
+
+/// True when a journal lies beside `results_path` and a writer's open would act on it: recover the
+/// file from it, or refuse the file because of it (journal::recovery_plan). False when there is no
+/// journal or it holds nothing of the file as it is. Read-only: nothing is locked or written.
+bool journal_acts_on_open(const std::string& results_path);
 
 /// A token that changes whenever the committed state of the file may have changed: while a journal
 /// exists, its header (commit sequence, writer-session id), its size and its last bytes (records

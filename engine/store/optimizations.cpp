@@ -85,6 +85,7 @@ void ResultsWriter::write_optimization(const OptimizationRecord& r) {
   Impl& m = *impl_;
   m.usable();
   m.touched = true;
+  m.content = true;
   if (r.name.empty() || r.name == "." || r.name == ".." || r.name.find('/') != std::string::npos)
     throw StoreError(m.path, "invalid optimization name '" + r.name + "' (empty, '.', '..' or contains '/')");
   const std::size_t d = r.dims(), n = r.size();

@@ -217,11 +217,22 @@ LandscapeSpec ResultsReader::read_landscape(const std::string& block, bool grids
       check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), impl_->path, "read " + name);
     spec.axes.push_back({name, read_str_attr(d, "unit"), std::move(v)});
   }
+  // every metric grid holds one value per cell of the axes' grid
+  std::uint64_t cells = 1;
+  for (const auto& a : spec.axes)
+    cells = a.values.empty() || cells <= UINT64_MAX / a.values.size() ? cells * a.values.size() : UINT64_MAX;
   for (auto& name : read_str_list_attr(g, "metrics")) {
-    if (!grids) {
+    {
       Hid d(check(H5Dopen2(g, name.c_str(), H5P_DEFAULT), impl_->path, "open /" + gp + "/" + name));
-      spec.metrics.push_back({name, read_str_attr(d, "unit"), read_str_attr(d, "description"), {}});
-      continue;
+      Hid s(H5Dget_space(d));
+      const hssize_t n = H5Sget_simple_extent_npoints(s);
+      if (n < 0 || static_cast<std::uint64_t>(n) != cells)
+        throw StoreError(impl_->path, "/" + gp + "/" + name + " has " + std::to_string(n) + " cells; its axes make " +
+                                          std::to_string(cells));
+      if (!grids) {
+        spec.metrics.push_back({name, read_str_attr(d, "unit"), read_str_attr(d, "description"), {}});
+        continue;
+      }
     }
     auto [v, unit] = read_all(name);
     Hid d(H5Dopen2(g, name.c_str(), H5P_DEFAULT));

@@ -84,6 +84,18 @@ IndexEntry index_entry(HistoryIndexCache& c, std::int64_t id, std::int64_t n_run
   return e;
 }
 
+/// Throws StoreError naming /histories/<dataset> unless the run's rows [start, start + rows) lie
+/// inside dataset `d` (a damaged index would read other runs' rows or past the end).
+void check_rows(const HistoryDataset& d, const IndexEntry& e, std::int64_t run_id, const std::string& path) {
+  if (d.cols == 0) return;  // an array of no columns: a fixed (0 x 0) dataset
+  Hid s(H5Dget_space(d.dset));
+  hsize_t dims[2] = {0, 0};
+  if (H5Sget_simple_extent_dims(s, dims, nullptr) < 1 || e.start > dims[0] || e.rows > dims[0] - e.start)
+    throw StoreError(path, "/histories/" + d.name + ": run " + std::to_string(run_id) + "'s rows [" +
+                               std::to_string(e.start) + ", " + std::to_string(e.start + e.rows) + ") lie outside its " +
+                               std::to_string(dims[0]) + " rows (/histories/start, rows)");
+}
+
 RunHistory read_v2(hid_t file, std::int64_t run_id, std::int64_t n_runs, const std::string& path) {
   RunHistory h;
   const std::string g = "histories/" + history_group_name(run_id, n_runs);
@@ -135,6 +147,7 @@ RunHistory ResultsReader::read_history(std::int64_t run_id) const {
   if (run_id < 0 || run_id >= r.n_runs) return h;
   const IndexEntry e = index_entry(cache_of(r.hist, r.file, r.path), run_id, r.n_runs, r.path);
   for (const HistoryDataset* d : e.datasets) {
+    check_rows(*d, e, run_id, r.path);
     HistoryArray a{d->array, d->unit, e.rows, d->cols, std::vector<double>(e.rows * d->cols)};
     if (!a.data.empty()) {
       Hid fs(H5Dget_space(d->dset));
@@ -161,6 +174,7 @@ EncodedHistory ResultsReader::read_history_chunks(std::int64_t run_id, int level
   if (run_id < 0 || run_id >= r.n_runs) return out;
   const IndexEntry e = index_entry(cache_of(r.hist, r.file, r.path), run_id, r.n_runs, r.path);
   for (const HistoryDataset* d : e.datasets) {
+    check_rows(*d, e, run_id, r.path);
     EncodedArray a;
     a.name = d->array; a.unit = d->unit; a.rows = e.rows; a.cols = d->cols;
     a.chunk_rows = e.rows == 0 ? 0 : e.chunk_rows;

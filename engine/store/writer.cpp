@@ -134,7 +134,8 @@ std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, co
       throw StoreError(path, "column '" + c.name + "': its labels must be 1 to 65534 distinct, non-empty names");
   }
   struct stat st{};
-  if (::stat(path.c_str(), &st) == 0) {
+  const bool replaces = ::stat(path.c_str(), &st) == 0;
+  if (replaces) {
     if (S_ISDIR(st.st_mode)) throw StoreError(path, "is a directory");
     if (!options.overwrite) throw StoreError(path, "file exists (pass overwrite to replace it)");
   }
@@ -166,6 +167,17 @@ std::unique_ptr<ResultsWriter> ResultsWriter::create(const std::string& path, co
     }
     if (H5Fclose(f.release()) < 0) throw StoreError(path, "cannot write " + tmp + ": " + h5_error_text());
     if (options.durable) fsync_path(tmp, false);  // against power loss only: a killed process loses nothing
+    if (replaces && options.overwrite) {
+      auto impl = open_aside(path, tmp, options);  // writer_aside.cpp
+      impl->columns = columns;
+      impl->n_runs = n_runs;
+      impl->done.assign(static_cast<std::size_t>(n_runs), false);
+      impl->open_objects();
+      impl->count_chunk_done();
+      impl->touched = true;
+      impl->content = n_runs == 0;  // complete as created: placed at its first commit
+      return std::unique_ptr<ResultsWriter>(new ResultsWriter(std::move(impl)));
+    }
     if (!options.overwrite && ::stat(path.c_str(), &st) == 0)
       throw StoreError(path, "file exists (pass overwrite to replace it)");
     // The writer lock, held while the new file is put into place: the journal of a file we replace
@@ -247,6 +259,7 @@ void ResultsWriter::write_run(std::int64_t run_id, const Record& record, const E
   Impl& m = *impl_;
   m.usable();
   m.touched = true;
+  m.content = true;
   if (run_id < 0 || run_id >= m.n_runs)
     throw StoreError(m.path, "run id " + std::to_string(run_id) + " outside 0.." + std::to_string(m.n_runs - 1));
   if (record.cells.size() != m.columns.size())
@@ -426,6 +439,7 @@ void ResultsWriter::Impl::do_flush() {
     unflagged.clear();
   }
   if (H5Fflush(file, H5F_SCOPE_LOCAL) < 0) fail("flush (commit) failed");
+  if (!aside.empty() && content) place_aside();
   uncommitted_bytes = 0;
   for (auto& s : landscape_streams) s.fresh = false;  // committed: later writes to them are journaled
   last_flush = std::chrono::steady_clock::now();
@@ -452,10 +466,12 @@ void ResultsWriter::close() {
     m.done_dset.reset(); m.runs.reset(); m.histories.reset(); m.landscapes.reset();
     H5Fclose(m.file.release());
     H5Eclear2(H5E_DEFAULT);
+    if (!m.aside.empty()) m.drop_aside();  // nothing of it was placed: the previous file stays
     return;
   }
   m.trim_histories();
   if (m.touched) write_str_attr(m.file, "closed", now_iso8601());  // the end of the last session that wrote it
+  m.content = true;  // closed: the file is complete as it is (placed by this last commit)
   m.do_flush();
   m.runs_chunks.clear();
   m.col_dsets.clear();

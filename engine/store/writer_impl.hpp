@@ -86,6 +86,15 @@ struct ResultsWriter::Impl {
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false, broken = false;
   bool touched = false;  ///< this writer created the file or wrote into it (close() then records when)
+  bool content = false;  ///< runs or optimizations were written (a file written aside is then placed)
+  /// A file created over an existing one (overwrite) is written aside, under this temporary name in
+  /// the same folder, with its own journal, while `path` keeps the previous file and `place_lock`
+  /// holds the writer lock of path's journal; the first commit after `content` (or at close())
+  /// renames it into place. Empty once placed (or for any other writer).
+  std::string aside;
+  int place_lock = -1;
+  void place_aside();   ///< journal then file renamed over path's (writer.cpp)
+  void drop_aside();    ///< the aside file and its journal removed, the lock released (a failed writer)
 
   /// Marks the writer broken and throws StoreError: the file keeps its last commit (the journal
   /// driver commits nothing more: abandon_journal_file; close() leaves the file as that commit left it).
@@ -125,6 +134,12 @@ void validate_name(const std::string& path, const std::string& name, const std::
 void set_format(hid_t fapl);
 /// A file-space selection of `dset`'s rows `ids` (sorted, unique) as a union of hyperslabs.
 Hid select_rows(hid_t dset, const std::vector<hsize_t>& ids);
+/// The writer of a new file `tmp` (its skeleton written) that is to replace the existing file `path`
+/// (overwrite): the previous file stays until the new one holds runs (Impl::aside). Takes the writer
+/// lock of path's journal at once, so that no other writer starts on the previous file meanwhile.
+/// Only path, opt, file, aside and place_lock are set. Throws StoreError (writer_aside.cpp).
+std::unique_ptr<ResultsWriter::Impl> open_aside(const std::string& path, const std::string& tmp,
+                                                const StoreOptions& opt);
 /// Opens an existing results file for writing through the journal driver (which recovers it first
 /// after a crash). Only path, opt and file are set. Throws StoreError.
 std::unique_ptr<ResultsWriter::Impl> open_writer_impl(const std::string& path, const StoreOptions& opt);

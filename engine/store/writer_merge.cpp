@@ -55,6 +55,7 @@ bool ResultsWriter::copy_runs(const std::vector<const ResultsReader*>& sources, 
   Impl& m = *impl_;
   m.usable();
   m.touched = true;
+  m.content = true;
   if (!m.runs_chunks.active() || std::any_of(m.chunk_col.begin(), m.chunk_col.end(), [](int c) { return c < 0; }))
     return false;
   const hsize_t cr = m.runs_chunks.chunk_rows();

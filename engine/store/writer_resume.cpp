@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "store/h5util.hpp"
+#include "store/journal_format.hpp"
 #include "store/journal_vfd.hpp"
 #include "store/label_columns.hpp"
 #include "store/runs_read.hpp"
@@ -47,14 +48,15 @@ void require_resumable_format(const std::string& path, const FormatStamp& s) {
 }
 
 /// Checks the format read-only, before anything opens the file for writing (which would touch it).
-/// A file that does not open read-only is refused untouched unless a journal exists beside it (a
-/// commit waiting in its journal: the check after the recovering open below catches that case).
+/// A file that does not open read-only is refused untouched unless the journal beside it acts on the
+/// file (recovers it, or makes the writer's open refuse it untouched: the check after the recovering
+/// open below catches the rest). A journal that holds nothing of the file (empty, cut within its
+/// header) does not save a file that is no results file.
 void check_format_read_only(const std::string& path) {
   Hid f(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
-  struct stat st{};
   if (!f.ok()) {
     H5Eclear2(H5E_DEFAULT);
-    if (::stat(journal_path(path).c_str(), &st) == 0) return;
+    if (journal_acts_on_open(path)) return;
     if (::access(path.c_str(), R_OK | W_OK) != 0) throw StoreError(path, std::string("cannot resume: ") + std::strerror(errno));
     struct stat fs{};
     const long long bytes = ::stat(path.c_str(), &fs) == 0 ? static_cast<long long>(fs.st_size) : -1;
@@ -63,9 +65,9 @@ void check_format_read_only(const std::string& path) {
                                "); nothing was written");
   }
   const FormatStamp s = read_format_stamp(f);
-  // Root attributes that do not read as a results file's while a journal exists: the file may have
-  // been changed after its writer stopped, which the recovering open reports as such.
-  if (s.format != kFormatName && ::stat(journal_path(path).c_str(), &st) == 0) return;
+  // Root attributes that do not read as a results file's while a journal acts on the file: the file
+  // may have been changed after its writer stopped, which the recovering open reports as such.
+  if (s.format != kFormatName && journal_acts_on_open(path)) return;
   require_resumable_format(path, s);
 }
 
@@ -92,6 +94,7 @@ ResultsWriter::Resumed ResultsWriter::open_for_resume(const std::string& path, c
   if (::stat(path.c_str(), &st) != 0) throw StoreError(path, std::string("cannot resume: ") + std::strerror(errno));
   if (!journal_has_pending_commit(path)) check_format_read_only(path);
   auto impl = open_writer_impl(path, options);
+  journal::remove_orphans(path);  // a killed creation's or overwrite's temporary file (its process is gone)
   hid_t f = impl->file;
   require_resumable_format(path, read_format_stamp(f));
   const std::string sha = read_str_attr(f, "study_sha256");

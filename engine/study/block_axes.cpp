@@ -143,7 +143,13 @@ void Parser::generate_axes(BlockDraft& d) {
       ranges.push_back(a.lhs_range);
       lhs_axes.push_back(&a);
     }
-  if (d.lhs_node && lhs_axes.empty() && d.lhs_node->as_table())
+  // An axis written { lhs = ... } or { saltelli = ... } whose settings were refused has its own
+  // error: the design's settings are then not unused.
+  bool written = false;
+  if (d.axes_t)
+    for (auto&& [k, n] : *d.axes_t)
+      if (const auto* t = n.as_table()) written = written || t->get("lhs") || t->get("saltelli");
+  if (d.lhs_node && lhs_axes.empty() && !written && d.lhs_node->as_table())
     error(*d.lhs_node, d.design + " settings given but no axis uses them; expected axes written { " + d.design +
                            " = { from, to } }");
   if (!lhs_axes.empty() && d.lhs_count && d.lhs_seed) {
