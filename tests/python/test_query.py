@@ -254,7 +254,7 @@ class QueryTest(unittest.TestCase):
     def test_column_attributes_describe_every_column(self):
         """role / kinds / unit / description of every /runs column (h5py) against what the engine writes."""
         with h5py.File(self.h5, "r") as f:
-            self.assertEqual(int(f.attrs["format_version"]), 4)
+            self.assertEqual(int(f.attrs["format_version"]), 5)
             runs = f["runs"]
             attrs = {k: {a: h5s(runs[k].attrs[a]) for a in ("role", "kinds", "unit", "description")} for k in runs}
         for c in ("run_id", "block", "status", "wall_time", "done"):
