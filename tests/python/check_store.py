@@ -26,7 +26,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from kslive import stamp  # noqa: E402  FORMAT.md, "Reading while a sweep runs"
 from kinesweep.kinds import enum_labels, text_values  # noqa: E402
 
-FORMAT_VERSION = 4
+FORMAT_VERSION = 5
 CHUNK_ROWS = 16384  # rows per chunk of the fixed-size /runs columns (FORMAT.md, "/runs")
 
 STATUSES = ["ok", "diverged", "singular", "ok-\u00f1"]
