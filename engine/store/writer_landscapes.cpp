@@ -387,7 +387,19 @@ bool ResultsWriter::copy_landscape(std::size_t landscape, const std::vector<cons
   std::vector<haddr_t> to(n_metrics, HADDR_UNDEF);
   std::vector<std::vector<haddr_t>> from_at(sources.size());
   std::vector<int> in_fd(sources.size(), -1);
-  for (std::size_t mt = 0; mt < n_metrics && by_offset; ++mt) to[mt] = H5Dget_offset(s.metrics[mt]);
+  // A grid smaller than HDF5's small-data block (an int8 grid of codes, a small f64 grid) comes
+  // from a block HDF5 may have reserved before the last commit, where the journal holds the pages:
+  // such grids go through HDF5.
+  hsize_t small = 2048;  // HDF5's default
+  {
+    Hid fapl(H5Fget_access_plist(m.file));
+    if (fapl.ok()) H5Pget_small_data_block_size(fapl, &small);
+  }
+  for (std::size_t mt = 0; mt < n_metrics && by_offset; ++mt) {
+    Hid type(H5Dget_type(s.metrics[mt]));
+    by_offset = type.ok() && cells * H5Tget_size(type) >= small;
+    to[mt] = H5Dget_offset(s.metrics[mt]);
+  }
   for (std::size_t k = 0; k < sources.size() && by_offset; ++k) {
     if (!used[k]) continue;
     in_fd[k] = sources[k]->bytes_are_committed_state() ? file_descriptor(static_cast<hid_t>(sources[k]->raw_file_id())) : -1;
