@@ -153,7 +153,7 @@ TEST(StoreColumns, ResumeRefusesAVersion1FileAndLeavesItUntouched) {
   const std::string msg = error_of([&] { ResultsWriter::open_for_resume(path, test_meta().study_sha256); });
   EXPECT_NE(msg.find(path), std::string::npos) << msg;
   EXPECT_NE(msg.find("results file format v1 (written by kinesweep " KINESWEEP_VERSION
-                     "); this kinesweep resumes v3 to v4: rerun with --overwrite"),
+                     "); this kinesweep resumes v3 to v5: rerun with --overwrite"),
             std::string::npos)
       << msg;
   EXPECT_EQ(slurp(path), before);

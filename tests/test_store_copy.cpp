@@ -139,10 +139,14 @@ LandscapeSpec copy_grid() {
     for (std::size_t i = 0; i < dims[a]; ++i) ax.values.push_back(static_cast<double>(i));
     spec.axes.push_back(ax);
   }
-  spec.metrics = {{"u", "m", "first", {}}, {"v", "s", "second", {}}};
+  spec.metrics = {{"u", "m", "first", {}}, {"v", "s", "second", {}}, {"w", "", "codes", {}, "w", {"p", "q", "r"}}};
   return spec;
 }
-double grid_value(std::size_t c, std::size_t m, int source) { return 1000.0 * source + 0.5 * m + 1e-3 * static_cast<double>(c); }
+/// Metric 2 is a grid of codes 0..2, NaN (none) in every fourth cell.
+double grid_value(std::size_t c, std::size_t m, int source) {
+  if (m == 2) return (c + static_cast<std::size_t>(source)) % 4 == 3 ? std::nan("") : static_cast<double>((c + static_cast<std::size_t>(source)) % 4);
+  return 1000.0 * source + 0.5 * m + 1e-3 * static_cast<double>(c);
+}
 
 TEST(StoreCopy, LandscapeCellsCopiedFromTheirOwnersGrid) {
   TempDir td;
@@ -157,25 +161,28 @@ TEST(StoreCopy, LandscapeCellsCopiedFromTheirOwnersGrid) {
     const std::size_t h = w->begin_landscape(spec);
     for (std::size_t c = 0; c < cells; ++c)
       if (owner[c] == s) {
-        const double v[2] = {grid_value(c, 0, s), grid_value(c, 1, s)};
+        const double v[3] = {grid_value(c, 0, s), grid_value(c, 1, s), grid_value(c, 2, s)};
         w->write_landscape_cell(h, c, v);
       }
     w->close();
   }
   auto w = ResultsWriter::create(td.file("dst.h5"), test_meta(), copy_columns(), n);
   const std::size_t h = w->begin_landscape(spec);
-  const double mine[2] = {-1.0, -2.0};
+  const double mine[3] = {-1.0, -2.0, 2.0};
   for (std::size_t c = 0; c < cells; ++c)
     if (owner[c] < 0) w->write_landscape_cell(h, c, mine);
   ResultsReader r0(td.file("src0.h5")), r1(td.file("src1.h5"));
   ASSERT_TRUE(w->copy_landscape(h, {&r0, &r1}, owner.data()));
   w->close();
   const LandscapeSpec got = ResultsReader(td.file("dst.h5")).read_landscape("b");
-  ASSERT_EQ(got.metrics.size(), 2u);
-  for (std::size_t m = 0; m < 2; ++m) {
+  ASSERT_EQ(got.metrics.size(), 3u);
+  for (std::size_t m = 0; m < 3; ++m) {
     ASSERT_EQ(got.metrics[m].grid.size(), cells);
-    for (std::size_t c = 0; c < cells; ++c)
-      ASSERT_EQ(got.metrics[m].grid[c], owner[c] < 0 ? mine[m] : grid_value(c, m, owner[c])) << "metric " << m << " cell " << c;
+    for (std::size_t c = 0; c < cells; ++c) {
+      const double want = owner[c] < 0 ? mine[m] : grid_value(c, m, owner[c]);
+      ASSERT_TRUE(got.metrics[m].grid[c] == want || (std::isnan(want) && std::isnan(got.metrics[m].grid[c])))
+          << "metric " << m << " cell " << c << ": " << got.metrics[m].grid[c] << ", want " << want;
+    }
   }
   // a source without this landscape: refused, nothing written
   auto w2 = ResultsWriter::create(td.file("dst2.h5"), test_meta(), copy_columns(), n);

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "store/label_columns.hpp"
 #include "store/runs_chunks.hpp"
 #include "store/store.hpp"
 #include "store_testgen.hpp"
@@ -65,14 +66,19 @@ TEST(StoreLabels, LabelledColumnsAreEnumsWithFlagAttributesAndReadBackAsText) {
   hid_t t = H5Dget_type(d);
   ASSERT_EQ(H5Tget_class(t), H5T_ENUM);
   EXPECT_EQ(H5Tget_size(t), 1u);
-  ASSERT_EQ(H5Tget_nmembers(t), 3);
-  for (unsigned i = 0; i < 3; ++i) {
+  ASSERT_EQ(H5Tget_nmembers(t), 4);  // the labels and the missing code
+  EXPECT_GT(H5Tcommitted(t), 0);      // a named type, as netCDF-4 readers need
+  for (unsigned i = 0; i < 4; ++i) {
     std::uint8_t v = 0;
     H5Tget_member_value(t, i, &v);
     char* name = H5Tget_member_name(t, i);
-    EXPECT_EQ(std::string(name), labelled_columns()[3].labels[v]);
+    EXPECT_EQ(std::string(name), v == 255 ? std::string("_missing") : labelled_columns()[3].labels[v]);
     H5free_memory(name);
   }
+  hid_t named = H5Topen2(f, "runs_word_t", H5P_DEFAULT);
+  ASSERT_GE(named, 0);
+  EXPECT_GT(H5Tequal(named, t), 0);
+  H5Tclose(named);
   std::uint8_t fill[2] = {0, 0}, flags[3] = {9, 9, 9};
   hid_t a = H5Aopen(d, "_FillValue", H5P_DEFAULT);
   H5Aread(a, H5T_NATIVE_UINT8, fill);
@@ -213,6 +219,27 @@ TEST(StoreLabels, ChunkEncodingIsHdf5sShuffleAndDeflate) {
       H5Pclose(dcpl);
     }
   H5Fclose(f);
+}
+
+// The labels of an enum type, as format 4 wrote it (no member for the missing code) and as format 5
+// does (a member `_missing` = 255, `_missing_` when `_missing` is a label): the same labels by code.
+TEST(StoreLabels, EnumLabelsOfFormat4And5TypesAreTheSame) {
+  const std::vector<std::string> labels = {"ok", "_missing", "bad"};
+  hid_t v4 = H5Tenum_create(H5T_STD_U8LE);
+  for (std::uint8_t i = 0; i < 3; ++i) H5Tenum_insert(v4, labels[i].c_str(), &i);
+  hid_t v5 = ks::store::detail::enum_file_type(labels);
+  ASSERT_GE(v5, 0);
+  ASSERT_EQ(H5Tget_nmembers(v5), 4);
+  char* name = H5Tget_member_name(v5, 3);
+  EXPECT_STREQ(name, "_missing_");
+  H5free_memory(name);
+  std::uint8_t v = 0;
+  H5Tget_member_value(v5, 3, &v);
+  EXPECT_EQ(v, 255);
+  EXPECT_EQ(ks::store::detail::enum_labels(v4, "f.h5", "c"), labels);
+  EXPECT_EQ(ks::store::detail::enum_labels(v5, "f.h5", "c"), labels);
+  H5Tclose(v4);
+  H5Tclose(v5);
 }
 
 }  // namespace

@@ -216,3 +216,57 @@ TEST(StoreLandscapes, CellsWrittenAgainIntoAKeptLandscapeAreCommittedEveryFewMiB
 }
 
 }  // namespace
+
+namespace {
+/// A block of 5 sampled points (parameters a, drawn out of order, and b, a string parameter) by 2
+/// values of k, with the metric E and a grid of status codes.
+LandscapeSpec sampled_spec() {
+  LandscapeSpec s;
+  s.block = "S";
+  LandscapeAxis sample{"sample", "", {0, 1, 2, 3, 4}};
+  sample.coordinates = {{"a", "rad", {0.3, -0.1, 0.3, 0.2, -0.5}}, {"b", "labels:x,y", {0, 1, 0, 1, 1}}};
+  s.axes = {sample, {"k", "", {0.0, 1.0}}};
+  s.metrics = {{"E", "Nm", "energy", {}}, {"status_code", "", "index of the status", {}, "status_code", {"ok", "bad"}}};
+  return s;
+}
+}  // namespace
+
+// Format 5: a sampled dimension keeps every parameter's values along it, and a grid of codes reads
+// back as written, NaN (stored as -1) where no cell was written; a resumed writer keeps that grid.
+TEST(StoreLandscapes, ASampledDimensionKeepsItsParametersAndCodesReadBackWithNaN) {
+  TempDir td;
+  const std::string path = td.file("s.h5");
+  const double nan = std::nan("");
+  const LandscapeSpec spec = sampled_spec();
+  {
+    auto w = ResultsWriter::create(path, test_meta(), test_columns(), 4);
+    const std::size_t h = w->begin_landscape(spec);
+    const double a[2] = {1.5, 1.0}, b[2] = {2.5, 0.0}, c[2] = {nan, nan};
+    w->write_landscape_cell(h, 1, a);
+    w->write_landscape_cell(h, 2, b);
+    w->write_landscape_cell(h, 3, c);
+    w->close();
+  }
+  LandscapeSpec got = ResultsReader(path).read_landscape("S");
+  ASSERT_EQ(got.axes.size(), 2u);
+  EXPECT_EQ(got.axes[0].name, "sample");
+  ASSERT_EQ(got.axes[0].coordinates.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(got.axes[0].coordinates[i].name, spec.axes[0].coordinates[i].name);
+    EXPECT_EQ(got.axes[0].coordinates[i].unit, spec.axes[0].coordinates[i].unit);
+    EXPECT_EQ(got.axes[0].coordinates[i].values, spec.axes[0].coordinates[i].values);
+  }
+  EXPECT_TRUE(got.axes[1].coordinates.empty());
+  const std::vector<double> E(10, nan), code(10, nan);
+  std::vector<double> wantE = E, wantCode = code;
+  wantE[1] = 1.5, wantE[2] = 2.5, wantCode[1] = 1.0, wantCode[2] = 0.0;
+  expect_grid(got, {wantE, wantCode}, "written");
+  {
+    auto w = std::move(ResultsWriter::open_for_resume(path, test_meta().study_sha256).writer);
+    const double d[2] = {4.0, 1.0};
+    w->write_landscape_cell(w->begin_landscape(spec), 9, d);
+    w->close();
+  }
+  wantE[9] = 4.0, wantCode[9] = 1.0;
+  expect_grid(ResultsReader(path).read_landscape("S"), {wantE, wantCode}, "kept by a resumed writer");
+}

@@ -4,7 +4,7 @@ histories through Histories. Run with Debian's interpreter: /usr/bin/python3.
 
 format_version 1 and 2: one group per run with a history, /histories/<zero-padded run id>/<array>,
   group attribute `arrays` = the array names in the order the run produced them.
-format_version 3 and 4: one row space shared by every history dataset. /histories/start, /rows, /layout
+format_version 3 to 5: one row space shared by every history dataset. /histories/start, /rows, /layout
   (int64, indexed by run id): run i's arrays are rows [start[i], start[i] + rows[i]) of the datasets
   named in the group attribute layouts[layout[i]] (comma-separated); layout -1 = no history. A
   dataset's `array` attribute names its array (`q.2` holds an array q of another column count or unit).
@@ -20,7 +20,7 @@ import numpy as np
 from kinesweep.kinds import FormatVersionError, _s
 
 GROUP_VERSIONS = (1, 2)  # one group per run
-RAGGED_VERSIONS = (3, 4)  # one shared row space
+RAGGED_VERSIONS = (3, 4, 5)  # one shared row space
 NEWEST_VERSION = 4
 
 
@@ -37,7 +37,7 @@ def _as_2d(v):
 
 
 class Histories:
-    """The histories of one open h5py.File (format_version 1 to 4). Reads nothing until asked."""
+    """The histories of one open h5py.File (format_version 1 to 5). Reads nothing until asked."""
 
     def __init__(self, f):
         self.f = f

@@ -104,9 +104,11 @@ def enum_labels(dset):
     e = h5py.check_enum_dtype(dset.dtype)
     if e is None:
         return None
+    missing = 256 ** dset.dtype.itemsize - 1  # the missing code's member (format 5) names no label
+    e = {name: int(code) for name, code in e.items() if int(code) != missing}
     labels = [""] * len(e)
     for name, code in e.items():
-        labels[int(code)] = name
+        labels[code] = name
     return labels
 
 
@@ -147,8 +149,12 @@ class Table(dict):
 
 
 class Axis:
-    def __init__(self, name, unit, values, labels=None):
+    """A landscape dimension: name, unit, values, labels (a string axis), and for a sampled dimension
+    (format 5: `sample`, values 0..n-1) its parameters along it, `coordinates` (list of Axis)."""
+
+    def __init__(self, name, unit, values, labels=None, coordinates=None):
         self.name, self.unit, self.values, self.labels = name, unit, values, labels
+        self.coordinates = coordinates or []
 
     @property
     def categorical(self):
@@ -159,6 +165,8 @@ class Axis:
         """The points of a design, which no grid or heatmap can draw: a dimension of several axes
         advancing together ("a+b", an LHS group or a zip) whose values are not monotonic, or numeric
         values that repeat (a Saltelli design). A single random axis is a grid axis (sorted)."""
+        if self.coordinates:
+            return True
         if self.categorical or len(self.values) < 2:
             return False
         v = np.asarray(self.values, dtype=float)
@@ -225,6 +233,9 @@ class Landscape:
         import xarray as xr  # optional dependency
         dims = [axis_dataset_name(a.name) for a in self.axes]
         coords = {d: (d, self._coordinate(a), {"units": a.unit}) for d, a in zip(dims, self.axes)}
+        for d, a in zip(dims, self.axes):  # a sampled dimension's parameters, coordinates along it
+            coords.update({axis_dataset_name(c.name): (d, self._coordinate(c), {"units": c.unit})
+                           for c in a.coordinates})
         data = {m: (dims, v, {"units": self.units.get(m, ""), "long_name": self.descriptions.get(m, "")})
                 for m, v in self.metrics.items()}
         return xr.Dataset(data, coords=coords, attrs={"block": self.block, "kind": self.kind})

@@ -44,7 +44,7 @@ from kinesweep.kinds import (GOOD_STATUSES, IK_STATUSES, KIND_MEANING, METRIC_LA
                              axis_dataset_name, display_name, enum_labels, text_values)
 
 RAD2DEG = 180.0 / np.pi
-FORMAT_VERSIONS = (2, 3, 4)  # the results formats this module reads (engine/store/FORMAT.md)
+FORMAT_VERSIONS = (2, 3, 4, 5)  # the results formats this module reads (engine/store/FORMAT.md)
 ROLES = ("parameter", "metric", "bookkeeping")
 
 # The thesis' optimised points on the (alpha1A, k) landscape of each local method:
@@ -53,6 +53,14 @@ THESIS_OPTIMA = {
     "local_weighted": {"global": "1h", "partial": ["1d", "1f", "1g"]},
     "local_unweighted": {"global": "2h", "partial": ["2d", "2f", "2g"]},
 }
+
+
+def _grid(d):
+    """A landscape grid as float64: a grid of codes (integer, format 5) with -1 (no run) as NaN."""
+    v = np.array(d[()], dtype=float)
+    if d.dtype.kind in "iu":
+        v[v == -1] = np.nan
+    return v
 
 class _Grids(Mapping):
     """A landscape's metric grids by name, each read from the file when first asked for (a
@@ -398,8 +406,7 @@ class Results:
         if block not in names:
             raise KeyError(f"no landscape {block!r}; landscapes: {', '.join(names)}")
         g = self.f["landscapes"][block]
-        axes = []
-        for a in (_s(x) for x in g.attrs["axes"]):
+        def axis(a):
             d = g[axis_dataset_name(a)] if axis_dataset_name(a) in g else g[a]  # (older files: g[a])
             unit = _s(d.attrs.get("unit", ""))
             vals = np.array(d[()], dtype=float)
@@ -408,7 +415,11 @@ class Results:
                 labels, unit = unit[len("labels:"):].split(","), ""
             elif degrees and unit == "rad":
                 vals, unit = vals * RAD2DEG, "deg"
-            axes.append(Axis(a, unit, vals, labels))
+            # a sampled dimension (format 5): its parameters, coordinates along it
+            along = [axis(_s(p)) for p in np.atleast_1d(d.attrs.get("parameters", []))]
+            return Axis(a, unit, vals, labels, along)
+
+        axes = [axis(_s(x)) for x in g.attrs["axes"]]
         units, desc, shown = {}, {}, {}
         names = [_s(x) for x in g.attrs["metrics"]]
         shape = tuple(len(a.values) for a in axes)
@@ -419,7 +430,7 @@ class Results:
             units[m] = _s(g[m].attrs.get("unit", ""))
             desc[m] = _s(g[m].attrs.get("description", ""))
             shown[m] = display_name(g[m], m)
-        metrics = _Grids(names, lambda m: np.array(self.f["landscapes"][block][m][()], dtype=float))
+        metrics = _Grids(names, lambda m: _grid(self.f["landscapes"][block][m]))
         kind = self._block_kind(block)
         return Landscape(block, axes, metrics, units, desc, kind, self.kind_meaning(kind), shown)
 

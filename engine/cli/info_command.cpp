@@ -190,7 +190,10 @@ void print_optimizations(store::ResultsReader& reader, const RunsTable& t, std::
 std::string axis_text(const store::LandscapeAxis& a) {
   std::ostringstream o;
   o << a.name << " (" << a.values.size();
-  if (a.unit.rfind("labels:", 0) == 0) {
+  if (!a.coordinates.empty()) {  // a sampled dimension: the parameters along it
+    o << ": ";
+    for (std::size_t i = 0; i < a.coordinates.size(); ++i) o << (i ? ", " : "") << axis_text(a.coordinates[i]);
+  } else if (a.unit.rfind("labels:", 0) == 0) {
     o << ": " << a.unit.substr(7);
   } else if (!a.values.empty()) {
     const bool deg = a.unit == "rad";

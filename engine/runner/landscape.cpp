@@ -7,7 +7,39 @@ namespace ks {
 namespace {
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+/// An axis as a landscape axis: its values (a string axis: the codes 0..n-1, its names in the unit
+/// "labels:a,b,...").
+store::LandscapeAxis landscape_axis(const Axis& axis) {
+  store::LandscapeAxis a;
+  a.name = axis.name;
+  a.unit = axis.unit;
+  std::string labels;
+  for (std::size_t i = 0; i < axis.values.size(); ++i) {
+    if (const std::string* str = std::get_if<std::string>(&axis.values[i])) {
+      a.values.push_back(static_cast<double>(i));
+      labels += (i ? "," : "") + *str;
+    } else {
+      a.values.push_back(cell_number(axis.values[i]));
+    }
+  }
+  if (!labels.empty()) a.unit = "labels:" + labels;
+  return a;
+}
+
 }  // namespace
+
+bool LandscapeGrid::is_sampled(const Dim& d) const {
+  if (d.axes.size() != 1) return true;  // a zip, LHS or Saltelli group
+  const Axis& axis = block_.axes()[d.axes.front()];
+  if (axis.form == "random" || axis.form == "lhs" || axis.form == "saltelli") return true;
+  const store::LandscapeAxis a = landscape_axis(axis);
+  bool up = true, down = true;  // a coordinate is strictly monotonic (CF)
+  for (std::size_t i = 1; i < a.values.size(); ++i) {
+    up = up && a.values[i] > a.values[i - 1];
+    down = down && a.values[i] < a.values[i - 1];
+  }
+  return !up && !down;
+}
 
 LandscapeGrid::LandscapeGrid(const Block& block, bool enabled) : block_(block) {
   // The good-status grid (ok / converged), the metrics marked gridded, the status code.
@@ -107,21 +139,18 @@ void LandscapeGrid::add_range(std::uint64_t first, std::uint64_t count, const do
 store::LandscapeSpec LandscapeGrid::spec() const {
   store::LandscapeSpec s;
   s.block = block_.name();
+  std::size_t sampled = 0;  // sampled dimensions so far
   for (const Dim& d : block_.dims()) {
-    store::LandscapeAxis a;
-    const Axis& first = block_.axes()[d.axes.front()];
-    for (std::size_t i = 0; i < d.axes.size(); ++i) a.name += (i ? "+" : "") + block_.axes()[d.axes[i]].name;
-    a.unit = first.unit;
-    std::string labels;
-    for (std::size_t i = 0; i < first.values.size(); ++i) {
-      if (const std::string* str = std::get_if<std::string>(&first.values[i])) {
-        a.values.push_back(static_cast<double>(i));
-        labels += (i ? "," : "") + *str;
-      } else {
-        a.values.push_back(cell_number(first.values[i]));
-      }
+    std::vector<store::LandscapeAxis> along;  // the dimension's axes, as coordinates
+    for (std::size_t a : d.axes) along.push_back(landscape_axis(block_.axes()[a]));
+    if (!is_sampled(d)) {
+      s.axes.push_back(std::move(along.front()));
+      continue;
     }
-    if (!labels.empty()) a.unit = "labels:" + labels;
+    store::LandscapeAxis a;
+    a.name = ++sampled == 1 ? "sample" : "sample_" + std::to_string(sampled);
+    for (std::size_t i = 0; i < d.size; ++i) a.values.push_back(static_cast<double>(i));
+    a.coordinates = std::move(along);
     s.axes.push_back(std::move(a));
   }
   const auto& ms = block_.metrics();
@@ -137,7 +166,10 @@ store::LandscapeSpec LandscapeGrid::spec() const {
     if (sources_[m] == Source::is_ok) lm.description = "1 where the run's status is " + lm.name + ", else 0";
     if (sources_[m] == Source::status_code) {
       lm.description = "index of the run's status in:";
-      for (const auto& st : statuses(block_.kind())) lm.description += " " + std::string(st);
+      for (const auto& st : statuses(block_.kind())) {
+        lm.description += " " + std::string(st);
+        lm.flags.emplace_back(st);
+      }
     }
     s.metrics.push_back(std::move(lm));
   }

@@ -40,10 +40,14 @@ class LandscapeGrid {
   std::vector<std::size_t> columns(const StudySchema& schema, std::size_t b) const;
   /// Which value a grid takes from a row: a metric column, or a status-derived value.
   enum class Source { column, is_ok, status_code };
-  /// The axes (one per dimension; a zipped dimension is named "a+b" and takes the first axis'
-  /// values; string axes take 0..n-1 with the names in the unit field) and the gridded metrics'
-  /// names, units and descriptions (their grids empty).
+  /// The axes (one per dimension, named after its axis; string axes take 0..n-1 with the names in
+  /// the unit field; a sampled dimension is the axis "sample" ("sample_2", ... for the next ones)
+  /// of values 0..n-1 with its axes as coordinates) and the gridded metrics' names, units and
+  /// descriptions (their grids empty; status_code: the statuses as flags).
   store::LandscapeSpec spec() const;
+  /// Whether dimension `d` is sampled: a group of axes (zip, LHS, Saltelli), a random, LHS or
+  /// Saltelli axis, or values not strictly monotonic (no CF coordinate).
+  bool is_sampled(const Dim& d) const;
 
  private:
   const Block& block_;

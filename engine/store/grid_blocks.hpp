@@ -3,6 +3,9 @@
 #include <hdf5.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace ks::store::detail {
@@ -58,19 +61,44 @@ bool transfer_consecutive(hid_t d, const std::vector<hsize_t>& dims, hsize_t fir
   return ok;
 }
 
-/// Writes `count` consecutive cells (row-major) from `first` of the f64 grid dataset `d` of shape
-/// `dims` from `v`. False on an HDF5 error.
+/// Writes the `n` cells `v` to the selection `fs` (`ms` in memory) of grid dataset `d`: as they are
+/// to an f64 grid; to a grid of integer codes rounded, NaN as -1 (no code). False on an HDF5 error.
+inline bool write_cells(hid_t d, hid_t ms, hid_t fs, const double* v, hsize_t n) {
+  const hid_t type = H5Dget_type(d);
+  const bool codes = type >= 0 && H5Tget_class(type) == H5T_INTEGER;
+  if (type >= 0) H5Tclose(type);
+  if (!codes) return H5Dwrite(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, v) >= 0;
+  std::vector<std::int64_t> c(n);
+  for (hsize_t i = 0; i < n; ++i) c[i] = v[i] == v[i] ? static_cast<std::int64_t>(std::llround(v[i])) : -1;
+  return H5Dwrite(d, H5T_NATIVE_INT64, ms, fs, H5P_DEFAULT, c.data()) >= 0;
+}
+
+/// Reads `n` cells of grid dataset `d` (selection `fs`, `ms` in memory) into `v`: a grid of integer
+/// codes with -1 (no code) as NaN. False on an HDF5 error.
+inline bool read_cells(hid_t d, hid_t ms, hid_t fs, double* v, hsize_t n) {
+  if (H5Dread(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, v) < 0) return false;
+  const hid_t type = H5Dget_type(d);
+  const bool codes = type >= 0 && H5Tget_class(type) == H5T_INTEGER;
+  if (type >= 0) H5Tclose(type);
+  if (codes)
+    for (hsize_t i = 0; i < n; ++i)
+      if (v[i] == -1.0) v[i] = std::numeric_limits<double>::quiet_NaN();
+  return true;
+}
+
+/// Writes `count` consecutive cells (row-major) from `first` of the grid dataset `d` of shape
+/// `dims` from `v` (write_cells). False on an HDF5 error.
 inline bool write_consecutive(hid_t d, const std::vector<hsize_t>& dims, hsize_t first, hsize_t count, const double* v) {
   return transfer_consecutive(d, dims, first, count, [&](hid_t ms, hid_t fs, hsize_t done) {
-    return H5Dwrite(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, v + done) >= 0;
+    return write_cells(d, ms, fs, v + done, static_cast<hsize_t>(H5Sget_simple_extent_npoints(ms)));
   });
 }
 
-/// Reads `count` consecutive cells (row-major) from `first` of the f64 grid dataset `d` of shape
-/// `dims` into `v`. False on an HDF5 error.
+/// Reads `count` consecutive cells (row-major) from `first` of the grid dataset `d` of shape
+/// `dims` into `v` (read_cells). False on an HDF5 error.
 inline bool read_consecutive(hid_t d, const std::vector<hsize_t>& dims, hsize_t first, hsize_t count, double* v) {
   return transfer_consecutive(d, dims, first, count, [&](hid_t ms, hid_t fs, hsize_t done) {
-    return H5Dread(d, H5T_NATIVE_DOUBLE, ms, fs, H5P_DEFAULT, v + done) >= 0;
+    return read_cells(d, ms, fs, v + done, static_cast<hsize_t>(H5Sget_simple_extent_npoints(ms)));
   });
 }
 

@@ -1,5 +1,6 @@
 #include "store/label_columns.hpp"
 
+#include <algorithm>
 #include <set>
 
 #include "store/store.hpp"
@@ -21,18 +22,29 @@ namespace {
 hid_t base_type(std::size_t n_labels) { return enum_code_bytes(n_labels) == 1 ? H5T_STD_U8LE : H5T_STD_U16LE; }
 }  // namespace
 
+std::string enum_missing_name(const std::vector<std::string>& labels) {
+  std::string name = "_missing";
+  while (std::find(labels.begin(), labels.end(), name) != labels.end()) name += "_";
+  return name;
+}
+
 hid_t enum_file_type(const std::vector<std::string>& labels) {
   hid_t t = H5Tenum_create(base_type(labels.size()));
-  for (std::size_t i = 0; i < labels.size(); ++i) {
-    // H5Tenum_insert reads the value in the base type's size; little-endian hosts only (as the store)
-    const std::uint16_t v = static_cast<std::uint16_t>(i);
-    if (H5Tenum_insert(t, labels[i].c_str(), &v) < 0) {
+  // H5Tenum_insert reads the value in the base type's size; little-endian hosts only (as the store)
+  const auto insert = [&](const std::string& name, std::uint16_t v) { return H5Tenum_insert(t, name.c_str(), &v) >= 0; };
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    if (!insert(labels[i], static_cast<std::uint16_t>(i))) {
       H5Tclose(t);
       return -1;
     }
+  if (!insert(enum_missing_name(labels), enum_file_missing(labels.size()))) {
+    H5Tclose(t);
+    return -1;
   }
   return t;
 }
+
+std::string enum_type_name(const std::string& column) { return "runs_" + column + "_t"; }
 
 void write_enum_attributes(hid_t d, const std::vector<std::string>& labels, const std::string& path) {
   const hid_t base = base_type(labels.size());
@@ -60,17 +72,26 @@ std::vector<std::string> enum_labels(hid_t type, const std::string& path, const 
   const int n = H5Tget_nmembers(type);
   const std::string bad = std::string(kBadColumnAttribute) + "/runs/" + name;
   if (n <= 0) throw StoreError(path, bad + " is an enum without members");
-  std::vector<std::string> labels(static_cast<std::size_t>(n));
+  // The member of the missing code (format 5 on), when there is one, names no label.
+  const std::uint64_t missing = H5Tget_size(type) == 1 ? 0xFF : 0xFFFF;
+  std::vector<std::pair<std::uint64_t, std::string>> members;
   for (int i = 0; i < n; ++i) {
     std::uint64_t v = 0;  // the member value in the base type's size (little-endian)
     H5Tget_member_value(type, static_cast<unsigned>(i), &v);
     char* s = H5Tget_member_name(type, static_cast<unsigned>(i));
     if (!s) throw StoreError(path, bad + ": unreadable enum member");
-    std::string label(s);
+    members.emplace_back(v, s);
     H5free_memory(s);
+  }
+  const auto has_missing = std::count_if(members.begin(), members.end(), [&](const auto& m) { return m.first == missing; });
+  std::vector<std::string> labels(members.size() - static_cast<std::size_t>(has_missing == 1 ? 1 : 0));
+  if (labels.empty()) throw StoreError(path, bad + " is an enum without labels");
+  for (auto& [v, label] : members) {
+    if (v == missing && has_missing == 1) continue;
     if (v >= labels.size() || !labels[v].empty())
       throw StoreError(path, bad + " has enum member '" + label + "' = " + std::to_string(v) +
-                                 " (expected the values 0.." + std::to_string(n - 1) + ", each once)");
+                                 " (expected the values 0.." + std::to_string(labels.size() - 1) +
+                                 ", each once, and at most the missing code " + std::to_string(missing) + ")");
     labels[v] = std::move(label);
   }
   return labels;

@@ -21,8 +21,14 @@ inline constexpr std::uint16_t kMissingCode = 0xFFFF;
 /// True when `labels` can be an enum column: 1 to 65534 distinct, non-empty labels.
 bool enum_storable(const std::vector<std::string>& labels);
 /// The file type of a labelled column (caller closes): an HDF5 enum over u8 (fewer than 255
-/// labels) or u16, member i named labels[i] with value i. The missing value has no member.
+/// labels) or u16, member i named labels[i] with value i, and the missing code (enum_file_missing)
+/// named enum_missing_name(labels), so that netCDF readers can name every stored value.
 hid_t enum_file_type(const std::vector<std::string>& labels);
+/// The member name of the missing code: "_missing", with '_' appended while that is a label.
+std::string enum_missing_name(const std::vector<std::string>& labels);
+/// The name under which the enum type of /runs/<column> is committed in the root group
+/// ("runs_<column>_t"): netCDF-4 readers map only committed (named) types.
+std::string enum_type_name(const std::string& column);
 /// Bytes of one code in the file (1 or 2).
 std::size_t enum_code_bytes(std::size_t n_labels);
 /// The file's missing code for `n_labels` labels (255 or 65535).
@@ -31,8 +37,9 @@ std::uint16_t enum_file_missing(std::size_t n_labels);
 /// flag_meanings (the labels, blanks as '_', space-separated) and _FillValue (the missing code),
 /// each of the column's base type.
 void write_enum_attributes(hid_t d, const std::vector<std::string>& labels, const std::string& path);
-/// The labels of enum type `type` by code (member values must be 0..n-1). Throws StoreError
-/// (kBadColumnAttribute) naming column `name` otherwise.
+/// The labels of enum type `type` by code (member values must be 0..n-1, besides one member for
+/// the missing code, which names no label). Throws StoreError (kBadColumnAttribute) naming
+/// column `name` otherwise.
 std::vector<std::string> enum_labels(hid_t type, const std::string& path, const std::string& name);
 
 /// label -> code of one column, for writing.

@@ -207,15 +207,27 @@ LandscapeSpec ResultsReader::read_landscape(const std::string& block, bool grids
     std::vector<double> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
     if (!v.empty())
       check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), impl_->path, "read " + name);
+    Hid type(H5Dget_type(d));
+    if (H5Tget_class(type) == H5T_INTEGER)  // a grid of codes (format 5): -1 is no code
+      for (double& x : v)
+        if (x == -1.0) x = std::numeric_limits<double>::quiet_NaN();
     return std::make_pair(std::move(v), read_str_attr(d, "unit"));
   };
-  for (auto& name : read_str_list_attr(g, "axes")) {
+  auto read_axis = [&](const std::string& name) {
     Hid d(check(open_axis_dataset(g, name), impl_->path, "open /" + gp + "/" + axis_dataset_name(name)));
     Hid s(H5Dget_space(d));
     std::vector<double> v(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)));
     if (!v.empty())
       check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), impl_->path, "read " + name);
-    spec.axes.push_back({name, read_str_attr(d, "unit"), std::move(v)});
+    LandscapeAxis a{name, read_str_attr(d, "unit"), std::move(v)};
+    if (has_attr(d, "parameters"))  // a sampled dimension (format 5): its parameters along it
+      for (auto& p : read_str_list_attr(d, "parameters")) a.coordinates.push_back(LandscapeAxis{p, "", {}});
+    return a;
+  };
+  for (auto& name : read_str_list_attr(g, "axes")) {
+    LandscapeAxis a = read_axis(name);
+    for (LandscapeAxis& c : a.coordinates) c = read_axis(c.name);
+    spec.axes.push_back(std::move(a));
   }
   // every metric grid holds one value per cell of the axes' grid
   std::uint64_t cells = 1;

@@ -41,10 +41,14 @@ class StoreError : public std::runtime_error {
 void print_hdf5_error_stack(bool print);
 
 inline constexpr const char* kFormatName = "kinesweep-results";
-/// The format this kinesweep writes (4: text columns with few distinct values as HDF5 enums; 3:
-/// histories as ragged arrays sharing one row space; 2: one group per run's history; all three:
+/// The format this kinesweep writes (5: netCDF-readable: the enums committed as named types with a
+/// member for the missing code, sampled landscape dimensions as `sample` with a coordinate per
+/// parameter, integer status grids; 4: text columns with few distinct values as HDF5 enums; 3:
+/// histories as ragged arrays sharing one row space; 2: one group per run's history; all four:
 /// /runs columns carry `role` and `kinds` attributes).
-inline constexpr std::int64_t kFormatVersion = 4;
+inline constexpr std::int64_t kFormatVersion = 5;
+/// The CF conventions version a results file declares (root attribute `Conventions`).
+inline constexpr const char* kConventions = "CF-1.10";
 /// Rows per chunk of the fixed-size /runs columns (format 4; FORMAT.md, /runs): the unit in which
 /// they are compressed, and in which a distributed sweep hands out work (so its shards merge by chunk).
 inline constexpr std::uint64_t kRunsChunkRows = 16384;
@@ -172,14 +176,20 @@ RunHistory decode_history(const EncodedHistory& history);
 std::size_t encoded_bytes(const EncodedHistory& history);
 
 /// One axis of a block's grid, or one gridded metric (row-major over the axes, NaN = no value).
+/// A sampled dimension (zip, LHS, random, Saltelli, or values not in order) is the axis `sample`
+/// (values 0..n-1) whose `coordinates` are its parameters, each with its n values.
 struct LandscapeAxis {
   std::string name, unit;
   std::vector<double> values;
+  std::vector<LandscapeAxis> coordinates = {};  ///< the parameters along a sampled dimension
 };
 struct LandscapeMetric {
   std::string name, unit, description;
   std::vector<double> grid;
   std::string display_name = {};  ///< as ColumnSpec::display_name (attribute `display_name` when set)
+  /// Non-empty: the grid holds codes 0..n-1 of these names (stored as int8/int16 with flag_values and
+  /// flag_meanings, -1 where there is none; read back as NaN there).
+  std::vector<std::string> flags = {};
 };
 struct LandscapeSpec {
   std::string block;

@@ -112,7 +112,6 @@ void ResultsWriter::Impl::write_history(std::int64_t id, const EncodedHistory& g
     Hid run_dim(netcdf_dimension(histories, "run_id", n));
     for (Hid* d : dsets)
       if (!run_dim.ok() || H5DSattach_scale(*d, run_dim, 0) < 0) fail("cannot name the dimension of the /histories index");
-    write_str_attr(h.rows, "sample_dimension", "history_row");  // CF: the count of a ragged array's rows
     write_str_attr(h.start, "description", "first row of the run's history in every history dataset (-1: none)");
     write_str_attr(h.rows, "description", "rows of the run's history");
     write_str_attr(h.layout, "description", "index into the attribute layouts of /histories (-1: none)");

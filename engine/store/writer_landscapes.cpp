@@ -50,6 +50,34 @@ std::pair<ResultsWriter::Impl::LandscapeStream*, hsize_t> begun_stream(ResultsWr
   return {&s, std::accumulate(s.dims.begin(), s.dims.end(), hsize_t{1}, std::multiplies<>())};
 }
 
+/// The file type of a landscape metric: f64, or for a grid of codes (flags) int8 (int16 past 127 codes).
+hid_t metric_file_type(const LandscapeMetric& mt) {
+  if (mt.flags.empty()) return H5T_IEEE_F64LE;
+  return mt.flags.size() <= 127 ? H5T_STD_I8LE : H5T_STD_I16LE;
+}
+
+/// CF flags of a grid of codes `mt.flags`: flag_values (0..n-1, in the grid's type), flag_meanings
+/// (the names, blanks as '_') and _FillValue (-1: no run).
+void write_code_flags(hid_t d, const LandscapeMetric& mt) {
+  hsize_t n = mt.flags.size();
+  std::vector<std::int16_t> codes(mt.flags.size());
+  std::string meanings;
+  for (std::size_t i = 0; i < mt.flags.size(); ++i) {
+    codes[i] = static_cast<std::int16_t>(i);
+    std::string name = mt.flags[i];
+    std::replace(name.begin(), name.end(), ' ', '_');
+    meanings += (i ? " " : "") + name;
+  }
+  Hid space(H5Screate_simple(1, &n, nullptr));
+  Hid a(H5Acreate2(d, "flag_values", metric_file_type(mt), space, H5P_DEFAULT, H5P_DEFAULT));
+  if (a.ok()) H5Awrite(a, H5T_NATIVE_INT16, codes.data());
+  write_str_attr(d, "flag_meanings", meanings);
+  const std::int16_t missing = -1;
+  Hid scalar(H5Screate(H5S_SCALAR));
+  Hid f(H5Acreate2(d, "_FillValue", metric_file_type(mt), scalar, H5P_DEFAULT, H5P_DEFAULT));
+  if (f.ok()) H5Awrite(f, H5T_NATIVE_INT16, &missing);
+}
+
 /// The doubles of a 1-D dataset (empty when it cannot be read).
 std::vector<double> read_doubles(hid_t d) {
   Hid space(H5Dget_space(d));
@@ -67,11 +95,16 @@ std::vector<Hid> same_grid_metrics(hid_t g, const LandscapeSpec& spec, const std
   std::vector<std::string> names;
   for (auto& a : spec.axes) names.push_back(a.name);
   if (read_str_list_attr(g, "axes") != names) return {};
-  for (auto& a : spec.axes) {
+  const auto same_axis = [&](const LandscapeAxis& a) {
     Hid d(open_axis_dataset(g, a.name));
-    if (!d.ok() || read_str_attr(d, "unit") != a.unit) return {};
+    if (!d.ok() || read_str_attr(d, "unit") != a.unit) return false;
     const std::vector<double> v = read_doubles(d);
-    if (v.size() != a.values.size() || std::memcmp(v.data(), a.values.data(), v.size() * sizeof(double)) != 0) return {};
+    return v.size() == a.values.size() && std::memcmp(v.data(), a.values.data(), v.size() * sizeof(double)) == 0;
+  };
+  for (auto& a : spec.axes) {
+    if (!same_axis(a)) return {};
+    for (auto& c : a.coordinates)
+      if (!same_axis(c)) return {};
   }
   names.clear();
   for (auto& mt : spec.metrics) names.push_back(mt.name);
@@ -81,7 +114,7 @@ std::vector<Hid> same_grid_metrics(hid_t g, const LandscapeSpec& spec, const std
     Hid d(H5Dopen2(g, mt.name.c_str(), H5P_DEFAULT));
     if (!d.ok() || read_str_attr(d, "unit") != mt.unit || read_str_attr(d, "description") != mt.description) return {};
     Hid type(H5Dget_type(d)), space(H5Dget_space(d));
-    if (!type.ok() || H5Tequal(type, H5T_IEEE_F64LE) <= 0 || !space.ok()) return {};
+    if (!type.ok() || H5Tequal(type, metric_file_type(mt)) <= 0 || !space.ok()) return {};
     const int rank = H5Sget_simple_extent_ndims(space);
     std::vector<hsize_t> shape(rank > 0 ? static_cast<std::size_t>(rank) : 0);
     if (rank < 0 || (rank > 0 && H5Sget_simple_extent_dims(space, shape.data(), nullptr) < 0) || shape != dims) return {};
@@ -129,6 +162,14 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
     if (a.values.empty()) throw StoreError(m.path, "landscape " + spec.block + ": axis " + a.name + " has no values");
     dims.push_back(a.values.size());
     axis_names.push_back(a.name);
+    for (auto& c : a.coordinates) {
+      validate_name(m.path, c.name, "landscape coordinate");
+      if (!names.insert(c.name).second) throw StoreError(m.path, "landscape " + spec.block + ": duplicate name " + c.name);
+      if (c.values.size() != a.values.size())
+        throw StoreError(m.path, "landscape " + spec.block + ": coordinate " + c.name + " has " +
+                                     std::to_string(c.values.size()) + " values along " + a.name + " of " +
+                                     std::to_string(a.values.size()));
+    }
   }
   for (auto& mt : spec.metrics) {
     validate_name(m.path, mt.name, "landscape metric");
@@ -173,6 +214,7 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
   // Each axis is an HDF5 dimension scale attached to its dimension of every metric, so that netCDF
   // readers (xarray with h5netcdf) see named dimensions with these values as coordinates.
   std::vector<Hid> axis_dsets;
+  std::string coordinate_names;  // of every sampled dimension: the metrics' CF `coordinates`
   for (auto& a : spec.axes) {
     hsize_t n = a.values.size();
     Hid space(H5Screate_simple(1, &n, nullptr));
@@ -185,6 +227,25 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
     if (a.unit.rfind("labels:", 0) == 0) write_label_axis_flags(d, a.unit.substr(7), a.values.size());
     write_str_attr(d, "kind", "axis");
     if (H5DSset_scale(d, dname.c_str()) < 0) m.fail("cannot make landscape axis " + a.name + " a dimension scale");
+    if (!a.coordinates.empty()) {
+      // A sampled dimension: its index, and one CF auxiliary coordinate variable per parameter along it.
+      std::vector<std::string> params;
+      for (auto& c : a.coordinates) params.push_back(c.name);
+      write_str_list_attr(d, "parameters", params);
+      write_str_attr(d, "long_name", "sample index");
+      for (auto& c : a.coordinates) {
+        const std::string cname = axis_dataset_name(c.name);
+        Hid cd(H5Dcreate2(g, cname.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+        if (!cd.ok() || H5Dwrite(cd, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, c.values.data()) < 0)
+          m.fail("cannot write landscape coordinate " + c.name);
+        write_str_attr(cd, "unit", c.unit);
+        write_cf_units(cd, c.unit);
+        if (c.unit.rfind("labels:", 0) == 0) write_label_axis_flags(cd, c.unit.substr(7), c.values.size());
+        write_str_attr(cd, "kind", "coordinate");
+        if (H5DSattach_scale(cd, d, 0) < 0) m.fail("cannot attach landscape axis " + a.name + " to " + c.name);
+        coordinate_names += (coordinate_names.empty() ? "" : " ") + cname;
+      }
+    }
     axis_dsets.push_back(std::move(d));
   }
   // Metrics: contiguous, allocated (and filled with NaN) when their first cell is written, so a
@@ -207,13 +268,20 @@ std::size_t ResultsWriter::begin_landscape(const LandscapeSpec& spec) {
       H5Pset_fill_value(dcpl, H5T_NATIVE_DOUBLE, &nan) < 0 ||
       H5Pset_fill_time(dcpl, unfilled ? H5D_FILL_TIME_NEVER : H5D_FILL_TIME_ALLOC) < 0)
     m.fail("cannot set up landscape " + spec.block);
+  Hid code_dcpl(H5Pcopy(dcpl));  // grids of codes: -1 where there is none
+  const std::int16_t no_code = -1;
+  if (!code_dcpl.ok() || H5Pset_fill_value(code_dcpl, H5T_NATIVE_INT16, &no_code) < 0)
+    m.fail("cannot set up landscape " + spec.block);
   for (auto& mt : spec.metrics) {
     Hid space(dims.empty() ? H5Screate(H5S_SCALAR)
                            : H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr));
-    Hid d(H5Dcreate2(g, mt.name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT));
+    Hid d(H5Dcreate2(g, mt.name.c_str(), metric_file_type(mt), space, H5P_DEFAULT, mt.flags.empty() ? dcpl : code_dcpl,
+                     H5P_DEFAULT));
     if (!d.ok()) m.fail("cannot create landscape metric " + mt.name);
     write_str_attr(d, "unit", mt.unit);
     write_cf_units(d, mt.unit);
+    if (!mt.flags.empty()) write_code_flags(d, mt);
+    if (!coordinate_names.empty()) write_str_attr(d, "coordinates", coordinate_names);
     write_str_attr(d, "description", mt.description);
     write_str_attr(d, "long_name", mt.description);
     if (!mt.display_name.empty()) write_str_attr(d, "display_name", mt.display_name);
@@ -300,7 +368,8 @@ bool ResultsWriter::copy_landscape(std::size_t landscape, const std::vector<cons
       Hid space(d.ok() ? H5Dget_space(d) : -1);
       Hid type(d.ok() ? H5Dget_type(d) : -1);
       std::vector<hsize_t> shape(s.dims.size());
-      if (!space.ok() || !type.ok() || H5Tequal(type, H5T_IEEE_F64LE) <= 0 ||
+      Hid our_type(H5Dget_type(ours));
+      if (!space.ok() || !type.ok() || !our_type.ok() || H5Tequal(type, our_type) <= 0 ||
           H5Sget_simple_extent_ndims(space) != static_cast<int>(shape.size()) ||
           H5Sget_simple_extent_dims(space, shape.data(), nullptr) < 0 || shape != s.dims)
         return false;
@@ -318,7 +387,19 @@ bool ResultsWriter::copy_landscape(std::size_t landscape, const std::vector<cons
   std::vector<haddr_t> to(n_metrics, HADDR_UNDEF);
   std::vector<std::vector<haddr_t>> from_at(sources.size());
   std::vector<int> in_fd(sources.size(), -1);
-  for (std::size_t mt = 0; mt < n_metrics && by_offset; ++mt) to[mt] = H5Dget_offset(s.metrics[mt]);
+  // A grid smaller than HDF5's small-data block (an int8 grid of codes, a small f64 grid) comes
+  // from a block HDF5 may have reserved before the last commit, where the journal holds the pages:
+  // such grids go through HDF5.
+  hsize_t small = 2048;  // HDF5's default
+  {
+    Hid fapl(H5Fget_access_plist(m.file));
+    if (fapl.ok()) H5Pget_small_data_block_size(fapl, &small);
+  }
+  for (std::size_t mt = 0; mt < n_metrics && by_offset; ++mt) {
+    Hid type(H5Dget_type(s.metrics[mt]));
+    by_offset = type.ok() && cells * H5Tget_size(type) >= small;
+    to[mt] = H5Dget_offset(s.metrics[mt]);
+  }
   for (std::size_t k = 0; k < sources.size() && by_offset; ++k) {
     if (!used[k]) continue;
     in_fd[k] = sources[k]->bytes_are_committed_state() ? file_descriptor(static_cast<hid_t>(sources[k]->raw_file_id())) : -1;
@@ -336,9 +417,11 @@ bool ResultsWriter::copy_landscape(std::size_t landscape, const std::vector<cons
     while (hi < cells && hi - lo < kPiece && owner[hi] == owner[lo]) ++hi;
     if (owner[lo] >= 0) {
       const auto k = static_cast<std::size_t>(owner[lo]);
-      constexpr std::uint64_t w = sizeof(double);
-      for (std::size_t mt = 0; mt < n_metrics && by_offset; ++mt)
-        by_offset = kernel_copy(in_fd[k], from_at[k][mt] + lo * w, out_fd, to[mt] + lo * w, (hi - lo) * w, m.path);
+      for (std::size_t mt = 0; mt < n_metrics && by_offset; ++mt) {
+        Hid type(H5Dget_type(s.metrics[mt]));
+        const std::uint64_t w = type.ok() ? H5Tget_size(type) : 0;  // bytes of a cell
+        by_offset = w > 0 && kernel_copy(in_fd[k], from_at[k][mt] + lo * w, out_fd, to[mt] + lo * w, (hi - lo) * w, m.path);
+      }
       if (!by_offset) {  // the kernel cannot copy between these files: through HDF5 (all metrics again)
         v.resize(hi - lo);
         for (std::size_t mt = 0; mt < n_metrics; ++mt)
@@ -373,7 +456,7 @@ void ResultsWriter::Impl::write_landscape_cells() {
     for (std::size_t mt = 0; mt < metrics; ++mt) {
       for (std::size_t i = 0; i < n; ++i) v[i] = s.values[keep[i] * metrics + mt];
       if (s.dims.empty()) {  // the one cell of a block without axes
-        if (H5Dwrite(s.metrics[mt], H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0)
+        if (!write_cells(s.metrics[mt], H5S_ALL, H5S_ALL, v.data(), 1))
           fail("cannot write landscape cells of " + s.block);
         continue;
       }

@@ -41,6 +41,7 @@ hid_t file_type_of(CellType t) {
 
 void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
                     const std::vector<ColumnSpec>& columns, std::int64_t n_runs) {
+  write_str_attr(file, "Conventions", kConventions);
   write_str_attr(file, "format", kFormatName);
   write_i64_attr(file, "format_version", kFormatVersion);
   write_str_attr(file, "engine_version", meta.engine_version);
@@ -110,6 +111,9 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
   for (auto& c : columns) {
     if (c.type == CellType::str && !c.labels.empty()) {  // few distinct values: an enum (missing: no member)
       Hid ft(check(enum_file_type(c.labels), path, "enum type of /runs/" + c.name));
+      // committed (named) in the root group: netCDF-4 readers map only named types
+      check(H5Tcommit2(file, enum_type_name(c.name).c_str(), ft, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), path,
+            "commit the enum type of /runs/" + c.name);
       const std::uint16_t missing = enum_file_missing(c.labels.size());
       make(c, ft, H5T_NATIVE_UINT16, &missing, "str");
       Hid d(check(H5Dopen2(runs, c.name.c_str(), H5P_DEFAULT), path, "open /runs/" + c.name));
@@ -121,6 +125,7 @@ void build_skeleton(hid_t file, const std::string& path, const StoreMeta& meta,
       case CellType::f64: make(c, ft, H5T_NATIVE_DOUBLE, &nan, "f64"); break;
       case CellType::i64: {  // -1: missing, which CF readers learn from _FillValue
         make(c, ft, H5T_NATIVE_INT64, &minus1, "i64");
+        if (c.name == "run_id") break;  // a coordinate: no fill value (CF), never missing in a run's row
         Hid d(check(H5Dopen2(runs, c.name.c_str(), H5P_DEFAULT), path, "open /runs/" + c.name));
         write_i64_attr(d, "_FillValue", minus1);
         break;

@@ -26,7 +26,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from kslive import stamp  # noqa: E402  FORMAT.md, "Reading while a sweep runs"
 from kinesweep.kinds import enum_labels, text_values  # noqa: E402
 
-FORMAT_VERSION = 4
+FORMAT_VERSION = 5
 CHUNK_ROWS = 16384  # rows per chunk of the fixed-size /runs columns (FORMAT.md, "/runs")
 
 STATUSES = ["ok", "diverged", "singular", "ok-\u00f1"]
@@ -206,7 +206,8 @@ def check_complete(path, n):
 
 def check_column_layout(runs, n):
     """FORMAT.md, "/runs": a labelled text column is an enum over uint8 (label = code 0..L-1) with
-    flag_values, flag_meanings and _FillValue (255, no member) attributes and reads as its codes;
+    flag_values, flag_meanings and _FillValue (255, the member `_missing`) attributes, its type
+    committed at the root as runs_<name>_t, and reads as its codes;
     free text is variable-length UTF-8 strings, contiguous; numbers and labels are chunked (C rows,
     N when N is smaller) through shuffle then deflate, with fill values the missing values."""
     for name, kind, _ in COLUMNS + [("done", "u", "")]:
@@ -214,8 +215,10 @@ def check_column_layout(runs, n):
         labels = LABELS.get(name)
         if labels is not None:
             check(d.dtype == np.dtype("uint8"), f"/runs/{name} base type {d.dtype}")
-            check(h5py.check_enum_dtype(d.dtype) == {lab: code for code, lab in enumerate(labels)},
+            check(h5py.check_enum_dtype(d.dtype) == {**{lab: code for code, lab in enumerate(labels)}, "_missing": 255},
                   f"/runs/{name} enum members {h5py.check_enum_dtype(d.dtype)}")
+            named = runs.file.get(f"runs_{name}_t")
+            check(isinstance(named, h5py.Datatype) and named.dtype == d.dtype, f"/runs_{name}_t: {named!r}")
             check(enum_labels(d) == labels, f"/runs/{name} labels by code {enum_labels(d)}")
             fv = d.attrs.get("flag_values")
             check(fv is not None and np.asarray(fv).dtype == np.dtype("uint8")

@@ -58,8 +58,9 @@ def decode_text(values, source=None):
     flat = np.asarray(values).reshape(-1)
     enum = h5py.check_enum_dtype(dtype) if dtype.kind != "b" else None
     if enum is not None:
-        names = {code: name for name, code in enum.items()}
-        return [names.get(int(v), "") for v in flat]  # a code without a member: the missing value
+        missing = 256 ** dtype.itemsize - 1  # the missing code (a member of its own since format 5)
+        names = {code: name for name, code in enum.items() if code != missing}
+        return [names.get(int(v), "") for v in flat]  # a code without a label: the missing value
     if dtype.kind in "SUO":
         return [v.decode("utf-8") if isinstance(v, bytes) else str(v) for v in flat]
     return None

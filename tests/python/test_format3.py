@@ -79,7 +79,7 @@ class Format3(unittest.TestCase):
 
     def test_the_files_are_of_the_two_formats(self):
         self.assertEqual(self.version3, 3)
-        self.assertEqual(self.version4, 4)
+        self.assertEqual(self.version4, 5)  # this kinesweep's format (labelled columns since 4)
         with h5py.File(self.v3, "r") as f3, h5py.File(self.v4, "r") as f4:
             self.assertEqual(f3["runs"]["method"].dtype.kind, "O")  # strings ...
             self.assertIsNotNone(h5py.check_enum_dtype(f4["runs"]["method"].dtype))  # ... and labels

@@ -405,17 +405,17 @@ class HistoryLayouts(unittest.TestCase):
         write_v2(v1, self.hist, version=1)
         with h5py.File(v1, "r") as f:
             self.assertEqual([i for i, _ in kshistory.Histories(f).items()], sorted(self.hist))
-        v5 = os.path.join(self.tmp.name, "v5.h5")
-        write_v3(v5, self.hist, sorted(self.hist), spare_chunks=0, compression=False, version=4)
-        with h5py.File(v5, "r+") as f:
-            f.attrs["format_version"] = np.int64(5)
+        v6 = os.path.join(self.tmp.name, "v6.h5")
+        write_v3(v6, self.hist, sorted(self.hist), spare_chunks=0, compression=False, version=4)
+        with h5py.File(v6, "r+") as f:
+            f.attrs["format_version"] = np.int64(6)
         with self.assertRaises(ksread.FormatVersionError) as e:
-            ksread.open_results(v5)
-        self.assertIn("format v5", str(e.exception))
-        with h5py.File(v5, "r") as f, self.assertRaises(ksread.FormatVersionError) as e:
+            ksread.open_results(v6)
+        self.assertIn("format v6", str(e.exception))
+        with h5py.File(v6, "r") as f, self.assertRaises(ksread.FormatVersionError) as e:
             kshistory.Histories(f)
-        self.assertIn("format v5", str(e.exception))
-        for version in (2, 3, 4):
+        self.assertIn("format v6", str(e.exception))
+        for version in (2, 3, 4, 5):
             path = os.path.join(self.tmp.name, f"none_v{version}.h5")
             with h5py.File(path, "w") as f:
                 write_common(f, version)

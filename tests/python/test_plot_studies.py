@@ -107,16 +107,16 @@ def file_blocks(f):
 
 def landscape_axes(g):
     """[(name, categorical, n values, sampled)] of a /landscapes group; sampled: the points of a design,
-    which no plot draws a grid over: a group of axes ("a+b") whose values are not monotonic, or
-    repeated values (a Saltelli design)."""
+    which no plot draws a grid over: the dimension `sample` (its `parameters` along it), or in format 4
+    files a group of axes ("a+b") whose values are not monotonic, or repeated values (a Saltelli design)."""
     out = []
     for a in g.attrs["axes"]:
         d = g[axis_dataset_name(h5str(a))]
         cat = h5str(d.attrs.get("unit", "")).startswith("labels:")
         v = d[()].astype(float)
         steps = np.diff(v)
-        sampled = not cat and len(v) > 1 and (len(np.unique(v)) < len(v) or (
-            "+" in h5str(a) and not (np.all(steps > 0) or np.all(steps < 0))))
+        sampled = "parameters" in d.attrs or not cat and len(v) > 1 and (len(np.unique(v)) < len(v) or (
+            "+" in h5str(a) and not (np.all(steps > 0) or np.all(steps < 0))))  # format 5: `sample`; 4: a+b
         out.append((h5str(a), cat, len(d), sampled))
     return out
 

@@ -254,7 +254,7 @@ class QueryTest(unittest.TestCase):
     def test_column_attributes_describe_every_column(self):
         """role / kinds / unit / description of every /runs column (h5py) against what the engine writes."""
         with h5py.File(self.h5, "r") as f:
-            self.assertEqual(int(f.attrs["format_version"]), 4)
+            self.assertEqual(int(f.attrs["format_version"]), 5)
             runs = f["runs"]
             attrs = {k: {a: h5s(runs[k].attrs[a]) for a in ("role", "kinds", "unit", "description")} for k in runs}
         for c in ("run_id", "block", "status", "wall_time", "done"):
@@ -450,7 +450,7 @@ class Version1FileTest(unittest.TestCase):
         r = ks("run", self.study, "-o", self.v1, "--resume", "-q")
         self.assertEqual(r.returncode, 1, r.stderr)
         self.assertIn("results file format v1 (written by kinesweep ", r.stderr)
-        self.assertIn("); this kinesweep resumes v3 to v4: rerun with --overwrite", r.stderr)
+        self.assertIn("); this kinesweep resumes v3 to v5: rerun with --overwrite", r.stderr)
         self.assertEqual((sha256(self.v1), os.stat(self.v1).st_mtime_ns), before)
         self.assertFalse(os.path.exists(self.v1 + ".journal"))
         self.assertEqual(sorted(os.listdir(self.tmp.name)), ["q.toml", "v1.h5", "v2.h5"])

@@ -129,12 +129,14 @@ class GroupAndOr(StudyFileTest):
                 self.assertIn(what, r.stderr)
 
     def test_info_gives_a_drawn_axis_its_range(self):
-        # The Latin-hypercube block's landscape axis (its LHS axes advance together: one axis named
-        # "alpha1A+k", holding alpha1A's draws in run order): info shows the range of the draws.
+        # The Latin-hypercube block's landscape dimension (its LHS axes advance together: the
+        # dimension "sample", alpha1A's draws in run order a coordinate along it): info shows the
+        # range of the draws.
         with h5py.File(self.h5, "r") as f:
             g = f["landscapes"]["drawn"]
             name = s(g.attrs["axes"][0])
-            a = g[name][()] * D
+            self.assertEqual(name, "sample")
+            a = g["alpha1A"][()] * D
         drawn = self.t["alpha1A"][self.t["block"] == "drawn"] * D
         np.testing.assert_allclose(np.sort(a), np.sort(drawn), rtol=1e-12)
         r = ks("info", self.h5)
@@ -142,7 +144,7 @@ class GroupAndOr(StudyFileTest):
         line = [x for x in r.stdout.splitlines() if "drawn: " + name in x]
         self.assertTrue(line, r.stdout)
         lo, hi = (f"{v:.6g}" for v in (a.min(), a.max()))
-        self.assertIn(f"({len(a)}, drawn in {lo} .. {hi} deg)", line[0])
+        self.assertIn(f"alpha1A ({len(a)}, drawn in {lo} .. {hi} deg)", line[0])
 
 
 class OptimizationWhere(unittest.TestCase):

@@ -60,8 +60,9 @@ class Xarray(StudyFileTest):
         import xarray as xr
         for block in ("local", "basins"):
             axes, metrics = stored(self.h5, block)
+            # the stored values (a status grid's int8 codes as they are: no _FillValue masking)
             with self.subTest(block=block), xr.open_dataset(self.h5, group="landscapes/" + block,
-                                                            engine="h5netcdf") as ds:
+                                                            engine="h5netcdf", mask_and_scale=False) as ds:
                 names = [a[0] for a in axes]
                 self.assertEqual(list(ds.dims), names)  # no phony_dim_N
                 for name, unit, values in axes:
