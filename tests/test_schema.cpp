@@ -74,6 +74,8 @@ std::string expected_units(const Family& f, const std::string& name) {
     if (name == "K_D") return "1/s";
     if (name == "tracking_bound") return "m";
     if (name == "orientation_bound") return "deg/rad";
+    if (name == "end_window") return "s";
+    if (name == "end_gain") return "1/s";
     return "";
   }
   if (name == "q0_1" || name == "q0_2" || name == "target_alpha") return "deg/rad";

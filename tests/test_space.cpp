@@ -37,7 +37,8 @@ TEST(Space, ColumnsCoverEveryParameterOfTheKind) {
   EXPECT_EQ(names, (std::vector<std::string>{"preset", "method", "k", "alpha1A", "K_N", "K_L", "vertex_alpha_2",
                                              "vertex_alpha_3", "vertex_alpha_4", "vertex_alpha_5", "integrator",
                                              "dt", "torque_bound", "K_P", "K_D", "tracking_bound", "orientation_bound",
-                                             "on_violation", "inertia"}));
+                                             "on_violation", "inertia", "start_branch", "end", "end_window",
+                                             "end_gain"}));
   EXPECT_EQ(t.columns()[t.column_index("alpha1A")].unit, "rad");
   EXPECT_EQ(t.columns()[t.column_index("vertex_alpha_5")].unit, "rad");
   EXPECT_EQ(t.columns()[t.column_index("method")].type, CellType::str);

@@ -260,6 +260,9 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
     if constexpr (S == TaskSpace::planar_pose) v.orient = std::abs(d.alpha_now - d.alpha);
     if constexpr (S == TaskSpace::spatial_pose) v.orient = orientation_angle(e.st.tip.R, held);
     v.alpha = angle ? d.alpha_now : nan;
+    double ke = 0;  // qd^T M qd (no temporary per sample)
+    for (int j = 0; j < dof; ++j) ke += qd[j] * e.st.M.row(j).head(dof).dot(qd.head(dof));
+    v.ke = 0.5 * ke;
     const bool off = sums.add(i, t, v, abs_tau, dof, keep);
     const bool beyond = sums.limits(q.data(), qd.data(), tau.data(), dof);
     sums.mark(off, beyond);
@@ -345,6 +348,8 @@ TrajectoryMetrics simulate(const Chain& chain, const ChainTask& task, const VecN
   if (sampled.dt() != o.dt)
     throw std::invalid_argument("simulate: path sampled at dt = " + std::to_string(sampled.dt()) +
                                 " s, options ask for dt = " + std::to_string(o.dt) + " s");
+  if (o.end == EndState::rest)
+    throw std::invalid_argument("simulate: end = rest is the seed arm's closed-form runs' option; a chain's runs end free");
   if (q0.size() != n)
     throw std::invalid_argument("simulate: q0 has " + std::to_string(q0.size()) + " values for a chain of " +
                                 std::to_string(n) + " joints");

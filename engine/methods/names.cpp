@@ -38,6 +38,7 @@ constexpr NameTable<Extension, 3> kExtensions{
     {{Extension::alpha, "alpha"}, {Extension::self_motion, "self_motion"}, {Extension::joints, "joints"}}};
 constexpr NameTable<EndState, 2> kEnds{{{EndState::rest, "rest"}, {EndState::free, "free"}}};
 constexpr NameTable<StartPosture, 2> kPostures{{{StartPosture::fixed, "fixed"}, {StartPosture::free, "free"}}};
+constexpr NameTable<Elbow, 2> kElbows{{{Elbow::positive, "elbow_down"}, {Elbow::negative, "elbow_up"}}};
 constexpr NameTable<OnViolation, 3> kOnViolation{
     {{OnViolation::mark, "mark"}, {OnViolation::stop, "stop"}, {OnViolation::ignore, "ignore"}}};
 
@@ -50,6 +51,8 @@ bool parse(std::string_view n, TrajectoryMethod& out) { return value_of(kMethods
 bool parse(std::string_view n, Integrator& out) { return value_of(kIntegrators, n, out); }
 bool parse(std::string_view n, RunStatus& out) { return value_of(kStatuses, n, out); }
 std::string_view to_string(OnViolation v) { return name_of(kOnViolation, v); }
+std::string_view to_string(Elbow e) { return name_of(kElbows, e); }
+bool parse(std::string_view n, Elbow& out) { return value_of(kElbows, n, out); }
 bool parse(std::string_view n, OnViolation& out) { return value_of(kOnViolation, n, out); }
 std::string_view to_string(GlobalObjective v) { return name_of(kObjectives, v); }
 std::string_view to_string(AlphaSpline v) { return name_of(kSplines, v); }
@@ -81,7 +84,9 @@ bool TrajectoryOptions::IsValid(std::string* why) const {
                      {"K_P", clik_kp, clik_gain_rule},
                      {"K_D", clik_kd, clik_gain_rule},
                      {"tracking_bound", tracking_bound, bound_rule},
-                     {"orientation_bound", orientation_bound, bound_rule}},
+                     {"orientation_bound", orientation_bound, bound_rule},
+                     {"end_window", end_window, end_window_rule},
+                     {"end_gain", end_gain, end_gain_rule}},
                     why))
     return false;
   if (method == TrajectoryMethod::global_spline && !global.IsValid(why)) return false;

@@ -216,7 +216,8 @@ TrajectoryMetrics PathGlobalProblem::measure(const AlphaBasis& basis, const doub
     const double p0 = s.tau[0] * s.qd[0], p1 = s.tau[1] * s.qd[1], p2 = s.tau[2] * s.qd[2];
     const double alpha = s.q[0] + s.q[1] + s.q[2];
     const SampleValues<double> v{3, s.q.data(), s.qd.data(), s.tau.data(), tt, 0.0, Mi.P.quadratic_form(s.tau), Mi.det,
-                                 p0 * p0 + p1 * p1 + p2 * p2, manipulability_squared(s.J), err.squaredNorm(), 0.0, alpha};
+                                 p0 * p0 + p1 * p1 + p2 * p2, manipulability_squared(s.J), err.squaredNorm(), 0.0, alpha,
+                                 0.5 * s.M.quadratic_form(s.qd)};
     const bool off = sums.add(i, t, v, abs_tau, 3, keep);
     sums.mark(off);
     if (history && (i % static_cast<std::size_t>(history->stride) == 0 || i + 1 == n)) {

@@ -200,8 +200,9 @@ TrajectoryMetrics ChainGlobalProblem::measure(const AlphaBasis& basis, const dou
     double p6 = 0;
     for (int j = 0; j < n_; ++j) p6 += (s.tau[j] * s.qd[j]) * (s.tau[j] * s.qd[j]);
     const double qf = s.tau.dot(state_.M.ldlt().solve(s.tau));
-    const SampleValues<double> v{n_, s.q.data(), s.qd.data(), s.tau.data(), s.tau.squaredNorm(), 0.0, qf, 1.0, p6, w2,
-                                 err2, 0.0, s.alpha};
+    SampleValues<double> v{n_, s.q.data(), s.qd.data(), s.tau.data(), s.tau.squaredNorm(), 0.0, qf, 1.0, p6, w2,
+                                 err2, 0.0, s.alpha, 0.0};
+    for (int j = 0; j < n_; ++j) v.ke += 0.5 * s.qd[j] * state_.M.row(j).head(n_).dot(s.qd.head(n_));
     const bool off = sums.add(i, task_.path.time(i), v, abs_tau, n_, keep);
     const bool beyond = sums.limits(s.q.data(), s.qd.data(), s.tau.data(), n_);
     sums.mark(off, beyond);

@@ -262,6 +262,13 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
     v.err2 = ex * ex + ey * ey;
     v.orient = oriented ? std::abs(alpha - fb[2]) : 0.0;
     v.alpha = alpha;
+    double ke = 0;  // qd^T M qd / 2: the same in the kernel's coordinates u = sigma q
+    for (int j = 0; j < N; ++j) {
+      double Mqd = 0;
+      for (int l = 0; l < N; ++l) Mqd += e.st.M[j][l] * qd[l];
+      ke += qd[j] * Mqd;
+    }
+    v.ke = 0.5 * ke;
     const bool off = sums.add(i, t, v, abs_tau, N, keep);
     bool beyond = false;
     if (shape.limits) beyond = sums.limits(qa, qda, tau, N);

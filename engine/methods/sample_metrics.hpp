@@ -38,6 +38,7 @@ struct SampleValues {
   T err2;                 ///< squared tip position error [m^2]
   T orient;               ///< |orientation error| [rad] (0 for position tasks)
   T alpha;                ///< tip angle [rad] (NaN for spatial tasks)
+  T ke;                   ///< kinetic energy qd^T M(q) qd / 2 [J]
 };
 
 /// How the per-sample values of a metric become the run's value (an empty run: NaN).
@@ -45,6 +46,7 @@ enum class Reduce {
   mean,  ///< sum / samples
   max,   ///< largest (std::max semantics: a NaN value is skipped)
   min,   ///< smallest (std::min semantics)
+  last,  ///< the value at the last sample computed (the run's end state)
 };
 
 /// One metric: what /runs shows (name, unit, description, display label, whether landscapes grid
@@ -69,6 +71,15 @@ inline constexpr auto kSampleMetrics = std::tuple{
                    for (int j = 1; j < s.n; ++j) p = vmax(p, vabs(s.tau[j] * s.qd[j]));
                    return p;
                  }},
+    SampleMetric{"end_qd_max", "rad/s", "max over joints of |qd_i| at the last sample (the arm's motion at the end)",
+                 "end joint rate", false, Reduce::last,
+                 [](const auto& s) {
+                   auto m = vabs(s.qd[0]);
+                   for (int j = 1; j < s.n; ++j) m = vmax(m, vabs(s.qd[j]));
+                   return m;
+                 }},
+    SampleMetric{"end_kinetic_energy", "J", "kinetic energy qd^T M qd / 2 at the last sample", "end kinetic energy",
+                 false, Reduce::last, [](const auto& s) { return s.ke; }},
 };
 
 inline constexpr int kSampleMetricCount = static_cast<int>(std::tuple_size_v<decltype(kSampleMetrics)>);
@@ -95,7 +106,8 @@ constexpr int sample_metric_index(std::string_view name) {
 constexpr double reduce_start(Reduce r) {
   return r == Reduce::mean  ? 0.0
          : r == Reduce::max ? -std::numeric_limits<double>::infinity()
-                            : std::numeric_limits<double>::infinity();
+         : r == Reduce::min ? std::numeric_limits<double>::infinity()
+                            : std::numeric_limits<double>::quiet_NaN();
 }
 
 }  // namespace ks

@@ -107,7 +107,8 @@ class SampleSums {
       const T x = m.value(v);
       sampled_[k] = keep(m.reduce == Reduce::mean ? sampled_[k] + x
                          : m.reduce == Reduce::max ? vmax(sampled_[k], x)
-                                                   : vmin(sampled_[k], x),
+                         : m.reduce == Reduce::min ? vmin(sampled_[k], x)
+                                                   : x,
                          sampled_[k]);
     });
     return (v.err2 > bound2_) | (v.orient > obound_);

@@ -5,6 +5,7 @@
 // store buffer (a stall of the whole step on x86).
 #include "methods/trajectory.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -59,6 +60,12 @@ void stage_tasks(const Path2& path, const Profile1* unit, double t, double dt, S
   out.unit_1 = unit ? unit->sample_on(out.seg_1, t1).a[0] : 0.0;
 }
 
+double rest_weight(const Shared& s, double t) {
+  if (!(t >= s.rest_from)) return 0.0;
+  const double u = std::min(1.0, (t - s.rest_from) / s.rest_window);
+  return u * u * (3.0 - 2.0 * u);
+}
+
 double unit_alpha_acceleration(const Profile1& unit, std::size_t segment, double t) {
   return unit.sample_on(segment, t).a[0];
 }
@@ -107,6 +114,14 @@ void prepare(Batch& b, int lanes, const PlanarArm3& arm, const SampledPath& samp
   s.alpha_unit = nullptr;
   s.closed_loop = o0.closed_loop();
   s.stop_on_bound = o0.on_violation == OnViolation::stop;
+  const bool local = o0.method == TrajectoryMethod::local_weighted || o0.method == TrajectoryMethod::local_unweighted;
+  if (local && o0.end == EndState::rest) {
+    double duration = 0;
+    for (double d : path.durations()) duration += d;
+    s.rest_from = duration - o0.end_window;
+    s.rest_window = o0.end_window;
+    s.rest_gain = o0.end_gain;
+  }
   const std::size_t segments = path.segments();
   if (o0.method == TrajectoryMethod::vertex_alpha) {
     std::vector<Eigen::Matrix<double, 1, 1>> v;

@@ -61,6 +61,11 @@ std::string_view to_string(TrajectoryMethod m);
 std::string_view to_string(Integrator i);
 std::string_view to_string(RunStatus s);
 std::string_view to_string(OnViolation v);
+/// The start posture's elbow branch by name: "elbow_down" (Elbow::positive, the seed's sin(theta2) >= 0: the
+/// elbow on the clockwise side of the shoulder-to-wrist line, below it for the seed's square) and
+/// "elbow_up" (Elbow::negative).
+std::string_view to_string(Elbow e);
+bool parse(std::string_view name, Elbow& out);
 /// Parse a name; false when unknown.
 bool parse(std::string_view name, TrajectoryMethod& out);
 bool parse(std::string_view name, Integrator& out);
@@ -92,6 +97,18 @@ struct TrajectoryOptions {
   double tracking_bound = 0.05;       ///< |tip - path| above this [m] is off the path
   double orientation_bound = 0.05;    ///< pose tasks: an orientation error above this [rad] is off the path
   OnViolation on_violation = OnViolation::mark;
+  /// Local methods (seed arm): the arm's state at the path's end. free: the method's own motion to
+  /// the end (the seed's; the arm may still move in its self-motion there). rest: a terminal feedback
+  /// over the last end_window seconds: the method's null-space term (-(I - J+ J) (M^-1 (c + k g) +
+  /// K_N qd)) blends into -(I - J+ J) K_S qd, K_S = end_gain, J+ the method's own weighted
+  /// pseudo-inverse, with a weight s rising smoothly from 0 to 1 over the window (3 u^2 - 2 u^3), so
+  /// the self-motion rate decays by about exp(-K_S end_window / 2); an open-loop run also feeds the
+  /// tip's error back there (K_D = 2 K_S, K_P = K_S^2: critically damped; a closed-loop run keeps its
+  /// own gains), so the tip holds the path, which ends at rest: the arm ends at rest up to the open
+  /// loop's integration residual. The window's samples count in E like any other.
+  EndState end = EndState::free;
+  double end_window = 0.5;            ///< end = rest: the feedback's time before the path's end [s]
+  double end_gain = 60.0;             ///< end = rest: K_S [1/s]
   PathGlobalOptions global;           ///< global_spline only
 
   /// The rules on the fields (checked by IsValid; the study schema reports them at the key).
@@ -102,6 +119,8 @@ struct TrajectoryOptions {
   static constexpr Domain singular_tolerance_rule = Domain::nonnegative();
   static constexpr Domain clik_gain_rule = Domain::nonnegative();
   static constexpr Domain bound_rule = Domain::positive();
+  static constexpr Domain end_window_rule = Domain::positive();
+  static constexpr Domain end_gain_rule = Domain::positive();
 
   /// True when the run feeds the task error back (a gain is not 0).
   bool closed_loop() const { return clik_kp != 0.0 || clik_kd != 0.0; }

@@ -63,7 +63,15 @@ struct Shared {
   const std::uint32_t* segment = nullptr;  ///< SampledPath::segments()
   bool closed_loop = false;             ///< the runs feed the task error back (TrajectoryOptions::closed_loop)
   bool stop_on_bound = false;           ///< on_violation = stop
+  /// end = rest (local methods): the time from which the terminal feedback replaces the method's
+  /// null-space term [s] (infinity: never), and its gain K_S [1/s]
+  double rest_from = std::numeric_limits<double>::infinity();
+  double rest_window = 1;  ///< its duration [s]
+  double rest_gain = 0;
 };
+/// Out of line (methods/trajectory.cpp): the terminal feedback's weight at time t [s]: 0 before the
+/// window, rising smoothly (3 u^2 - 2 u^3 of the window's fraction u) to 1 at the path's end.
+double rest_weight(const Shared& s, double t);
 
 /// The per-run inputs, one slot per lane (lanes past the batch and unreachable starts: active = 0, with
 /// another run's inputs so that they compute ordinary numbers).
@@ -102,6 +110,8 @@ struct Task {
   // orientation, its rate and the arm's orientation at this state
   double p[2], v[2];
   T alpha_d, alpha_v, alpha;
+  bool rest = false;  // end = rest: in the terminal feedback's window (local methods)
+  double rest_weight = 0;  // and its weight there (rest_weight)
 };
 
 template <class T>
@@ -120,7 +130,8 @@ class Resolver {
   Resolver(const Shared& s, const Runs& in)
       : arm_(*s.arm), dyn_(*s.dyn), method_(s.method),
         w_(s.method == TrajectoryMethod::local_unweighted ? Weighting::inertia_squared : Weighting::inertia),
-        closed_(s.closed_loop), k_(load_lanes<T>(in.k)), kn_(load_lanes<T>(in.null_damping)),
+        closed_(s.closed_loop), ks_(s.rest_gain), kp_rest_(s.rest_gain * s.rest_gain), kd_rest_(2.0 * s.rest_gain),
+        k_(load_lanes<T>(in.k)), kn_(load_lanes<T>(in.null_damping)),
         tol_(load_lanes<T>(in.tolerance)), tol2_(tol_ * tol_), kp_(load_lanes<T>(in.kp)), kd_(load_lanes<T>(in.kd)) {}
 
   /// Joint accelerations of the method for task x at (trig, qd); fills every intermediate in `e`.
@@ -134,11 +145,14 @@ class Resolver {
     const Vec2Of<T> jdqd = jacobian_dot_times_qd(arm_, trig, qd);
     Vec2Of<T> b{x.a[0] - jdqd[0], x.a[1] - jdqd[1]};
     T alpha_dd = x.alpha_dd;
-    if (closed_) {  // CLIK: + K_D (v_path - J qd) + K_P (p_path - tip), tip = (J10, -J00)
+    if (closed_ || x.rest) {  // CLIK: + K_D (v_path - J qd) + K_P (p_path - tip), tip = (J10, -J00)
+      // (the end = rest window of an open-loop run: K_D = 2 K_S, K_P = K_S^2, the tip error critically damped)
+      const T& kd = closed_ ? kd_ : kd_rest_;
+      const T& kp = closed_ ? kp_ : kp_rest_;
       const T v0 = e.J(0, 0) * qd[0] + e.J(0, 1) * qd[1] + e.J(0, 2) * qd[2];
       const T v1 = e.J(1, 0) * qd[0] + e.J(1, 1) * qd[1] + e.J(1, 2) * qd[2];
-      b[0] = b[0] + kd_ * (x.v[0] - v0) + kp_ * (x.p[0] - e.J(1, 0));
-      b[1] = b[1] + kd_ * (x.v[1] - v1) + kp_ * (x.p[1] + e.J(0, 0));
+      b[0] = b[0] + kd * (x.v[0] - v0) + kp * (x.p[0] - e.J(1, 0));
+      b[1] = b[1] + kd * (x.v[1] - v1) + kp * (x.p[1] + e.J(0, 0));
       if (method_ == TrajectoryMethod::vertex_alpha)
         alpha_dd = alpha_dd + kd_ * (x.alpha_v - (qd[0] + qd[1] + qd[2])) + kp_ * (x.alpha_d - x.alpha);
     }
@@ -151,6 +165,13 @@ class Resolver {
     e.w2 = manipulability_squared(e.J);
     const MaskOf<T> ok = e.w2 >= tol2_;
     if (!any(ok)) return ok;
+    if (x.rest) {  // terminal feedback: the null-space term blends from the method's into -(I - J+ J) K_S qd
+      // (local_acceleration is linear in c, g and K_N: weights 1 - s and s give that blend)
+      const T keep = T(1.0 - x.rest_weight), s = T(x.rest_weight);
+      const Vec3Of<T> c{keep * e.c[0], keep * e.c[1], keep * e.c[2]}, g{keep * e.g[0], keep * e.g[1], keep * e.g[2]};
+      e.qdd = local_acceleration<T>(w_, e.Mi, e.J, b, c, g, k_, keep * kn_ + s * ks_, qd);
+      return ok;
+    }
     e.qdd = local_acceleration<T>(w_, e.Mi, e.J, b, e.c, e.g, k_, kn_, qd);
     return ok;
   }
@@ -161,7 +182,7 @@ class Resolver {
   const TrajectoryMethod method_;
   const Weighting w_;
   const bool closed_;
-  const T k_, kn_, tol_, tol2_, kp_, kd_;
+  const T ks_, kp_rest_, kd_rest_, k_, kn_, tol_, tol2_, kp_, kd_;
 };
 
 /// Writes sample i of the lanes in `write` (a bit per lane) to their histories.
@@ -258,7 +279,9 @@ void run(const Shared& s, const Runs& in, Sums* out) {
     const double* xa = s.samples + 4 * i;
     Task<T> x{{xa[2], xa[3]}, T(0.0), {xa[0], xa[1]}, {0.0, 0.0}, T(0.0), T(0.0), q[0] + q[1] + q[2]};
     if (vertex) x.alpha_dd = unit_alpha_acceleration(*s.alpha_unit, s.segment[i], t) * rise(s.segment[i]);
-    if (s.closed_loop || vertex) feed(s.segment[i], t, x);
+    x.rest = t >= s.rest_from;
+    x.rest_weight = rest_weight(s, t);
+    if (s.closed_loop || vertex || x.rest) feed(s.segment[i], t, x);
     if (stop(resolver.evaluate(x, trig.trig(), qd, e), singular)) break;
     const V3 Mqdd = e.M * e.qdd;
     const T tau0 = Mqdd[0] + e.c[0] + e.g[0], tau1 = Mqdd[1] + e.c[1] + e.g[1], tau2 = Mqdd[2] + e.c[2] + e.g[2];
@@ -274,9 +297,11 @@ void run(const Shared& s, const Runs& in, Sums* out) {
     const T p0 = tau0 * qd[0], p1 = tau1 * qd[1], p2 = tau2 * qd[2];
     const T alpha = q[0] + q[1] + q[2];
     const T taus[3] = {tau0, tau1, tau2};
+    const V3 Mqd = e.M * qd;
+    const T ke = 0.5 * (qd[0] * Mqd[0] + qd[1] * Mqd[1] + qd[2] * Mqd[2]);
     const SampleValues<T> v{3, &q[0], &qd[0], taus, tt, T(0.0), e.Mi.P.quadratic_form(tau), e.Mi.det,
                             p0 * p0 + p1 * p1 + p2 * p2, e.w2, ex * ex + ey * ey,
-                            vertex ? vabs(alpha - x.alpha_d) : T(0.0), alpha};
+                            vertex ? vabs(alpha - x.alpha_d) : T(0.0), alpha, ke};
     const M off = sums.add(i, t, v, a, 3, keep) & active;
     sums.mark(off);
     if (in.any_history) {
@@ -303,10 +328,12 @@ void run(const Shared& s, const Runs& in, Sums* out) {
         xh.alpha_dd = stt.unit_h * rise(stt.seg_h);
         x1.alpha_dd = stt.unit_1 * rise(stt.seg_1);
       }
-      if (s.closed_loop) {
-        feed(stt.seg_h, t + hdt, xh);
-        feed(stt.seg_1, t + dt, x1);
-      }
+      xh.rest = t + hdt >= s.rest_from;
+      x1.rest = t + dt >= s.rest_from;
+      xh.rest_weight = rest_weight(s, t + hdt);
+      x1.rest_weight = rest_weight(s, t + dt);
+      if (s.closed_loop || xh.rest) feed(stt.seg_h, t + hdt, xh);
+      if (s.closed_loop || x1.rest) feed(stt.seg_1, t + dt, x1);
       const V3 k1q = qd, k1v = e.qdd;
       const V3 q2{q[0] + hdt * k1q[0], q[1] + hdt * k1q[1], q[2] + hdt * k1q[2]};
       const V3 k2q{qd[0] + hdt * k1v[0], qd[1] + hdt * k1v[1], qd[2] + hdt * k1v[2]};

@@ -54,7 +54,8 @@ void limit_lanes(int lanes) {
 
 bool lane_compatible(const TrajectoryOptions& a, const TrajectoryOptions& b) {
   return a.method == b.method && a.integrator == b.integrator && a.dt == b.dt &&
-         a.closed_loop() == b.closed_loop() && a.on_violation == b.on_violation;
+         a.closed_loop() == b.closed_loop() && a.on_violation == b.on_violation && a.end == b.end &&
+         (a.end == EndState::free || (a.end_window == b.end_window && a.end_gain == b.end_gain));
 }
 
 void simulate_lanes(int lanes, const PlanarArm3& arm, const SampledPath& sampled, const TrajectoryOptions* options,

@@ -24,7 +24,7 @@ int max_lanes();
 /// tests and benchmarks or to run the single-run path. Process-wide; thread-safe.
 void limit_lanes(int lanes);
 
-/// Whether runs with options a and b may share lanes: the same method, integrator and dt.
+/// Whether runs with options a and b may share lanes: the same method, integrator, dt and end condition.
 bool lane_compatible(const TrajectoryOptions& a, const TrajectoryOptions& b);
 
 /// Runs `count` (1 .. lanes) lane-compatible runs at once in `lanes` lanes (1, 4 or 8, at most

@@ -151,6 +151,24 @@ std::vector<ParamDef> trajectory_params(const KindContext& ctx) {
   if (!robot.chain)
     t.push_back(named<Run>("inertia", names_of<InertiaForm>(InertiaForm::physical, InertiaForm::thesis_m11),
                            "closed form of M(q)", [](auto& r) -> auto& { return r.inertia; }));
+  if (!robot.chain) {
+    t.push_back(named<Run>("start_branch", names_of<Elbow>(Elbow::positive, Elbow::negative),
+                           "elbow branch of the start posture's analytic IK at alpha1A: elbow_down (sin theta2 >= 0, "
+                           "the seed's) or elbow_up",
+                           [](auto& r) -> auto& { return r.options.elbow; }));
+    const EffectRule local{"method", {"local_weighted", "local_unweighted"}};
+    t.push_back(named<Run>("end", names_of<EndState>(EndState::free, EndState::rest),
+                           "local methods: free (the method's own motion to the end) or rest (over the last "
+                           "end_window the null-space term blends into -(I - J+ J) end_gain qd and the tip error "
+                           "is fed back: the arm ends at rest on the path's end)",
+                           [](auto& r) -> auto& { return r.options.end; }, local));
+    t.push_back(real<Run>("end_window", FileUnit::none, "s", TrajectoryOptions::end_window_rule,
+                          "end = rest: time before the path's end from which the terminal feedback acts",
+                          [](auto& r) -> auto& { return r.options.end_window; }, local));
+    t.push_back(real<Run>("end_gain", FileUnit::none, "1/s", TrajectoryOptions::end_gain_rule,
+                          "end = rest: the terminal feedback's gain K_S on the self-motion rate",
+                          [](auto& r) -> auto& { return r.options.end_gain; }, local));
+  }
   for (int j = 0; robot.chain && j < robot.joints; ++j) {
     const bool prismatic = robot.is_prismatic(j);
     t.push_back(real<Run>("q0_" + std::to_string(j + 1), prismatic ? FileUnit::none : FileUnit::deg,
