@@ -1,0 +1,59 @@
+#pragma once
+// The best runs of a results file verified against their grid: each is computed again at dt/2 and
+// dt/4 (global_spline's cubic splines also at 2K and 4K knots), and the grid convergence index of
+// its key quantities (verify/gci.hpp) goes into the file's /verification table (FORMAT.md).
+#include <atomic>
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "store/store.hpp"
+#include "study/study.hpp"
+#include "verify/gci.hpp"
+
+namespace ks {
+
+/// A run that the verification step takes: the best good run of a group of a trajectory block.
+struct BestRunRef {
+  std::uint64_t run = 0;  ///< global run id
+  std::size_t block = 0;  ///< index into study.blocks
+  std::string method;
+  std::string group;      ///< "method=global_spline, end_state=rest"
+};
+
+/// The runs to verify in a results file of `study` (`file`, its done runs): per trajectory block, the
+/// best good run (schema/params.hpp `ranking`: lowest objective, then tie, then run id) of each
+/// method and, where the end_state parameter has an effect on the run, each end state (a run
+/// ending at rest and one free to move are not the same problem). In block order, then by method and
+/// end state. Throws store::StoreError when the file cannot be read.
+std::vector<BestRunRef> best_runs_to_verify(const Study& study, const store::ResultsReader& file);
+
+/// What the verification step computes.
+struct BestRunVerifyOptions {
+  int threads = 0;   ///< worker threads (0: all cores)
+  GciOptions gci;    ///< Fs
+  /// The /runs metrics verified (each that the block has): E, the peak torque, the integral of tau^T
+  /// tau, and global_spline's objective.
+  std::vector<std::string> quantities{"E", "tau_inf", "torque_sq_integral", "opt_objective"};
+  const std::atomic<bool>* stop = nullptr;  ///< set: the runs not begun are skipped (their rows not_enough)
+};
+inline constexpr double kGridRatio = 2.0;  ///< the refinement ratio r of the verification grids
+
+/// The grid studies of `runs` (from best_runs_to_verify): each run's spec computed at dt/2 and dt/4
+/// (refinement "dt"), and for global_spline with cubic splines at 2K and 4K knots ("knots", skipped
+/// when 4K is beyond the knots' domain), in parallel; grid 3 is the stored row of `file`. One row per
+/// (run, refinement, quantity). The same whatever the thread count (each run is a pure function of
+/// its spec).
+store::VerificationTable verify_best_runs(const Study& study, const store::ResultsReader& file,
+                                          const std::vector<BestRunRef>& runs, const BestRunVerifyOptions& options);
+
+/// "E = 34.36 Nm (GCI 0.03 %)" for a row of convergence monotone or unchanged (GCI of the run as
+/// stored, grid 3); "tau_inf diverges (182, 319, 573 Nm at 20, 40, 80 knots)" for divergent and
+/// oscillatory rows; "E: not verified (status on dt/4: max_evaluations)" for not_enough.
+std::string verification_phrase(const store::VerificationRow& row);
+
+/// The table as `kinesweep run` prints it: per run, one line per refinement with its quantities' phrases.
+void print_verification(std::ostream& out, const store::VerificationTable& table);
+
+}  // namespace ks
