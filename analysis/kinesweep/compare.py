@@ -103,11 +103,12 @@ def _grid(rows, run, metric):
     return "converged", gci
 
 
-def compare(results, by="method", metrics=None, end=None):
+def compare(results, by="method", metrics=None, end=None, where=None):
     """The verdict table (list of dicts, keys: kind, end, metric, unit, rank, <by>, run, value, grid,
     gci [%], uncertainty, next, margin, margin_uncertainty, verdict) of a results file (path or
     open Results). `metrics`: metric names (default: each kind's ranking objective); `end`: "rest"
-    or "free" (only runs that end so), "any" (mixed), None (each end condition on its own)."""
+    or "free" (only runs that end so), "any" (mixed), None (each end condition on its own); `where`:
+    `kinesweep query --where` expressions (str or list; angles in degrees) the rows must all meet."""
     r = _open(results)
     columns = r.columns()
     if by not in columns:
@@ -125,9 +126,9 @@ def compare(results, by="method", metrics=None, end=None):
                 raise KeyError(f"{m!r} is not a numeric metric of {kind} runs; expected one of {', '.join(numeric)}")
     needed = ["run_id", "status", by] + [c for c in ("method", "spline", "end_state") if c in columns]
     needed += sorted({m for ms in wanted.values() for m in ms})
-    t = r.runs(columns=list(dict.fromkeys(needed)))
-    row_kind = r.row_kinds()
+    t = r.runs(columns=list(dict.fromkeys(needed)), where=where)
     ids = np.asarray(t["run_id"], dtype=np.int64)
+    row_kind = r.row_kinds(done_only=False)[ids]
     group_text = np.array([_group_text(x) for x in t[by]], dtype=object)
     best = {}
     for i in range(len(ids)):

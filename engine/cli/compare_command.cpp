@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "cli/query_util.hpp"
+#include "cli/query_where.hpp"
 #include "schema/params.hpp"
 #include "store/store.hpp"
 #include "verify/gci.hpp"
@@ -118,6 +119,13 @@ int run_compare(const CompareArgs& args) {
       }
     }
   }
+  std::vector<Disjunction> filters;
+  try {
+    for (const std::string& expr : args.where) filters.push_back(parse_where(expr, t));
+  } catch (const ArgError& e) {
+    std::cerr << "kinesweep compare: error: --where: " << e.what() << '\n';
+    return 2;
+  }
   const store::VerificationTable verification = reader.read_verification();
   // best[(kind, end, metric)][group]: the lowest value among the good runs (then the lower run id)
   std::map<std::tuple<std::string, std::string, std::string>, std::map<std::string, Best>> best;
@@ -129,8 +137,10 @@ int run_compare(const CompareArgs& args) {
     const RunsColumn* spline = p.find("spline");
     const RunsColumn* end_state = p.find("end_state");
     const RunsColumn* group = p.find(args.by);
+    const Selector select{p, false};
     for (std::int64_t r = 0; r < static_cast<std::int64_t>(p.done.size()); ++r) {
       if (!p.done[static_cast<std::size_t>(r)]) continue;
+      if (!std::all_of(filters.begin(), filters.end(), [&](const Disjunction& d) { return select.test(d, r); })) continue;
       const std::string kind = p.kind(r);
       const auto m = metrics.find(kind);
       if (m == metrics.end()) continue;
@@ -215,6 +225,8 @@ CompareArgs& add_compare_command(CLI::App& app) {
   c->add_option("--metric", a.metrics, "metrics to compare (default: the run kind's ranking objective, E)");
   c->add_option("--end", a.end, "rest | free: only runs ending so; any: mix them (default: each on its own)")
       ->check(CLI::IsMember({"rest", "free", "any"}));
+  c->add_option("-w,--where", a.where, "only the rows where EXPR holds (kinesweep query's syntax, angles in degrees; "
+                                      "repeatable: all hold), e.g. inertia=physical");
   c->add_option("--format", a.format, "table (default), json or csv")->check(CLI::IsMember({"table", "json", "csv"}));
   return a;
 }

@@ -1,5 +1,6 @@
 #pragma once
-// `kinesweep compare FILE [--by COLUMN] [--metric M ...] [--end rest|free|any] [--format table|json]`:
+// `kinesweep compare FILE [--by COLUMN] [--metric M ...] [--end rest|free|any] [--where EXPR ...]
+//  [--format table|json|csv]`:
 // a verdict table. For each group of runs (by method, or any /runs column), the best run under
 // common conditions (the good status of its kind, the same end condition), its grid convergence
 // index from /verification, and its margin to the next group with the uncertainty of both, per
@@ -21,6 +22,9 @@ struct CompareArgs {
   /// condition on its own, never mixed
   std::string end;
   std::string format = "table";      ///< table | json | csv
+  /// only the rows where every expression holds (`kinesweep query --where` syntax; angles in degrees),
+  /// e.g. "inertia=physical": the same robot model for every group
+  std::vector<std::string> where;
 };
 
 CompareArgs& add_compare_command(CLI::App& app);

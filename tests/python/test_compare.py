@@ -10,7 +10,8 @@
 - compare: the best good run per group, runs ending at rest never ranked with runs free to move
   (unless --end any), the margin to the next group with the sum of both uncertainties; its JSON
   equals kinesweep.compare.compare() of the Python package, on a small study and on the shipped
-  thesis_table4; bad --by and --metric are refused with exit status 2.
+  thesis_table4; --where selects rows as query's; bad --by, --metric and --where are refused with
+  exit status 2.
 
 usage: /usr/bin/python3 test_compare.py KINESWEEP_BINARY SOURCE_DIR
 """
@@ -280,6 +281,9 @@ class CompareTest(TempDirTest):
         self.assertEqual(len(mixed), 4)  # one row per method: its best over both end conditions
         by_block = self.check_python_equals_cli(self.h5, "--by", "block", by="block")
         self.assertEqual({x["block"] for x in by_block}, {"local", "vertex", "global"})
+        no_global = self.check_python_equals_cli(self.h5, "--where", "block!=global", "-w", "alpha1A<0",
+                                                 where=["block!=global", "alpha1A<0"])
+        self.assertEqual({x["method"] for x in no_global}, {"local_weighted", "local_unweighted", "vertex_alpha"})
         text = run("compare", self.h5).stdout
         self.assertIn("margin", text)
         self.assertIn("global_spline", text)
@@ -291,6 +295,9 @@ class CompareTest(TempDirTest):
         p = run("compare", self.h5, "--metric", "Ee", check=False)
         self.assertEqual(p.returncode, 2)
         self.assertIn("not a numeric metric", p.stderr)
+        p = run("compare", self.h5, "--where", "methd=global_spline", check=False)
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("methd", p.stderr)
         p = run("compare", self.h5, "--end", "stopped", check=False)
         self.assertEqual(p.returncode, 2)
         p = run("compare", os.path.join(self.dir, "missing.h5"), check=False)
