@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <optional>
 #include <ostream>
 
 #include "runner/execute.hpp"
@@ -19,8 +20,8 @@ namespace ks {
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// The parameters whose value splits a method's runs into separate problems when they have an
-/// effect on the run: the state the arm must end in.
-constexpr std::string_view kConditionParams[] = {"end_state"};
+/// effect on the run: the state the arm must end in, the robot model (the seed arm's inertia form).
+constexpr std::string_view kConditionParams[] = {"end_state", "inertia"};
 
 std::size_t column_of(const std::vector<ColumnSpec>& columns, std::string_view name) {
   for (std::size_t i = 0; i < columns.size(); ++i)
@@ -34,17 +35,28 @@ std::string text_of(const Cell& c) {
 }
 }  // namespace
 
-std::vector<BestRunRef> best_runs_to_verify(const Study& study, const store::ResultsReader& file) {
+std::vector<BestRunRef> best_runs_to_verify(const Study& study, const store::ResultsReader& file,
+                                            const std::vector<std::string>& rank_by) {
   std::vector<BestRunRef> out;
   const auto& columns = file.columns();
   const std::size_t status_col = column_of(columns, "status"), method_col = column_of(columns, "method");
   for (std::size_t b = 0; b < study.blocks.size(); ++b) {
     const Block& block = study.blocks[b];
     if (block.kind() != BlockKind::trajectory || block.run_count() == 0) continue;
+    if (status_col >= columns.size() || method_col >= columns.size()) continue;
+    // the metrics ranked by (the kind's objective first, with its tie metric), as columns
     const Ranking rank = ranking(block.kind());
-    const std::size_t obj_col = column_of(columns, rank.objective);
-    const std::size_t tie_col = rank.tie.empty() ? static_cast<std::size_t>(-1) : column_of(columns, rank.tie);
-    if (status_col >= columns.size() || method_col >= columns.size() || obj_col >= columns.size()) continue;
+    std::vector<std::string> by{std::string(rank.objective)};
+    for (const std::string& m : rank_by)
+      if (std::find(by.begin(), by.end(), m) == by.end()) by.push_back(m);
+    std::vector<std::pair<std::size_t, std::size_t>> by_cols;  // metric column, tie column
+    std::vector<std::string> by_names;
+    for (const std::string& m : by)
+      if (column_of(columns, m) < columns.size()) {
+        by_names.push_back(m);
+        by_cols.emplace_back(column_of(columns, m), m == rank.objective && !rank.tie.empty()
+                                                        ? column_of(columns, rank.tie) : static_cast<std::size_t>(-1));
+      }
     // the condition parameters of this block: their column, and the column that controls their effect
     struct Condition {
       std::string name;
@@ -58,7 +70,8 @@ std::vector<BestRunRef> best_runs_to_verify(const Study& study, const store::Res
                               p->effect.always() ? static_cast<std::size_t>(-1) : column_of(columns, p->effect.controller),
                               &p->effect});
     const std::string good(statuses(block.kind()).front());
-    std::map<std::string, std::pair<RankKey, BestRunRef>> best;  // group -> its best run
+    // group -> per ranked metric, its best run
+    std::map<std::string, std::vector<std::optional<std::pair<RankKey, BestRunRef>>>> best;
     const std::uint64_t first = study.first_run(b), n = block.run_count();
     constexpr std::uint64_t kPiece = store::kRunsChunkRows;
     for (std::uint64_t at = 0; at < n; at += kPiece) {
@@ -79,14 +92,35 @@ std::vector<BestRunRef> best_runs_to_verify(const Study& study, const store::Res
               c.controller >= columns.size() ? c.effect->always() : c.effect->applies(text_of(cells[c.controller]));
           if (applies) ref.group += ", " + c.name + "=" + text_of(cells[c.col]);
         }
-        const RankKey key = rank_key(cell_number(cells[obj_col]),
-                                     tie_col < columns.size() ? cell_number(cells[tie_col]) : 0.0, ref.run);
-        auto it = best.find(ref.group);
-        if (it == best.end()) best.emplace(ref.group, std::make_pair(key, ref));
-        else if (key < it->second.first) it->second = {key, ref};
+        auto& slots = best[ref.group];
+        slots.resize(by_cols.size());
+        for (std::size_t m = 0; m < by_cols.size(); ++m) {
+          const double v = cell_number(cells[by_cols[m].first]);
+          if (!std::isfinite(v)) continue;  // never a best run (as the run summary)
+          const RankKey key = rank_key(v, by_cols[m].second < columns.size() ? cell_number(cells[by_cols[m].second]) : 0.0,
+                                       ref.run);
+          if (!slots[m] || key < slots[m]->first) slots[m] = std::make_pair(key, ref);
+        }
       }
     }
-    for (auto& [group, kr] : best) out.push_back(std::move(kr.second));
+    for (auto& [group, slots] : best) {  // each run once, saying what it is the lowest of
+      std::vector<BestRunRef> runs;
+      std::vector<std::string> lowest;
+      for (std::size_t m = 0; m < slots.size(); ++m) {
+        if (!slots[m]) continue;
+        auto it = std::find_if(runs.begin(), runs.end(), [&](const BestRunRef& r) { return r.run == slots[m]->second.run; });
+        if (it == runs.end()) {
+          runs.push_back(slots[m]->second);
+          lowest.push_back(by_names[m]);
+        } else {
+          lowest[static_cast<std::size_t>(it - runs.begin())] += ", " + by_names[m];
+        }
+      }
+      for (std::size_t r = 0; r < runs.size(); ++r) {
+        runs[r].group = "lowest " + lowest[r] + " of " + runs[r].group;
+        out.push_back(std::move(runs[r]));
+      }
+    }
   }
   return out;
 }

@@ -14,20 +14,26 @@
 
 namespace ks {
 
-/// A run that the verification step takes: the best good run of a group of a trajectory block.
+/// A run that the verification step takes: a best good run of a group of a trajectory block.
 struct BestRunRef {
   std::uint64_t run = 0;  ///< global run id
   std::size_t block = 0;  ///< index into study.blocks
   std::string method;
-  std::string group;      ///< "method=global_spline, end_state=rest"
+  std::string group;      ///< "lowest E, torque_sq_integral of method=global_spline, end_state=rest"
 };
 
-/// The runs to verify in a results file of `study` (`file`, its done runs): per trajectory block, the
-/// best good run (schema/params.hpp `ranking`: lowest objective, then tie, then run id) of each
-/// method and, where the end_state parameter has an effect on the run, each end state (a run
-/// ending at rest and one free to move are not the same problem). In block order, then by method and
-/// end state. Throws store::StoreError when the file cannot be read.
-std::vector<BestRunRef> best_runs_to_verify(const Study& study, const store::ResultsReader& file);
+/// The metrics whose best runs are verified besides the kind's ranking objective (E): the integral
+/// of tau^T tau, the other objective a comparison of methods is made by.
+inline const std::vector<std::string> kVerifiedRankings{"torque_sq_integral"};
+
+/// The runs to verify in a results file of `study` (`file`, its done runs): per trajectory block, per
+/// method and, where they have an effect on the run, per end_state (a run ending at rest and one
+/// free to move are not the same problem) and per inertia form (not the same robot model), the best
+/// good run under the kind's ranking (schema/params.hpp `ranking`: lowest objective, then tie, then
+/// run id) and the one of lowest value of each metric of `rank_by` (then lowest run id); each run
+/// once. In block order, then by group. Throws store::StoreError when the file cannot be read.
+std::vector<BestRunRef> best_runs_to_verify(const Study& study, const store::ResultsReader& file,
+                                            const std::vector<std::string>& rank_by = kVerifiedRankings);
 
 /// What the verification step computes.
 struct BestRunVerifyOptions {
