@@ -3,7 +3,7 @@
 get_filename_component(dir ${OUT} DIRECTORY)
 set(include_file ${dir}/kinesweep.h2m)
 file(WRITE ${include_file} "[NAME]\nkinesweep \\- parameter-sweep studies of redundant manipulators\n")
-foreach(sub run info query sensitivity schema robot table4)
+foreach(sub run info query sensitivity compare schema robot table4)
   execute_process(COMMAND ${KINESWEEP} ${sub} --help OUTPUT_VARIABLE text RESULT_VARIABLE rc)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "${KINESWEEP} ${sub} --help failed (${rc})")
