@@ -381,7 +381,7 @@ int conclude(const Study& study, const RunRequest& r, SweepBackend& backend, Swe
           << "; the best runs were not verified against the grid\nresume with: " << backend.resume_command(r) << '\n';
       return 130;
     }
-    res.writer->write_verification(table);
+    if (!table.rows.empty()) res.writer->write_verification(table);
     print_verification(out, table);
   }
   res.writer->close();
