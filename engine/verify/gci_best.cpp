@@ -269,7 +269,7 @@ std::string num(double v) {
 std::string percent(double v) {
   char s[32];
   if (v == 0.0) return "0 %";
-  std::snprintf(s, sizeof s, "%.2g %%", 100.0 * v);
+  std::snprintf(s, sizeof s, 100.0 * v < 100.0 ? "%.2g %%" : "%.0f %%", 100.0 * v);
   return s;
 }
 std::string with_unit(double v, const std::string& unit) { return unit.empty() ? num(v) : num(v) + " " + unit; }
