@@ -305,6 +305,14 @@ class CompareTest(TempDirTest):
         p = run("compare", os.path.join(self.dir, "missing.h5"), check=False)
         self.assertEqual(p.returncode, 1)
 
+    def test_mixed_kinds_of_a_format_3_file(self):
+        # a file of trajectory and IK runs, without /verification: each kind ranked by its own
+        # objective among its own good status
+        rows = self.check_python_equals_cli(os.path.join(SOURCE, "tests", "format3", "mixed_v3.h5"))
+        self.assertEqual({(x["kind"], x["metric"]) for x in rows}, {("ik", "iterations"), ("trajectory", "E")})
+        self.assertEqual({x["end"] for x in rows if x["kind"] == "ik"}, {""})
+        self.assertEqual({x["grid"] for x in rows}, {"none"})
+
     def test_thesis_table4(self):
         h5 = os.path.join(self.dir, "t4.h5")
         out = run("run", os.path.join(SOURCE, "studies", "thesis_table4.toml"), "-o", h5, "-q",
