@@ -152,6 +152,9 @@ store::VerificationTable verify_best_runs(const Study& study, const store::Resul
   // The refined specs: grid 0 is the finest (dt/4 or 4K), grid 1 the middle one (dt/2 or 2K).
   std::vector<Task> tasks;
   std::vector<bool> has_knots(runs.size(), false);
+  double duration = 0.0;  // of the study's path [s]
+  for (const double d : study.task.durations) duration += d;
+  auto affordable = [&](double dt) { return duration / dt + 1.0 <= options.max_samples; };
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const Block& block = study.blocks[runs[i].block];
     const RunSpec spec = block.run(runs[i].run - study.first_run(runs[i].block));
@@ -164,13 +167,14 @@ store::VerificationTable verify_best_runs(const Study& study, const store::Resul
       Task t;
       t.ref = i, t.grid = grid, t.run = *traj;
       t.run.options.dt = o.dt / factor;
+      t.runnable = affordable(t.run.options.dt);
       tasks.push_back(t);
       if (!has_knots[i]) continue;
       const double knots = static_cast<double>(o.global.knots) * factor;
       t.knots = true;
       t.run = *traj;
       t.run.options.global.knots = static_cast<std::int64_t>(knots);
-      t.runnable = PathGlobalOptions::knots_rule.holds(knots);
+      t.runnable = PathGlobalOptions::knots_rule.holds(knots) && affordable(o.dt);
       tasks.push_back(std::move(t));
     }
   }

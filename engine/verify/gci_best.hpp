@@ -43,12 +43,17 @@ struct BestRunVerifyOptions {
   /// tau, and global_spline's objective.
   std::vector<std::string> quantities{"E", "tau_inf", "torque_sq_integral", "opt_objective"};
   const std::atomic<bool>* stop = nullptr;  ///< set: the runs not begun are skipped (their rows not_enough)
+  /// The most samples a refined run may take (the path's duration / its dt, + 1): a longer one is not
+  /// run (status not_run; its rows not_enough), as its sampled path alone would take memory in
+  /// proportion (about 1e6 samples of the seed's square path: 6e6 s of motion at dt/4 = 0.25 ms).
+  double max_samples = 1e6;
 };
 inline constexpr double kGridRatio = 2.0;  ///< the refinement ratio r of the verification grids
 
 /// The grid studies of `runs` (from best_runs_to_verify): each run's spec computed at dt/2 and dt/4
 /// (refinement "dt"), and for global_spline with cubic splines at 2K and 4K knots ("knots", skipped
-/// when 4K is beyond the knots' domain), in parallel; grid 3 is the stored row of `file`. One row per
+/// when 4K is beyond the knots' domain), in parallel (a refined run of more than max_samples samples
+/// is not run); grid 3 is the stored row of `file`. One row per
 /// (run, refinement, quantity). The same whatever the thread count (each run is a pure function of
 /// its spec).
 store::VerificationTable verify_best_runs(const Study& study, const store::ResultsReader& file,
