@@ -11,6 +11,7 @@ Submodules (each importable alone):
     kinds       run kinds' statuses, good statuses, ranking, colours (fallback for older files)
     where       `kinesweep query --where` expressions on numpy columns
     solutions   clustering joint vectors into named IK solutions
+    compare     `kinesweep compare`'s verdict table (compare) and the /verification table (verification)
     plotting    shared matplotlib helpers of the plot commands
 Commands (`python3 -m kinesweep.NAME --help`; in a source tree, analysis/NAME.py is the same):
     plot_landscape, plot_histories, plot_cases, plot_basins, plot_convergence, plot_runs,

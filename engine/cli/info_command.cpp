@@ -12,6 +12,7 @@
 
 #include "cli/query_util.hpp"
 #include "schema/params.hpp"
+#include "verify/gci_best.hpp"
 #include "store/store.hpp"
 
 namespace ks::cli {
@@ -392,6 +393,11 @@ int run_info(const InfoArgs& args) {
       os << '\n';
     }
   }
+
+  // The best runs against their grid (/verification, written by kinesweep run).
+  const store::VerificationTable verification = consistent_read(reader, [&] { return reader.read_verification(); });
+  if (!verification.rows.empty()) os << '\n';
+  print_verification(os, verification);
 
   // Histories: which runs hold one, and the arrays of each kind.
   os << '\n';

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "cli/compare_command.hpp"
 #include "cli/info_command.hpp"
 #include "cli/query_command.hpp"
 #include "cli/robot_command.hpp"
@@ -38,6 +39,7 @@ int main(int argc, char** argv) {
   ks::cli::SchemaArgs& schema = ks::cli::add_schema_command(app);
   ks::cli::RobotArgs& robot = ks::cli::add_robot_command(app);
   ks::cli::SensitivityArgs& sensitivity = ks::cli::add_sensitivity_command(app);
+  ks::cli::CompareArgs& compare = ks::cli::add_compare_command(app);
   auto* table4 = app.add_subcommand("table4", "Print seed 000's Table 4 beside kinesweep's figures (no file)");
   try {
     app.parse(argc, argv);
@@ -56,5 +58,6 @@ int main(int argc, char** argv) {
   if (app.got_subcommand("schema")) return ks::cli::schema_command(schema);
   if (app.got_subcommand("robot")) return ks::cli::robot_command(robot, std::cout, std::cerr);
   if (app.got_subcommand("sensitivity")) return ks::cli::sensitivity_command(sensitivity);
+  if (app.got_subcommand("compare")) return ks::cli::compare_command(compare);
   return 0;
 }

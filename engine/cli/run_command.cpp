@@ -117,6 +117,8 @@ RunArgs& add_run_command(CLI::App& app) {
   c->add_option("--max-runs", a.max_runs, "the most runs a study may ask for (default 50000000; a study's max_runs may only lower it)")
       ->check(CLI::PositiveNumber);
   c->add_flag("-q,--quiet", a.quiet, "no progress display");
+  c->add_flag("--no-verify-best", a.no_verify_best,
+              "do not verify the best runs against the grid (dt/2, dt/4; 2K, 4K knots) at the end");
   c->add_flag("--verbose", a.verbose, "with a results-file error, HDF5's own error stack too");
   return a;
 }
@@ -155,6 +157,7 @@ int run_command(const RunArgs& a) {
   r.resume = a.resume;
   r.overwrite = a.overwrite;
   r.quiet = a.quiet;
+  r.verify_best = !a.no_verify_best;
   r.dry_run = a.dry_run;  // a few seconds at most; its temporary files are removed before it returns
   r.options.threads = a.threads;
   r.options.lanes = a.lanes;

@@ -1,6 +1,6 @@
 #pragma once
 // `kinesweep run STUDY.toml [-o FILE] [--threads N] [--resume] [--overwrite] [--dry-run]
-//  [--histories full|every=N|none] [--compression 0..9] [--max-runs N] [-q] [--verbose]`
+//  [--histories full|every=N|none] [--compression 0..9] [--max-runs N] [-q] [--verbose] [--no-verify-best]`
 #include <cstdint>
 #include <string>
 
@@ -18,6 +18,7 @@ struct RunArgs {
   bool resume = false, overwrite = false, dry_run = false;
   std::string histories;   ///< empty: the study's policy
   bool quiet = false;      ///< no progress display
+  bool no_verify_best = false;  ///< --no-verify-best: skip the best runs' grid verification
   int compression = 1;     ///< history deflate level (0: raw chunks, no filter)
   std::uint64_t max_runs = 50'000'000;  ///< the run-count limit (a study's max_runs may only lower it)
   bool verbose = false;    ///< HDF5's own error stack with a results-file error

@@ -19,6 +19,7 @@
 #include "runner/resume_edited.hpp"
 #include "runner/dry_run.hpp"
 #include "runner/sweep_backend.hpp"
+#include "verify/gci_best.hpp"
 
 namespace ks {
 
@@ -410,6 +411,22 @@ int conclude(const Study& study, const RunRequest& r, SweepBackend& backend, Swe
           << "\nresume with: " << backend.resume_command(r) << '\n';
       return 130;
     }
+  }
+  if (r.verify_best) {
+    res.writer->flush();
+    const store::ResultsReader file(res.writer->path());
+    BestRunVerifyOptions vo;
+    vo.threads = backend.threads(r);
+    vo.stop = r.options.stop;
+    const store::VerificationTable table = verify_best_runs(study, file, best_runs_to_verify(study, file), vo);
+    if (r.options.stop && r.options.stop->load()) {
+      res.writer->close();
+      out << "interrupted: " << backend.kept(r, "the sweep's " + std::to_string(report.total) + " runs")
+          << "; the best runs were not verified against the grid\nresume with: " << backend.resume_command(r) << '\n';
+      return 130;
+    }
+    if (!table.rows.empty()) res.writer->write_verification(table);
+    print_verification(out, table);
   }
   res.writer->close();
   backend.publish(r);

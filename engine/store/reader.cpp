@@ -49,6 +49,7 @@ void ResultsReader::Impl::load() {
   }
   columns = read_run_columns(f, path, n_runs, meta.format_version >= 2);
   if (meta.format_version == 1 && v1_roles) v1_roles(columns);
+  meta.kinds = read_kind_meta(f, path);
   if (n_runs < 0) {
     Hid d(check(H5Dopen2(f, "runs/done", H5P_DEFAULT), path, "open /runs/done"));
     n_runs = H5Sget_simple_extent_npoints(Hid(H5Dget_space(d)));

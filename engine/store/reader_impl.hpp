@@ -61,4 +61,8 @@ struct ResultsReader::Impl {
   }
 };
 
+/// The run kinds' meanings of an open results file (/kinds, FORMAT.md): one KindMeta per group, its
+/// string-list attributes as written; empty when the file has no /kinds (kinds_read.cpp).
+std::vector<KindMeta> read_kind_meta(hid_t file, const std::string& path);
+
 }  // namespace ks::store

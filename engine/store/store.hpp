@@ -4,6 +4,7 @@
 // Threading: encode_history() is thread-safe and HDF5-free (zlib only): call it in worker threads.
 // A ResultsWriter must be used by one thread (the writer thread) only; history_chunk_rows() is the
 // exception (worker threads read it to encode).
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -246,6 +247,30 @@ struct OptimizationRecord {
   std::size_t size() const { return value.size(); }
 };
 
+/// One row of /verification (FORMAT.md): a quantity of one best run computed again on two refined
+/// grids, and Roache's grid convergence index of the three (verify/gci.hpp). Grid 1 is the finest,
+/// grid 3 the run as stored.
+struct VerificationRow {
+  std::int64_t run = 0;     ///< the run id (its /runs row)
+  std::string block;        ///< the run's block
+  std::string method;       ///< its method (the group it is the best of)
+  std::string group;        ///< what it is the best of, as "method=local_weighted" ("column=value, ...")
+  std::string quantity;     ///< a /runs metric: "E", "tau_inf", "torque_sq_integral", "opt_objective"
+  std::string unit;         ///< the quantity's stored unit
+  std::string refinement;   ///< "dt" (dt, dt/2, dt/4) or "knots" (K, 2K, 4K)
+  double ratio = 2.0;       ///< r: the refinement ratio between consecutive grids
+  std::array<double, 3> dt{};     ///< per grid (finest first) [s]
+  std::array<double, 3> knots{};  ///< per grid (finest first); NaN for methods without knots
+  std::array<double, 3> value{};  ///< the quantity per grid (finest first) [unit]; NaN when the run failed
+  std::array<std::string, 3> status;  ///< the run's status per grid (finest first)
+  std::string convergence;  ///< monotone | unchanged | oscillatory | divergent | not_enough
+  double order = 0.0, extrapolated = 0.0, gci_fine = 0.0, gci_coarse = 0.0;  ///< as GciResult (NaN: none)
+};
+struct VerificationTable {
+  double safety_factor = 1.25;  ///< Fs of the GCI
+  std::vector<VerificationRow> rows;
+};
+
 class ResultsReader;
 
 class ResultsWriter {
@@ -319,6 +344,8 @@ class ResultsWriter {
   void write_landscape(const LandscapeSpec& spec);
   /// Write /optimizations/<record.name>/ (replacing an existing one) and flush (optimizations.cpp).
   void write_optimization(const OptimizationRecord& record);
+  /// Write /verification (replacing an existing one) and flush (verification.cpp).
+  void write_verification(const VerificationTable& table);
   /// Flush and close; further calls throw.
   void close();
 
@@ -411,6 +438,8 @@ class ResultsReader {
   /// Names of the groups under /optimizations (empty when none), and one of them (optimizations_read.cpp).
   std::vector<std::string> optimizations() const;
   OptimizationRecord read_optimization(const std::string& name) const;
+  /// The /verification table (verification.cpp); no rows when the file has none.
+  VerificationTable read_verification() const;
 
  private:
   friend class ResultsWriter;                ///< copy_runs reads a source's chunks as stored

@@ -1,0 +1,334 @@
+// The best runs of a results file against their grid (see gci_best.hpp).
+#include "verify/gci_best.hpp"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <optional>
+#include <ostream>
+
+#include "runner/execute.hpp"
+#include "schema/params.hpp"
+
+namespace ks {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/// The parameters whose value splits a method's runs into separate problems when they have an
+/// effect on the run: the state the arm must end in, the robot model (the seed arm's inertia form).
+constexpr std::string_view kConditionParams[] = {"end_state", "inertia"};
+
+std::size_t column_of(const std::vector<ColumnSpec>& columns, std::string_view name) {
+  for (std::size_t i = 0; i < columns.size(); ++i)
+    if (columns[i].name == name) return i;
+  return static_cast<std::size_t>(-1);
+}
+
+std::string text_of(const Cell& c) {
+  if (const auto* s = std::get_if<std::string>(&c)) return *s;
+  return "";
+}
+}  // namespace
+
+std::vector<BestRunRef> best_runs_to_verify(const Study& study, const store::ResultsReader& file,
+                                            const std::vector<std::string>& rank_by) {
+  std::vector<BestRunRef> out;
+  const auto& columns = file.columns();
+  const std::size_t status_col = column_of(columns, "status"), method_col = column_of(columns, "method");
+  for (std::size_t b = 0; b < study.blocks.size(); ++b) {
+    const Block& block = study.blocks[b];
+    if (block.kind() != BlockKind::trajectory || block.run_count() == 0) continue;
+    if (status_col >= columns.size() || method_col >= columns.size()) continue;
+    // the metrics ranked by (the kind's objective first, with its tie metric), as columns
+    const Ranking rank = ranking(block.kind());
+    std::vector<std::string> by{std::string(rank.objective)};
+    for (const std::string& m : rank_by)
+      if (std::find(by.begin(), by.end(), m) == by.end()) by.push_back(m);
+    std::vector<std::pair<std::size_t, std::size_t>> by_cols;  // metric column, tie column
+    std::vector<std::string> by_names;
+    for (const std::string& m : by)
+      if (column_of(columns, m) < columns.size()) {
+        by_names.push_back(m);
+        by_cols.emplace_back(column_of(columns, m), m == rank.objective && !rank.tie.empty()
+                                                        ? column_of(columns, rank.tie) : static_cast<std::size_t>(-1));
+      }
+    // the condition parameters of this block: their column, and the column that controls their effect
+    struct Condition {
+      std::string name;
+      std::size_t col, controller;
+      const EffectRule* effect;
+    };
+    std::vector<Condition> conditions;
+    for (std::string_view name : kConditionParams)
+      if (const ParamDef* p = find_param(block.table(), name); p && column_of(columns, name) < columns.size())
+        conditions.push_back({std::string(name), column_of(columns, name),
+                              p->effect.always() ? static_cast<std::size_t>(-1) : column_of(columns, p->effect.controller),
+                              &p->effect});
+    const std::string good(statuses(block.kind()).front());
+    // group -> per ranked metric, its best run
+    std::map<std::string, std::vector<std::optional<std::pair<RankKey, BestRunRef>>>> best;
+    const std::uint64_t first = study.first_run(b), n = block.run_count();
+    constexpr std::uint64_t kPiece = store::kRunsChunkRows;
+    for (std::uint64_t at = 0; at < n; at += kPiece) {
+      const auto count = static_cast<std::int64_t>(std::min(kPiece, n - at));
+      const auto done = file.done_mask(static_cast<std::int64_t>(first + at), count);
+      const auto rows = file.read_rows(static_cast<std::int64_t>(first + at), count);
+      for (std::size_t i = 0; i < rows.size() && i < done.size(); ++i) {
+        if (!done[i]) continue;
+        const auto& cells = rows[i].cells;
+        if (text_of(cells[status_col]) != good) continue;
+        BestRunRef ref;
+        ref.run = first + at + i;
+        ref.block = b;
+        ref.method = text_of(cells[method_col]);
+        ref.group = "method=" + ref.method;
+        for (const Condition& c : conditions) {
+          const bool applies =
+              c.controller >= columns.size() ? c.effect->always() : c.effect->applies(text_of(cells[c.controller]));
+          if (applies) ref.group += ", " + c.name + "=" + text_of(cells[c.col]);
+        }
+        auto& slots = best[ref.group];
+        slots.resize(by_cols.size());
+        for (std::size_t m = 0; m < by_cols.size(); ++m) {
+          const double v = cell_number(cells[by_cols[m].first]);
+          if (!std::isfinite(v)) continue;  // never a best run (as the run summary)
+          const RankKey key = rank_key(v, by_cols[m].second < columns.size() ? cell_number(cells[by_cols[m].second]) : 0.0,
+                                       ref.run);
+          if (!slots[m] || key < slots[m]->first) slots[m] = std::make_pair(key, ref);
+        }
+      }
+    }
+    for (auto& [group, slots] : best) {  // each run once, saying what it is the lowest of
+      std::vector<BestRunRef> runs;
+      std::vector<std::string> lowest;
+      for (std::size_t m = 0; m < slots.size(); ++m) {
+        if (!slots[m]) continue;
+        auto it = std::find_if(runs.begin(), runs.end(), [&](const BestRunRef& r) { return r.run == slots[m]->second.run; });
+        if (it == runs.end()) {
+          runs.push_back(slots[m]->second);
+          lowest.push_back(by_names[m]);
+        } else {
+          lowest[static_cast<std::size_t>(it - runs.begin())] += ", " + by_names[m];
+        }
+      }
+      for (std::size_t r = 0; r < runs.size(); ++r) {
+        runs[r].group = "lowest " + lowest[r] + " of " + runs[r].group;
+        out.push_back(std::move(runs[r]));
+      }
+    }
+  }
+  return out;
+}
+
+namespace {
+/// One refined computation: a run's spec with dt or knots changed.
+struct Task {
+  std::size_t ref = 0;      // index into the runs verified
+  bool knots = false;       // refinement "knots" (else "dt")
+  int grid = 0;             // 0 (finest) or 1
+  bool runnable = true;     // false: beyond the parameter's domain, not run
+  TrajectoryRun run;
+  RunOutcome outcome;
+  bool done = false;
+};
+
+/// The value of metric `name` of `metrics` in outcome `o` (NaN when absent or not numeric).
+double metric_value(const std::vector<MetricDef>& metrics, const std::string& name, const RunOutcome& o) {
+  for (const MetricDef& m : metrics)
+    if (m.name == name) return cell_number(m.get(o));
+  return kNaN;
+}
+}  // namespace
+
+store::VerificationTable verify_best_runs(const Study& study, const store::ResultsReader& file,
+                                          const std::vector<BestRunRef>& runs, const BestRunVerifyOptions& options) {
+  store::VerificationTable table;
+  table.safety_factor = options.gci.safety_factor;
+  // The refined specs: grid 0 is the finest (dt/4 or 4K), grid 1 the middle one (dt/2 or 2K).
+  std::vector<Task> tasks;
+  std::vector<bool> has_knots(runs.size(), false);
+  double duration = 0.0;  // of the study's path [s]
+  for (const double d : study.task.durations) duration += d;
+  auto affordable = [&](double dt) { return duration / dt + 1.0 <= options.max_samples; };
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const Block& block = study.blocks[runs[i].block];
+    const RunSpec spec = block.run(runs[i].run - study.first_run(runs[i].block));
+    const auto* traj = std::get_if<TrajectoryRun>(&spec);
+    if (!traj) continue;
+    const TrajectoryOptions& o = traj->options;
+    has_knots[i] = o.method == TrajectoryMethod::global_spline && o.global.spline == AlphaSpline::cubic;
+    for (int grid = 0; grid < 2; ++grid) {
+      const double factor = grid == 0 ? kGridRatio * kGridRatio : kGridRatio;
+      Task t;
+      t.ref = i, t.grid = grid, t.run = *traj;
+      t.run.options.dt = o.dt / factor;
+      t.runnable = affordable(t.run.options.dt);
+      tasks.push_back(t);
+      if (!has_knots[i]) continue;
+      const double knots = static_cast<double>(o.global.knots) * factor;
+      t.knots = true;
+      t.run = *traj;
+      t.run.options.global.knots = static_cast<std::int64_t>(knots);
+      t.runnable = PathGlobalOptions::knots_rule.holds(knots) && affordable(o.dt);
+      tasks.push_back(std::move(t));
+    }
+  }
+  const Scenario scenario = Scenario::of(study);
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(std::size_t(0), tasks.size(), [&](std::size_t i) {
+      Task& t = tasks[i];
+      if (!t.runnable || (options.stop && options.stop->load())) return;
+      RunWorkspace workspace;
+      t.outcome = execute(scenario, RunSpec(t.run), 0, workspace);
+      t.done = true;
+    });
+  });
+  // The rows: per run, per refinement, per quantity; grid 3 from the stored row.
+  const auto& columns = file.columns();
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const BestRunRef& ref = runs[i];
+    const Block& block = study.blocks[ref.block];
+    const RunSpec spec = block.run(ref.run - study.first_run(ref.block));
+    const auto* traj = std::get_if<TrajectoryRun>(&spec);
+    if (!traj) continue;
+    const Record stored = file.read_record(static_cast<std::int64_t>(ref.run));
+    auto stored_cell = [&](const std::string& name) -> const Cell* {
+      const std::size_t c = column_of(columns, name);
+      return c < columns.size() ? &stored.cells[c] : nullptr;
+    };
+    const Cell* stored_status = stored_cell("status");
+    for (const bool knots : {false, true}) {
+      if (knots && !has_knots[i]) continue;
+      const Task* grid[2] = {nullptr, nullptr};
+      for (const Task& t : tasks)
+        if (t.ref == i && t.knots == knots) grid[t.grid] = &t;
+      for (const std::string& q : options.quantities) {
+        const MetricDef* def = nullptr;
+        for (const MetricDef& m : block.metrics())
+          if (m.name == q && m.type == CellType::f64) def = &m;
+        if (!def || (q == "opt_objective" && traj->options.method != TrajectoryMethod::global_spline)) continue;
+        const Cell* stored_value = stored_cell(q);
+        if (!stored_value) continue;
+        store::VerificationRow row;
+        row.run = static_cast<std::int64_t>(ref.run);
+        row.block = block.name();
+        row.method = ref.method;
+        row.group = ref.group;
+        row.quantity = q;
+        row.unit = def->unit;
+        row.refinement = knots ? "knots" : "dt";
+        row.ratio = kGridRatio;
+        const std::string good(statuses(BlockKind::trajectory).front());
+        bool all_good = stored_status && text_of(*stored_status) == good;
+        for (int g = 0; g < 3; ++g) {
+          const double factor = std::pow(kGridRatio, 2 - g);  // grid 0: r^2, grid 1: r, grid 2 (3): 1
+          const double k = has_knots[i] ? static_cast<double>(traj->options.global.knots) : kNaN;
+          row.dt[g] = knots ? traj->options.dt : traj->options.dt / factor;
+          row.knots[g] = knots ? k * factor : k;
+          if (g == 2) {
+            row.value[g] = cell_number(*stored_value);
+            row.status[g] = stored_status ? text_of(*stored_status) : "";
+            continue;
+          }
+          const Task* t = grid[g];
+          if (!t || !t->runnable) {
+            row.value[g] = kNaN;
+            row.status[g] = "not_run";
+            all_good = false;
+            continue;
+          }
+          if (!t->done) {
+            row.value[g] = kNaN;
+            row.status[g] = "interrupted";
+            all_good = false;
+            continue;
+          }
+          row.value[g] = metric_value(block.metrics(), q, t->outcome);
+          row.status[g] = std::string(t->outcome.status());
+          all_good = all_good && t->outcome.good();
+        }
+        GciResult r = grid_convergence(row.value[0], row.value[1], row.value[2], kGridRatio, options.gci);
+        if (!all_good) r = grid_convergence(kNaN, kNaN, kNaN, kGridRatio, options.gci);  // a failed grid: not_enough
+        row.convergence = std::string(to_string(r.convergence));
+        row.order = r.order, row.extrapolated = r.extrapolated, row.gci_fine = r.gci_fine, row.gci_coarse = r.gci_coarse;
+        table.rows.push_back(std::move(row));
+      }
+    }
+  }
+  return table;
+}
+
+namespace {
+std::string num(double v) {
+  char s[32];
+  std::snprintf(s, sizeof s, "%.4g", v);
+  return s;
+}
+std::string percent(double v) {
+  char s[32];
+  if (v == 0.0) return "0 %";
+  std::snprintf(s, sizeof s, 100.0 * v < 100.0 ? "%.2g %%" : "%.0f %%", 100.0 * v);
+  return s;
+}
+std::string with_unit(double v, const std::string& unit) { return unit.empty() ? num(v) : num(v) + " " + unit; }
+}  // namespace
+
+std::string verification_phrase(const store::VerificationRow& r) {
+  Convergence c = Convergence::not_enough;
+  parse(r.convergence, c);
+  const bool knots = r.refinement == "knots";
+  auto grids = [&] {
+    std::string s;
+    for (int g = 2; g >= 0; --g) s += (g == 2 ? "" : ", ") + num(knots ? r.knots[g] : r.dt[g]);
+    return s + (knots ? " knots" : " s");
+  };
+  auto values = [&] {
+    std::string s;
+    for (int g = 2; g >= 0; --g) s += (g == 2 ? "" : ", ") + num(r.value[g]);
+    return s + (r.unit.empty() ? "" : " " + r.unit);
+  };
+  switch (c) {
+    case Convergence::monotone:
+    case Convergence::unchanged:
+      return r.quantity + " = " + with_unit(r.value[2], r.unit) + " (GCI " + percent(r.gci_coarse) +
+             (c == Convergence::monotone && std::isfinite(r.order) ? ", order " + num(r.order) : "") + ", converged " +
+             with_unit(r.extrapolated, r.unit) + ")";
+    case Convergence::oscillatory:
+      return r.quantity + " oscillates (" + values() + " at " + grids() + "): no GCI";
+    case Convergence::divergent:
+      return r.quantity + " diverges (" + values() + " at " + grids() + "): no GCI";
+    case Convergence::not_enough:
+      break;
+  }
+  std::string why;
+  for (int g = 1; g >= 0; --g)
+    if (r.status[g] != "ok") why += (why.empty() ? "" : ", ") + r.status[g] + " at " + num(knots ? r.knots[g] : r.dt[g]) +
+                                    (knots ? " knots" : " s");
+  if (r.status[2] != "ok") why += (why.empty() ? "" : ", ") + r.status[2] + " as stored";
+  return r.quantity + ": not verified (" + (why.empty() ? "a value is not finite" : why) + ")";
+}
+
+void print_verification(std::ostream& out, const store::VerificationTable& table) {
+  if (table.rows.empty()) return;
+  out << "best runs against the grid (dt, dt/2, dt/4; global_spline also K, 2K, 4K knots; GCI of the run as stored, "
+         "Fs = " << num(table.safety_factor) << "):\n";
+  const auto& rows = table.rows;
+  for (std::size_t i = 0; i < rows.size();) {
+    if (i == 0 || rows[i - 1].run != rows[i].run)
+      out << "  run " << rows[i].run << " (block " << rows[i].block << ", " << rows[i].group << ")\n";
+    out << "    " << (rows[i].refinement == "knots" ? "knots: " : "dt:    ") << verification_phrase(rows[i]);
+    std::size_t j = i + 1;
+    for (; j < rows.size() && rows[j].run == rows[i].run && rows[j].refinement == rows[i].refinement; ++j)
+      out << "; " << verification_phrase(rows[j]);
+    out << '\n';
+    i = j;
+  }
+}
+
+}  // namespace ks
