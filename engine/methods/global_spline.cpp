@@ -6,12 +6,14 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <stdexcept>
 
 #include "methods/alpha_basis.hpp"
 #include "methods/global_solve.hpp"
 #include "methods/path_global.hpp"
+#include "methods/path_global_verify.hpp"
 
 namespace ks {
 namespace {
@@ -204,14 +206,57 @@ TrajectoryMetrics solve_global_spline(const PlanarArm3& arm, const SampledPath& 
       s.reach_at(static_cast<unsigned>(s.problem->samples()), con, n, x, jac);
     };
   }
-  const RunStatus outcome = minimise_slsqp(spec, x);
-  const std::vector<double> best(s.coefficients(x.data()), s.coefficients(x.data()) + basis.coefficients);
-  if (coefficients) *coefficients = best;
+  const std::vector<double> x_start = x;
+  RunStatus outcome = minimise_slsqp(spec, x);
+  std::vector<double> best(s.coefficients(x.data()), s.coefficients(x.data()) + basis.coefficients);
   TrajectoryMetrics m = problem.measure(basis, best.data(), o, history);
-  if (m.status == RunStatus::ok) m.status = outcome;
-  // the projected gradient at the optimum: components pushing against an active bound count 0
+  const auto basis_on = [&](const SampledPath& p) {
+    return g.spline == AlphaSpline::cubic ? cubic_spline_basis(p, static_cast<int>(g.knots), g.end == EndState::rest)
+                                          : vertex_quintic_basis(p);
+  };
+  // the same trajectory on the grid of step h (figures only)
+  const auto measure_at = [&](double h) {
+    const SampledPath fine(path.path(), h);
+    const AlphaBasis fb = basis_on(fine);
+    const PathGlobalProblem fp(arm, fine, o.elbow, o.singular_tolerance, extension);
+    if (!fp.chart_defined()) return not_simulated(RunStatus::singular_extension, 3);
+    TrajectoryOptions fo = o;
+    fo.dt = h;
+    return fp.measure(fb, best.data(), fo, nullptr);
+  };
+  const int factor = static_cast<int>(g.verify_factor);
+  m.dense = verify_between_samples(m, o.dt, factor, o.tracking_bound, measure_at);
+  // while the run departs between its samples, the optimiser solves again from its start on a grid
+  // verify_factor times finer (the trajectory's coefficients are functions of time: the same on every grid)
+  double step = o.dt;
+  std::optional<SampledPath> fine_path;
+  std::optional<AlphaBasis> fine_basis;
+  std::optional<PathGlobalProblem> fine_problem;
+  for (int level = 1; level <= g.refinements && m.dense.departure > g.verify_tolerance;
+       ++level) {
+    step = o.dt / std::pow(static_cast<double>(factor), level);
+    fine_problem.reset();
+    fine_path.emplace(path.path(), step);
+    fine_basis.emplace(basis_on(*fine_path));
+    fine_problem.emplace(arm, *fine_path, o.elbow, o.singular_tolerance, extension);
+    if (!fine_problem->chart_defined()) break;
+    s.problem = &*fine_problem;
+    s.basis = &*fine_basis;
+    if (extension == Extension::alpha) spec.constraints = static_cast<unsigned>(fine_problem->samples());
+    spec.max_evaluations = g.max_evaluations;  // each solve its budget
+    x = x_start;
+    outcome = minimise_slsqp(spec, x);
+    best.assign(s.coefficients(x.data()), s.coefficients(x.data()) + basis.coefficients);
+    m = problem.measure(basis, best.data(), o, history);
+    m.dense = verify_between_samples(m, o.dt, factor, o.tracking_bound, measure_at);
+  }
+  if (coefficients) *coefficients = best;
+  const bool departs = factor > 1 && !(m.dense.departure <= g.verify_tolerance);
+  if (m.status == RunStatus::ok) m.status = departs ? RunStatus::undersampled : outcome;
+  // the projected gradient at the optimum, on the grid the optimiser last solved on: components
+  // pushing against an active bound count 0
   std::vector<double> grad(basis.coefficients);
-  m.opt_objective = problem.objective(basis, best.data(), g.objective, grad.data());
+  m.opt_objective = s.problem->objective(*s.basis, best.data(), g.objective, grad.data());
   double norm = 0.0;
   for (int k = s.first; k < basis.coefficients; ++k) {
     const bool at_lower = best[k] <= -bound && grad[k] > 0, at_upper = best[k] >= bound && grad[k] < 0;
@@ -220,6 +265,7 @@ TrajectoryMetrics solve_global_spline(const PlanarArm3& arm, const SampledPath& 
   m.opt_gradient_norm = norm;
   m.opt_start_objective = start_f;
   m.opt_evaluations = static_cast<double>(s.evaluations);
+  m.opt_dt = step;
   return m;
 }
 

@@ -6,12 +6,14 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <stdexcept>
 
 #include "methods/global_solve.hpp"
 #include "methods/path_global_joints.hpp"
 #include "methods/path_global_planar.hpp"
+#include "methods/path_global_verify.hpp"
 #include "model/planar_chain_dynamics.hpp"
 
 namespace ks {
@@ -47,18 +49,23 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
   // the extension: the planar chart on the start's elbow branch, or joint coordinates with the solved
   // joints chosen along the local run in h
   double solved_code = 0.0;
+  Elbow chart_elbow = Elbow::positive;
+  std::vector<int> solved;
+  // the extension on a task sampled at any step (the run's, or a finer one for verification)
+  const auto extension_on = [&](const ChainTask& t) -> std::unique_ptr<ChainGlobalProblem> {
+    if (chart) return std::make_unique<PlanarChartProblem>(chain, t, g.extension, chart_elbow);
+    return std::make_unique<JointExtensionProblem>(chain, t, solved, q_start);
+  };
   const auto extension_of_run = [&]() -> std::unique_ptr<ChainGlobalProblem> {
     if (chart) {
-      Elbow elbow = Elbow::positive;
       double z[kMaxJoints];
-      PlanarChartProblem(chain, task, Extension::alpha, Elbow::positive).coordinates_of(0, q_start, z, elbow);
-      return std::make_unique<PlanarChartProblem>(chain, task, g.extension, elbow);
+      PlanarChartProblem(chain, task, Extension::alpha, Elbow::positive).coordinates_of(0, q_start, z, chart_elbow);
+      return extension_on(task);
     }
-    auto p = std::make_unique<JointExtensionProblem>(
-        chain, task, JointExtensionProblem::choose_solved(chain, position_rows(task.space), h.q, h.size), q_start);
+    solved = JointExtensionProblem::choose_solved(chain, position_rows(task.space), h.q, h.size);
     solved_code = 0.0;
-    for (int j : p->solved_joints()) solved_code = 10 * solved_code + j + 1;
-    return p;
+    for (int j : solved) solved_code = 10 * solved_code + j + 1;
+    return extension_on(task);
   };
   std::unique_ptr<ChainGlobalProblem> extension = extension_of_run();
   const AlphaBasis basis = cubic_spline_basis(task.path.size(), task.path.dt(), task.path.path().duration(),
@@ -99,12 +106,17 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
     // path: the other local method's run, when it stays on it
     const std::vector<double> keep = c, keep_first = first;
     const double keep_code = solved_code;
+    const Elbow keep_elbow = chart_elbow;
+    const std::vector<int> keep_solved = solved;
     const StartMethod other = g.start_method == StartMethod::local_unweighted ? StartMethod::local_weighted
                                                                               : StartMethod::local_unweighted;
     local_run(other);
     std::unique_ptr<ChainGlobalProblem> kept = std::move(extension);
     if (h.size > 0) extension = extension_of_run(), c = fitted();
-    if (h.size == 0 || !usable(c)) extension = std::move(kept), c = keep, first = keep_first, solved_code = keep_code;
+    if (h.size == 0 || !usable(c)) {
+      extension = std::move(kept), c = keep, first = keep_first, solved_code = keep_code;
+      chart_elbow = keep_elbow, solved = keep_solved;
+    }
   }
   const ChainGlobalProblem& problem = *extension;
   for (double v : c)  // a local run that diverged at both methods: nothing to start from
@@ -125,23 +137,26 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
     return full.data();
   };
   const double start_f = problem.objective(basis, c.data(), g.objective, nullptr);
+  // the problem the optimiser solves: the run's grid first, a finer one when the run departs between
+  // its samples (the spline's coefficients are functions of time: the same on every grid)
+  const ChainGlobalProblem* solving = &problem;
+  const AlphaBasis* solving_basis = &basis;
   // the robot's limits, one constraint per window of samples (as many windows as knots) and limited quantity
-  const LimitConstraints limits = LimitConstraints::of(chain, problem.samples(), static_cast<int>(g.knots));
-  const unsigned rows = limits.count();
+  LimitConstraints limits = LimitConstraints::of(chain, problem.samples(), static_cast<int>(g.knots));
+  unsigned rows = limits.count();
   // one pass gives the objective, the constraints and both gradients: NLopt asks for them in turn at each point
   std::vector<double> cached_x, con(rows), jac(static_cast<std::size_t>(rows) * c.size());
   double cached_f = 0.0;
   bool constrained = false;
   const auto evaluate = [&](const double* xs) {
     if (!cached_x.empty() && std::equal(cached_x.begin(), cached_x.end(), xs)) return;
-    cached_f = problem.objective(basis, at(xs), g.objective, grad.data(), constrained ? &limits : nullptr, con.data(),
-                                 jac.data());
+    cached_f = solving->objective(*solving_basis, at(xs), g.objective, grad.data(), constrained ? &limits : nullptr,
+                                  con.data(), jac.data());
     cached_x.assign(xs, xs + free.size());
   };
   SlsqpSpec spec;
   spec.bound = bound;
   spec.tolerance = g.tolerance;
-  spec.max_evaluations = g.max_evaluations;
   spec.f = [&](const double* xs, double* gx) {  // (NLopt's count, as max_evaluations counts)
     ++evaluations;
     evaluate(xs);
@@ -158,25 +173,71 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
   };
   // without the limits first; when the optimum leaves them, again from the start with the limits as
   // constraints (SLSQP from a point beyond them may not get back within them)
-  const std::vector<double> x_start = x;
-  RunStatus outcome = minimise_slsqp(spec, x);
-  if (rows > 0 && evaluations < g.max_evaluations) {
-    problem.objective(basis, at(x.data()), g.objective, nullptr, &limits, con.data(), nullptr);
-    if (std::ranges::any_of(con, [](double v) { return !(v <= 0.0); })) {
-      constrained = true;
-      cached_x.clear();
-      spec.constraints = rows;
-      spec.max_evaluations = g.max_evaluations - evaluations;
-      x = x_start;
-      outcome = minimise_slsqp(spec, x);
+  const auto solve = [&](std::vector<double> from) {
+    const long begun = evaluations;  // each solve has the whole budget
+    constrained = false;
+    cached_x.clear();
+    spec.constraints = 0;
+    spec.max_evaluations = g.max_evaluations;
+    x = from;
+    RunStatus status = minimise_slsqp(spec, x);
+    if (rows > 0 && evaluations - begun < g.max_evaluations) {
+      solving->objective(*solving_basis, at(x.data()), g.objective, nullptr, &limits, con.data(), nullptr);
+      if (std::ranges::any_of(con, [](double v) { return !(v <= 0.0); })) {
+        constrained = true;
+        cached_x.clear();
+        spec.constraints = rows;
+        spec.max_evaluations = g.max_evaluations - (evaluations - begun);
+        x = from;
+        status = minimise_slsqp(spec, x);
+      }
     }
-  }
-  const std::vector<double> best(at(x.data()), at(x.data()) + c.size());
-  if (coefficients) *coefficients = best;
+    return status;
+  };
+  const std::vector<double> x_start = x;
+  RunStatus outcome = solve(x_start);
+  std::vector<double> best(at(x.data()), at(x.data()) + c.size());
   TrajectoryMetrics m = problem.measure(basis, best.data(), q_start, o, history);
-  if (m.status == RunStatus::ok) m.status = outcome;
-  m.opt_objective =
-      problem.objective(basis, best.data(), g.objective, grad.data(), rows ? &limits : nullptr, con.data(), jac.data());
+  // the same trajectory on the grid of step h (figures only)
+  const auto basis_on = [&](const ChainTask& t) {
+    return cubic_spline_basis(t.path.size(), t.path.dt(), t.path.path().duration(), static_cast<int>(g.knots),
+                              g.end == EndState::rest);
+  };
+  const auto measure_at = [&](double h) {
+    const ChainTask fine(task.space, task.path.path(), h);
+    const AlphaBasis fb = basis_on(fine);
+    TrajectoryOptions fo = o;
+    fo.dt = h;
+    return extension_on(fine)->measure(fb, best.data(), q_start, fo, nullptr);
+  };
+  const int factor = static_cast<int>(g.verify_factor);
+  m.dense = verify_between_samples(m, o.dt, factor, o.tracking_bound, measure_at);
+  // while the run departs between its samples, the optimiser solves again from its start on a grid
+  // verify_factor times finer (the spline's coefficients are functions of time: the same on every grid)
+  double step = o.dt;
+  std::optional<ChainTask> fine_task;
+  std::optional<AlphaBasis> fine_basis;
+  std::unique_ptr<ChainGlobalProblem> fine_problem;
+  for (int level = 1; level <= g.refinements && m.dense.departure > g.verify_tolerance;
+       ++level) {
+    step = o.dt / std::pow(static_cast<double>(factor), level);
+    fine_problem.reset();
+    fine_task.emplace(task.space, task.path.path(), step);
+    fine_basis.emplace(basis_on(*fine_task));
+    fine_problem = extension_on(*fine_task);
+    solving = fine_problem.get();
+    solving_basis = &*fine_basis;
+    limits = LimitConstraints::of(chain, solving->samples(), static_cast<int>(g.knots));
+    outcome = solve(x_start);
+    best.assign(at(x.data()), at(x.data()) + c.size());
+    m = problem.measure(basis, best.data(), q_start, o, history);
+    m.dense = verify_between_samples(m, o.dt, factor, o.tracking_bound, measure_at);
+  }
+  if (coefficients) *coefficients = best;
+  const bool departs = factor > 1 && !(m.dense.departure <= g.verify_tolerance);
+  if (m.status == RunStatus::ok) m.status = departs ? RunStatus::undersampled : outcome;
+  m.opt_objective = solving->objective(*solving_basis, best.data(), g.objective, grad.data(), rows ? &limits : nullptr,
+                                       con.data(), jac.data());
   // stationarity: the gradient over the free coefficients not held by their box bound, with the limit
   // constraints within 1e-4 of their bound as active ones (the KKT residual; without any, the
   // projected gradient's norm)
@@ -194,6 +255,7 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
       for (std::size_t v : kept) jac_active.push_back(jac[row * c.size() + static_cast<std::size_t>(free[v])]);
     }
   m.opt_gradient_norm = kkt_residual(g_kept, jac_active, active);
+  m.opt_dt = step;
   m.opt_solved_joints = chart ? std::numeric_limits<double>::quiet_NaN() : solved_code;
   if (rows > 0) m.opt_active_limits = static_cast<double>(active);
   m.opt_start_objective = start_f;

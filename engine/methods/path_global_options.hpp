@@ -79,15 +79,29 @@ struct PathGlobalOptions {
   std::int64_t start_seed = 0;           ///< start = random
   double tolerance = 1e-10;              ///< relative change of the objective that stops the optimiser
   std::int64_t max_evaluations = 3000;   ///< objective evaluations (each with its gradient)
+  /// Verification between samples (methods/path_global_verify.hpp): the optimum is evaluated again at
+  /// dt / verify_factor and dt / verify_factor^2 (1: not verified); a relative departure of its
+  /// figures above verify_tolerance makes the optimiser solve again from its start on the grid of
+  /// step dt / verify_factor^level (level = 1 .. refinements, each solve with max_evaluations), and a
+  /// run still departing ends `undersampled`. The run's metrics stay those at its samples (step dt).
+  std::int64_t verify_factor = 4;
+  double verify_tolerance = 0.01;
+  std::int64_t refinements = 0;
 
   static constexpr Domain knots_rule = Domain::within(2, 2000);
   static constexpr Domain tolerance_rule = Domain::positive();
   static constexpr Domain max_evaluations_rule = Domain::within(1, 1e7);
+  static constexpr Domain verify_factor_rule = Domain::within(1, 64);
+  static constexpr Domain verify_tolerance_rule = Domain::positive();
+  static constexpr Domain refinements_rule = Domain::within(0, 3);
 
   bool IsValid(std::string* why = nullptr) const {
     return fields_valid({{"knots", static_cast<double>(knots), knots_rule},
                          {"opt_tolerance", tolerance, tolerance_rule},
-                         {"max_evaluations", static_cast<double>(max_evaluations), max_evaluations_rule}},
+                         {"max_evaluations", static_cast<double>(max_evaluations), max_evaluations_rule},
+                         {"verify_factor", static_cast<double>(verify_factor), verify_factor_rule},
+                         {"verify_tolerance", verify_tolerance, verify_tolerance_rule},
+                         {"refinements", static_cast<double>(refinements), refinements_rule}},
                         why);
   }
 };

@@ -39,7 +39,10 @@ enum class RunStatus {
   unreachable_start,  ///< no real analytic IK at the first vertex for alpha1A: nothing simulated
   singular,           ///< the Jacobian became singular (see TrajectoryOptions::singular_tolerance)
   diverged,           ///< a non-finite value, or a torque above TrajectoryOptions::torque_bound
-  undersampled,       ///< dt leaves fewer than kMinSamplesPerSegment samples on a segment: nothing simulated
+  /// the sampling is too coarse for the motion: dt leaves fewer than kMinSamplesPerSegment samples on a
+  /// segment (nothing simulated), or (global_spline) the trajectory between the samples departs from the
+  /// sampled figures beyond verify_tolerance (the metrics kept, the dense figures beside them)
+  undersampled,
   off_path,           ///< the tip left the path by more than tracking_bound (or orientation_bound)
   out_of_limits,      ///< a joint position, velocity or effort went beyond the robot's limits
   // global_spline: the optimiser's outcome (ok: converged, on the path, within the limits)
@@ -170,6 +173,20 @@ struct TrajectoryMetrics {
   /// Limit constraints (window x limited quantity) active at the optimum (ratio within 1e-4 of its
   /// bound); 0 when the robot has limits and none binds, NaN when it has none.
   double opt_active_limits = std::numeric_limits<double>::quiet_NaN();
+  /// global_spline: the sample step [s] of the grid the optimiser last solved on (dt, or dt / 2^k
+  /// after k refinements; see PathGlobalOptions::refinements)
+  double opt_dt = std::numeric_limits<double>::quiet_NaN();
+  /// global_spline: the run's trajectory evaluated between its samples (methods/path_global_verify.hpp)
+  struct Dense {
+    double E = std::numeric_limits<double>::quiet_NaN();                   ///< [Nm]
+    double tau_inf = std::numeric_limits<double>::quiet_NaN();             ///< max over joints [Nm]
+    double min_manipulability = std::numeric_limits<double>::quiet_NaN();  ///< [m^2]
+    double max_tracking_error = std::numeric_limits<double>::quiet_NaN();  ///< [m]
+    double max_limit_ratio = std::numeric_limits<double>::quiet_NaN();     ///< position, velocity, effort
+    /// the largest relative departure of the dense figures from the sampled ones (inf: the dense
+    /// evaluation stopped where the sampled one did not)
+    double departure = std::numeric_limits<double>::quiet_NaN();
+  } dense;
   /// the metrics of methods/sample_metrics.hpp's table, in its order (NaN: no sample, or not a metric)
   std::array<double, kMaxSampleMetrics> sampled = nan_array();
 

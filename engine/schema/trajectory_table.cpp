@@ -69,6 +69,19 @@ void global_params(std::vector<ParamDef>& t, const RobotShape& robot) {
   t.push_back(integer<Run>("max_evaluations", "", PathGlobalOptions::max_evaluations_rule,
                            "global_spline: objective evaluations allowed (each with its gradient)",
                            [](auto& r) -> auto& { return r.options.global.max_evaluations; }, kGlobalOnly));
+  t.push_back(integer<Run>("verify_factor", "", PathGlobalOptions::verify_factor_rule,
+                           "global_spline: the optimum is evaluated again between its samples, at dt / verify_factor "
+                           "and dt / verify_factor^2 (1: not verified)",
+                           [](auto& r) -> auto& { return r.options.global.verify_factor; }, kGlobalOnly));
+  t.push_back(real<Run>("verify_tolerance", FileUnit::none, "1", PathGlobalOptions::verify_tolerance_rule,
+                        "global_spline: the relative departure of the dense figures (E, peak torque, minimum "
+                        "manipulability, tracking, limit ratios) from the sampled ones above which the run is "
+                        "solved again on a finer grid, or ends undersampled",
+                        [](auto& r) -> auto& { return r.options.global.verify_tolerance; }, kGlobalOnly));
+  t.push_back(integer<Run>("refinements", "", PathGlobalOptions::refinements_rule,
+                           "global_spline: how many times a run that departs between its samples is solved again "
+                           "from its start on a grid verify_factor times finer (the metrics stay at dt)",
+                           [](auto& r) -> auto& { return r.options.global.refinements; }, kGlobalOnly));
 }
 
 /// The preset: sets the row's method, k, alpha1A and vertex orientations (explicit keys override).
@@ -262,6 +275,32 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
                           [](const M& r) { return r.opt_objective; }));
     m.push_back(metric<M>("opt_evaluations", CellType::f64, "", "global_spline: objective evaluations made", true,
                           [](const M& r) { return r.opt_evaluations; }));
+    m.push_back(metric<M>("opt_dt", CellType::f64, "s",
+                          "global_spline: the sample step of the grid the optimiser last solved on (dt / 2^k after "
+                          "k refinements)",
+                          false, [](const M& r) { return r.opt_dt; }));
+    m.push_back(metric<M>("dense_E", CellType::f64, "Nm",
+                          "global_spline: E of the same trajectory at dt / verify_factor^2 (between the samples)", false,
+                          [](const M& r) { return r.dense.E; }));
+    m.push_back(metric<M>("dense_tau_inf", CellType::f64, "Nm",
+                          "global_spline: max over joints of |tau_i| at dt / verify_factor^2", false,
+                          [](const M& r) { return r.dense.tau_inf; }));
+    m.push_back(metric<M>("dense_min_manipulability", CellType::f64, "m^2",
+                          "global_spline: min manipulability at dt / verify_factor^2", false,
+                          [](const M& r) { return r.dense.min_manipulability; }));
+    m.push_back(metric<M>("dense_max_tracking_error", CellType::f64, "m",
+                          "global_spline: max tracking error at dt / verify_factor^2", false,
+                          [](const M& r) { return r.dense.max_tracking_error; }));
+    if (robot.chain && robot.limited)
+      m.push_back(metric<M>("dense_max_limit_ratio", CellType::f64, "",
+                            "global_spline: the largest position, velocity or effort limit ratio at dt / "
+                            "verify_factor^2",
+                            false, [](const M& r) { return r.dense.max_limit_ratio; }));
+    m.push_back(metric<M>("dense_departure", CellType::f64, "",
+                          "global_spline: the largest relative departure of the figures at dt / verify_factor and "
+                          "dt / verify_factor^2 from those at the samples (inf: the dense evaluation stopped where "
+                          "the sampled one did not); above verify_tolerance the run is undersampled",
+                          true, [](const M& r) { return r.dense.departure; }));
     m.push_back(metric<M>("opt_gradient_norm", CellType::f64, "",
                           "global_spline: infinity norm of the projected gradient at the optimum, or with active "
                           "limit constraints the KKT residual min over lambda >= 0 of |grad + J^T lambda| "
