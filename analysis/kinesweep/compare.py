@@ -48,15 +48,15 @@ def verification(results):
     return out
 
 
-def end_condition(method, spline, end_state):
+def end_condition(method, spline, end_state, local_end=""):
     """The end condition of a trajectory run (`kinesweep compare`'s rule, cli/compare_command.hpp):
     rest for vertex_alpha and vertex-quintic splines (a quintic per segment stops the arm at every
-    vertex); global_spline's end_state; free for the local methods."""
+    vertex); global_spline's end_state; the local methods' `end` (free unless "rest")."""
     if method == "vertex_alpha":
         return "rest"
     if method == "global_spline" and end_state:
         return "rest" if spline == "vertex_quintic" else end_state
-    return "free"
+    return "rest" if local_end == "rest" else "free"
 
 
 def _format_double(v):
@@ -124,7 +124,7 @@ def compare(results, by="method", metrics=None, end=None, where=None):
                 wanted.setdefault(kind, []).append(m)
             elif len(kinds) == 1 or not metrics:
                 raise KeyError(f"{m!r} is not a numeric metric of {kind} runs; expected one of {', '.join(numeric)}")
-    needed = ["run_id", "status", by] + [c for c in ("method", "spline", "end_state") if c in columns]
+    needed = ["run_id", "status", by] + [c for c in ("method", "spline", "end_state", "end") if c in columns]
     needed += sorted({m for ms in wanted.values() for m in ms})
     t = r.runs(columns=list(dict.fromkeys(needed)), where=where)
     ids = np.asarray(t["run_id"], dtype=np.int64)
@@ -140,7 +140,7 @@ def compare(results, by="method", metrics=None, end=None, where=None):
         e = ""
         if kind == "trajectory":
             e = end_condition(t["method"][i] if "method" in t else "", t["spline"][i] if "spline" in t else "",
-                              t["end_state"][i] if "end_state" in t else "")
+                              t["end_state"][i] if "end_state" in t else "", t["end"][i] if "end" in t else "")
         if end not in (None, "any") and e != end:
             continue
         if end == "any":

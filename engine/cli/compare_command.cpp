@@ -136,6 +136,7 @@ int run_compare(const CompareArgs& args) {
     const RunsColumn* method = p.find("method");
     const RunsColumn* spline = p.find("spline");
     const RunsColumn* end_state = p.find("end_state");
+    const RunsColumn* local_end = p.find("end");
     const RunsColumn* group = p.find(args.by);
     const Selector select{p, false};
     for (std::int64_t r = 0; r < static_cast<std::int64_t>(p.done.size()); ++r) {
@@ -148,7 +149,7 @@ int run_compare(const CompareArgs& args) {
       if (std::find(good.begin(), good.end(), text(status, r)) == good.end()) continue;
       std::string end;
       if (kind == to_string(BlockKind::trajectory))
-        end = end_condition(text(method, r), text(spline, r), text(end_state, r));
+        end = end_condition(text(method, r), text(spline, r), text(end_state, r), text(local_end, r));
       if (!args.end.empty() && args.end != "any" && end != args.end) continue;
       if (args.end == "any") end = "any";
       const std::int64_t id = p.row_id(r);
@@ -203,7 +204,8 @@ int run_compare(const CompareArgs& args) {
 
 }  // namespace
 
-std::string end_condition(const std::string& method, const std::string& spline, const std::string& end_state) {
+std::string end_condition(const std::string& method, const std::string& spline, const std::string& end_state,
+                          const std::string& local_end) {
   static const EffectRule rule = [] {
     KindContext global;
     global.path_global = true;  // global_spline's parameters are in the table
@@ -213,7 +215,7 @@ std::string end_condition(const std::string& method, const std::string& spline, 
   }();
   if (method == "vertex_alpha") return "rest";
   if (!end_state.empty() && rule.applies(method)) return spline == "vertex_quintic" ? "rest" : end_state;
-  return "free";
+  return local_end == "rest" ? "rest" : "free";
 }
 
 CompareArgs& add_compare_command(CLI::App& app) {

@@ -34,9 +34,11 @@ int compare_command(const CompareArgs& args);
 /// The end condition of a trajectory run (rest: the arm at rest at the last vertex; free: it may
 /// still move): its end_state where that parameter has an effect on the run (the parameter table's
 /// rule: global_spline) and its spline is not vertex_quintic; rest for vertex_alpha and for
-/// vertex_quintic splines (a quintic per segment stops the arm at every vertex); free for the local
-/// methods (their integration ends with the rates it has). `spline` and `end_state` are "" when the
-/// file has no such column.
-std::string end_condition(const std::string& method, const std::string& spline, const std::string& end_state);
+/// vertex_quintic splines (a quintic per segment stops the arm at every vertex); for the local methods
+/// their `end` parameter: rest when "rest" (a stopping window brings the self-motion to rest), else free
+/// (their integration ends with the rates it has). `spline`, `end_state` and `local_end` are "" when
+/// the file has no such column.
+std::string end_condition(const std::string& method, const std::string& spline, const std::string& end_state,
+                          const std::string& local_end = "");
 
 }  // namespace ks::cli
