@@ -4,14 +4,24 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <nlopt.hpp>
+#include <stdexcept>
+#include <string>
 
 namespace ks {
 
 double kkt_residual(const std::vector<double>& grad, const std::vector<double>& jac, std::size_t rows) {
   const auto n = static_cast<Eigen::Index>(grad.size()), m = static_cast<Eigen::Index>(rows);
+  if (n == 0) return 0.0;  // no free variable: nothing to move, stationary
+  if (jac.size() != grad.size() * rows)
+    throw std::invalid_argument("kkt_residual: " + std::to_string(jac.size()) + " Jacobian entries for " +
+                                std::to_string(rows) + " rows of " + std::to_string(n) + " variables");
+  const auto finite = [](double v) { return std::isfinite(v); };
+  if (!std::ranges::all_of(grad, finite) || !std::ranges::all_of(jac, finite))
+    return std::numeric_limits<double>::quiet_NaN();
   const Eigen::Map<const Eigen::VectorXd> g(grad.data(), n);
-  if (m == 0) return n ? g.cwiseAbs().maxCoeff() : 0.0;
+  if (m == 0) return g.cwiseAbs().maxCoeff();
   // min ||A lambda - g|| over lambda >= 0 with A = -jac^T
   const Eigen::MatrixXd A = -Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
                                  jac.data(), m, n).transpose();

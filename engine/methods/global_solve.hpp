@@ -24,7 +24,9 @@ struct SlsqpSpec {
 /// The KKT residual at a point with active inequality constraints: min over lambda >= 0 of the
 /// infinity norm of grad + jac^T lambda (non-negative least squares, Lawson and Hanson's active set
 /// method), per variable. \param[in] grad (n), jac (rows x n, row-major: the active constraints'
-/// gradients). Without rows: the infinity norm of grad.
+/// gradients). Without rows: the infinity norm of grad; without variables (n = 0: every variable held
+/// by a bound): 0; a non-finite entry in grad or jac: NaN. Rows of zeros change nothing. Throws
+/// std::invalid_argument when jac does not hold rows x n entries.
 double kkt_residual(const std::vector<double>& grad, const std::vector<double>& jac, std::size_t rows);
 
 /// Minimise from x (updated in place to the last point SLSQP returns). Status: ok (a tolerance was
