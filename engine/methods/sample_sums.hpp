@@ -196,7 +196,8 @@ struct RunShape {
 /// The metrics of a run from its sums, after `done` samples at step dt [s], under `o`'s bound rule:
 /// the status is the loop's stop status (singular, diverged), else the first bound crossed (unless
 /// on_violation = ignore), else ok. Under on_violation = stop, a run ended by a bound has NaN metrics
-/// but its samples and stop time.
+/// but its samples and stop time; so has a run that stopped before its first sample (done = 0: no
+/// metric computed; final_alpha NaN too).
 TrajectoryMetrics finish_run(const RunSums& s, const RunShape& shape, const TrajectoryOptions& o);
 
 }  // namespace ks
