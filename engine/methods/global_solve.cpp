@@ -60,6 +60,12 @@ double kkt_residual(const std::vector<double>& grad, const std::vector<double>& 
   return (g - A * lambda).cwiseAbs().maxCoeff();
 }
 
+namespace {
+std::atomic<const std::atomic<bool>*> g_stop_flag{nullptr};
+}  // namespace
+
+void set_optimiser_stop_flag(const std::atomic<bool>* flag) { g_stop_flag.store(flag); }
+
 RunStatus minimise_slsqp(const SlsqpSpec& spec, std::vector<double>& x) {
   nlopt::opt opt(nlopt::LD_SLSQP, static_cast<unsigned>(x.size()));
   opt.set_lower_bounds(-spec.bound);
@@ -68,6 +74,9 @@ RunStatus minimise_slsqp(const SlsqpSpec& spec, std::vector<double>& x) {
   opt.set_maxeval(static_cast<int>(spec.max_evaluations));
   opt.set_min_objective(
       [](const std::vector<double>& x, std::vector<double>& grad, void* data) {
+        if (const std::atomic<bool>* stop = g_stop_flag.load(std::memory_order_relaxed);
+            stop && stop->load(std::memory_order_relaxed))
+          throw nlopt::forced_stop();
         return static_cast<const SlsqpSpec*>(data)->f(x.data(), grad.empty() ? nullptr : grad.data());
       },
       const_cast<SlsqpSpec*>(&spec));
@@ -80,6 +89,8 @@ RunStatus minimise_slsqp(const SlsqpSpec& spec, std::vector<double>& x) {
   try {
     double f = 0.0;
     if (opt.optimize(x, f) == nlopt::MAXEVAL_REACHED) return RunStatus::max_evaluations;
+  } catch (const nlopt::forced_stop&) {
+    return RunStatus::interrupted;
   } catch (const nlopt::roundoff_limited&) {
     // the gradient norm the run reports says how useful the result is
   } catch (const std::exception&) {

@@ -205,6 +205,7 @@ TrajectoryMetrics solve_global_spline(const PlanarArm3& arm, const SampledPath& 
     };
   }
   const RunStatus outcome = minimise_slsqp(spec, x);
+  if (outcome == RunStatus::interrupted) return not_simulated(outcome, 3);
   const std::vector<double> best(s.coefficients(x.data()), s.coefficients(x.data()) + basis.coefficients);
   if (coefficients) *coefficients = best;
   TrajectoryMetrics m = problem.measure(basis, best.data(), o, history);

@@ -160,6 +160,7 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
   // constraints (SLSQP from a point beyond them may not get back within them)
   const std::vector<double> x_start = x;
   RunStatus outcome = minimise_slsqp(spec, x);
+  if (outcome == RunStatus::interrupted) return not_simulated(outcome, n);
   if (rows > 0 && evaluations < g.max_evaluations) {
     problem.objective(basis, at(x.data()), g.objective, nullptr, &limits, con.data(), nullptr);
     if (std::ranges::any_of(con, [](double v) { return !(v <= 0.0); })) {
@@ -169,6 +170,7 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
       spec.max_evaluations = g.max_evaluations - evaluations;
       x = x_start;
       outcome = minimise_slsqp(spec, x);
+      if (outcome == RunStatus::interrupted) return not_simulated(outcome, n);
     }
   }
   const std::vector<double> best(at(x.data()), at(x.data()) + c.size());

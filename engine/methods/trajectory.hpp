@@ -47,6 +47,10 @@ enum class RunStatus {
   not_converged,       ///< the optimiser stopped without meeting its tolerance (NLopt failure)
   infeasible,          ///< alpha(t) puts the wrist out of reach at a sample: the run ends there
   singular_extension,  ///< the extended task [tip; alpha] is singular at a sample: the run ends there
+  /// global_spline: the process was asked to stop (SIGINT, SIGTERM; set_optimiser_stop_flag in
+  /// methods/global_solve.hpp) during the optimisation, which ended at once; metrics NaN. Never
+  /// stored: the run is not written, and `run --resume` computes it.
+  interrupted,
 };
 
 /// What a run does when a sample crosses its tracking bound or its robot's joint limits.
