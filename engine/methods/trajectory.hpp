@@ -86,7 +86,8 @@ struct TrajectoryOptions {
   double dt = 1e-3;                   ///< sample / integration step [s]
   Elbow elbow = Elbow::positive;      ///< branch of the start IK (the seed's sin(theta2) >= 0)
   double torque_bound = 1.0e6;        ///< |tau_i| above this [Nm] stops the run as diverged
-  /// singular when sqrt(det(J J^T)) [m^2] (local methods) or |det J3| (vertex_alpha) falls below this
+  /// singular when sqrt(det(J J^T)) [m^2] (local methods) or |det J3| (vertex_alpha) falls below this,
+  /// for arms reaching 1 m or more; below, relative to the arm's size (methods/singular_scale.hpp)
   double singular_tolerance = 1.0e-9;
   /// Closed-loop task feedback (CLIK): the commanded task acceleration is the path's plus
   /// K_D (xd_path - xd) + K_P (x_path - x), orientation rows included for pose tasks. 0 and 0 = the
