@@ -3,6 +3,7 @@
 
 #include <Eigen/LU>
 
+#include <array>
 #include <cmath>
 
 #include "methods/chain_resolution.hpp"
@@ -67,6 +68,22 @@ void shift_into_limits(const Chain& chain, VecN& q) {
     q[j] -= two_pi * std::round((q[j] - centre) / two_pi);
   }
 }
+
+/// The Halton sequence's k-th value in base b, in (0, 1): k's digits in base b mirrored about the point.
+double radical_inverse(int k, int b) {
+  double x = 0.0, f = 1.0 / b;
+  for (; k > 0; k /= b, f /= b) x += f * (k % b);
+  return x;
+}
+constexpr std::array<int, kMaxJoints> kPrimes = [] {
+  std::array<int, kMaxJoints> p{};
+  for (int n = 2, i = 0; i < kMaxJoints; ++n) {
+    bool prime = true;
+    for (int d = 2; d * d <= n; ++d) prime = prime && n % d != 0;
+    if (prime) p[static_cast<std::size_t>(i++)] = n;
+  }
+  return p;
+}();
 
 }  // namespace
 
@@ -167,9 +184,24 @@ std::optional<VecN> solve_start(const Chain& chain, const StartTarget& target, c
     const ChainJoint& J = chain.joints[static_cast<std::size_t>(j)];
     if (std::isfinite(J.lower) && std::isfinite(J.upper)) centre[j] = 0.5 * (J.lower + J.upper);
   }
-  if (const std::optional<VecN> c = place_on_target(chain, target, centre, o)) {
-    if (within_limits(chain, *c)) return c;
-    if (std::optional<VecN> m = moved_from(*c)) return m;
+  const auto from_guess = [&](const VecN& guess) -> std::optional<VecN> {
+    if (const std::optional<VecN> c = place_on_target(chain, target, guess, o)) {
+      if (within_limits(chain, *c)) return c;
+      if (std::optional<VecN> m = moved_from(*c)) return m;
+    }
+    return std::nullopt;
+  };
+  if (std::optional<VecN> c = from_guess(centre)) return c;
+  // again from guesses spread over the limits: the other branches of the inverse kinematics
+  for (int k = 1; k <= o.restarts; ++k) {
+    VecN guess = q0;
+    for (int j = 0; j < guess.size(); ++j) {
+      const ChainJoint& J = chain.joints[static_cast<std::size_t>(j)];
+      const double u = radical_inverse(k, kPrimes[static_cast<std::size_t>(j)]);
+      if (std::isfinite(J.lower) && std::isfinite(J.upper)) guess[j] = J.lower + u * (J.upper - J.lower);
+      else if (J.type == JointType::revolute) guess[j] = q0[j] + (2.0 * u - 1.0) * 3.14159265358979323846;
+    }
+    if (std::optional<VecN> c = from_guess(guess)) return c;
   }
   // none within the limits: the spatial start as the same pose nearest to them, else the first
   if (!target.planar) {

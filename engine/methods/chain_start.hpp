@@ -25,6 +25,10 @@ struct StartSolveOptions {
   /// into them, then null-space steps towards them (limit_steps at most), then the solve again
   bool respect_limits = true;
   int limit_steps = 200;
+  /// when neither the solution nor the middle of the limits leads within them: guesses spread over
+  /// the limits (this many), each solved as the middle is; another branch of the inverse kinematics
+  /// (an elbow bent the other way) with the same tip pose may lie within the limits
+  int restarts = 64;
 };
 
 /// Solve for q with the tip on `target`, starting from q0 (n = chain.dof() values [rad or m]).
@@ -40,8 +44,10 @@ struct StartSolveOptions {
 /// towards 2 % inside its range (v = its violation of that inner range) while the tip stays on the
 /// target (planar targets: these steps only, as their angle row counts turns); each candidate is put
 /// back on the target by the iteration above and kept when within the limits; else the same from the
-/// middle of the limits as the guess; else the first solution (spatial: 2 pi-shifted, on the target),
-/// whose run then reports its limit ratios. Every q returned is on the target to the tolerance.
+/// middle of the limits as the guess; else the same from each of options.restarts guesses spread over
+/// the limits (a Halton sequence over each joint's range, [q0 - pi, q0 + pi] for a revolute joint
+/// without both limits, deterministic); else the first solution (spatial: 2 pi-shifted, on the
+/// target), whose run then reports its limit ratios. Every q returned is on the target to the tolerance.
 /// Output: q, or std::nullopt when |e| > tolerance after max_iterations (out of reach, or a guess
 /// that does not lead there).
 ///

@@ -7,6 +7,7 @@
 #include "methods/path_global_chain.hpp"
 #include "methods/run_sums.hpp"
 #include "methods/sample_sums.hpp"
+#include "methods/singular_scale.hpp"
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -382,17 +383,22 @@ TrajectoryMetrics simulate(const Chain& chain, const ChainTask& task, const VecN
   const std::optional<VecN> start = solve_start(chain, target, q0);
   if (!start) return not_simulated(RunStatus::unreachable_start, n);
 
+  // the singularity tolerance relative to the arm's size below 1 m (methods/singular_scale.hpp)
+  const double scale = singular_scale(chain_reach(chain), position_rows(task.space));
+  TrajectoryOptions scaled;
+  if (scale != 1.0) scaled = o, scaled.singular_tolerance *= scale;
+  const TrajectoryOptions& os = scale != 1.0 ? scaled : o;
   // planar chains of revolute joints: the run on fixed-size types, chosen by the joint count
-  if (planar && planar_revolute(chain)) return planar_chain_run(chain, task, *start, o, alpha_profile, history);
+  if (planar && planar_revolute(chain)) return planar_chain_run(chain, task, *start, os, alpha_profile, history);
   switch (task.space) {
     case TaskSpace::planar_position:
-      return run_method<TaskSpace::planar_position>(chain, task, *start, o, alpha_profile, history);
+      return run_method<TaskSpace::planar_position>(chain, task, *start, os, alpha_profile, history);
     case TaskSpace::planar_pose:
-      return run_method<TaskSpace::planar_pose>(chain, task, *start, o, alpha_profile, history);
+      return run_method<TaskSpace::planar_pose>(chain, task, *start, os, alpha_profile, history);
     case TaskSpace::spatial_position:
-      return run_method<TaskSpace::spatial_position>(chain, task, *start, o, alpha_profile, history);
+      return run_method<TaskSpace::spatial_position>(chain, task, *start, os, alpha_profile, history);
     case TaskSpace::spatial_pose:
-      return run_method<TaskSpace::spatial_pose>(chain, task, *start, o, alpha_profile, history);
+      return run_method<TaskSpace::spatial_pose>(chain, task, *start, os, alpha_profile, history);
   }
   throw std::invalid_argument("simulate: unknown task space");
 }

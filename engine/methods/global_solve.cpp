@@ -4,14 +4,24 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <nlopt.hpp>
+#include <stdexcept>
+#include <string>
 
 namespace ks {
 
 double kkt_residual(const std::vector<double>& grad, const std::vector<double>& jac, std::size_t rows) {
   const auto n = static_cast<Eigen::Index>(grad.size()), m = static_cast<Eigen::Index>(rows);
+  if (n == 0) return 0.0;  // no free variable: nothing to move, stationary
+  if (jac.size() != grad.size() * rows)
+    throw std::invalid_argument("kkt_residual: " + std::to_string(jac.size()) + " Jacobian entries for " +
+                                std::to_string(rows) + " rows of " + std::to_string(n) + " variables");
+  const auto finite = [](double v) { return std::isfinite(v); };
+  if (!std::ranges::all_of(grad, finite) || !std::ranges::all_of(jac, finite))
+    return std::numeric_limits<double>::quiet_NaN();
   const Eigen::Map<const Eigen::VectorXd> g(grad.data(), n);
-  if (m == 0) return n ? g.cwiseAbs().maxCoeff() : 0.0;
+  if (m == 0) return g.cwiseAbs().maxCoeff();
   // min ||A lambda - g|| over lambda >= 0 with A = -jac^T
   const Eigen::MatrixXd A = -Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
                                  jac.data(), m, n).transpose();
@@ -50,6 +60,12 @@ double kkt_residual(const std::vector<double>& grad, const std::vector<double>& 
   return (g - A * lambda).cwiseAbs().maxCoeff();
 }
 
+namespace {
+std::atomic<const std::atomic<bool>*> g_stop_flag{nullptr};
+}  // namespace
+
+void set_optimiser_stop_flag(const std::atomic<bool>* flag) { g_stop_flag.store(flag); }
+
 RunStatus minimise_slsqp(const SlsqpSpec& spec, std::vector<double>& x) {
   nlopt::opt opt(nlopt::LD_SLSQP, static_cast<unsigned>(x.size()));
   opt.set_lower_bounds(-spec.bound);
@@ -58,6 +74,9 @@ RunStatus minimise_slsqp(const SlsqpSpec& spec, std::vector<double>& x) {
   opt.set_maxeval(static_cast<int>(spec.max_evaluations));
   opt.set_min_objective(
       [](const std::vector<double>& x, std::vector<double>& grad, void* data) {
+        if (const std::atomic<bool>* stop = g_stop_flag.load(std::memory_order_relaxed);
+            stop && stop->load(std::memory_order_relaxed))
+          throw nlopt::forced_stop();
         return static_cast<const SlsqpSpec*>(data)->f(x.data(), grad.empty() ? nullptr : grad.data());
       },
       const_cast<SlsqpSpec*>(&spec));
@@ -70,6 +89,8 @@ RunStatus minimise_slsqp(const SlsqpSpec& spec, std::vector<double>& x) {
   try {
     double f = 0.0;
     if (opt.optimize(x, f) == nlopt::MAXEVAL_REACHED) return RunStatus::max_evaluations;
+  } catch (const nlopt::forced_stop&) {
+    return RunStatus::interrupted;
   } catch (const nlopt::roundoff_limited&) {
     // the gradient norm the run reports says how useful the result is
   } catch (const std::exception&) {

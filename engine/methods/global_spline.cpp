@@ -208,6 +208,7 @@ TrajectoryMetrics solve_global_spline(const PlanarArm3& arm, const SampledPath& 
   }
   const std::vector<double> x_start = x;
   RunStatus outcome = minimise_slsqp(spec, x);
+  if (outcome == RunStatus::interrupted) return not_simulated(outcome, 3);
   std::vector<double> best(s.coefficients(x.data()), s.coefficients(x.data()) + basis.coefficients);
   TrajectoryMetrics m = problem.measure(basis, best.data(), o, history);
   const auto basis_on = [&](const SampledPath& p) {
@@ -246,6 +247,7 @@ TrajectoryMetrics solve_global_spline(const PlanarArm3& arm, const SampledPath& 
     spec.max_evaluations = g.max_evaluations;  // each solve its budget
     x = x_start;
     outcome = minimise_slsqp(spec, x);
+    if (outcome == RunStatus::interrupted) return not_simulated(outcome, 3);
     best.assign(s.coefficients(x.data()), s.coefficients(x.data()) + basis.coefficients);
     m = problem.measure(basis, best.data(), o, history);
     m.dense = verify_between_samples(m, o.dt, factor, o.tracking_bound, measure_at);

@@ -181,6 +181,7 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
     spec.max_evaluations = g.max_evaluations;
     x = from;
     RunStatus status = minimise_slsqp(spec, x);
+    if (status == RunStatus::interrupted) return status;
     if (rows > 0 && evaluations - begun < g.max_evaluations) {
       solving->objective(*solving_basis, at(x.data()), g.objective, nullptr, &limits, con.data(), nullptr);
       if (std::ranges::any_of(con, [](double v) { return !(v <= 0.0); })) {
@@ -196,6 +197,7 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
   };
   const std::vector<double> x_start = x;
   RunStatus outcome = solve(x_start);
+  if (outcome == RunStatus::interrupted) return not_simulated(outcome, n);
   std::vector<double> best(at(x.data()), at(x.data()) + c.size());
   TrajectoryMetrics m = problem.measure(basis, best.data(), q_start, o, history);
   // the same trajectory on the grid of step h (figures only)
@@ -229,6 +231,7 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
     solving_basis = &*fine_basis;
     limits = LimitConstraints::of(chain, solving->samples(), static_cast<int>(g.knots));
     outcome = solve(x_start);
+    if (outcome == RunStatus::interrupted) return not_simulated(outcome, n);
     best.assign(at(x.data()), at(x.data()) + c.size());
     m = problem.measure(basis, best.data(), q_start, o, history);
     m.dense = verify_between_samples(m, o.dt, factor, o.tracking_bound, measure_at);

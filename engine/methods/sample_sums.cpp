@@ -35,7 +35,7 @@ TrajectoryMetrics finish_run(const RunSums& s, const RunShape& shape, const Traj
   }
   const bool bounded_stop = o.on_violation == OnViolation::stop &&
                             (out.status == RunStatus::off_path || out.status == RunStatus::out_of_limits);
-  if (bounded_stop) {
+  if (bounded_stop || s.done == 0) {  // (no sample: no metric was computed)
     out.E = out.E_M = out.E_force = out.min_manipulability = out.torque_sq_integral = out.power_sq_integral = nan;
     out.max_tracking_error = out.mean_tracking_error = out.max_orientation_error = nan;
     out.max_q_limit_ratio = out.max_qd_limit_ratio = out.max_tau_limit_ratio = nan;

@@ -69,22 +69,26 @@ class SampleSums {
   /// bound: tracking bound [m] and orientation bound [rad] per lane; limits: the run's (T = double
   /// only; null = none).
   SampleSums(const T& tracking_bound, const T& orientation_bound, const LimitTable* limits = nullptr)
-      : bound2_(tracking_bound * tracking_bound), obound_(orientation_bound), limits_(limits) {
+      : bound_(tracking_bound), obound_(orientation_bound), limits_(limits) {
     for (T& x : inf) x = T(0.0);
     for_each_sample_metric([&](const auto& m, int k) { sampled_[k] = T(reduce_start(m.reduce)); });
   }
 
   /// Adds sample i at time t with per-joint |tau_j| in abs_tau (n joints); returns the lanes that
-  /// cross the tracking bound at this sample (the limits' crossings: limits()).
+  /// cross the tracking bound at this sample: |tip - path| > bound, the distance itself compared (a
+  /// distance equal to the bound is on the path; the limits' crossings: limits()).
   template <class Keep>
   M add(std::size_t i, double t, const SampleValues<T>& v, const T* abs_tau, int n, Keep&& keep) {
+    T err;
     if constexpr (one) {
       roots_.add(v.tt, v.qf, v.det);
-      sum_err_ += std::sqrt(v.err2);
+      err = std::sqrt(v.err2);
+      sum_err_ += err;
     } else {
+      err = vsqrt(v.err2);
       sumE = keep(sumE + vsqrt(v.tt), sumE);
       sumEM = keep(sumEM + vsqrt(v.qf / v.det), sumEM);
-      sum_err_ = keep(sum_err_ + vsqrt(v.err2), sum_err_);
+      sum_err_ = keep(sum_err_ + err, sum_err_);
     }
     sumEF = keep(sumEF + vsqrt(v.ff), sumEF);
     for (int j = 0; j < n; ++j) inf[j] = keep(vmax(inf[j], abs_tau[j]), inf[j]);
@@ -111,7 +115,7 @@ class SampleSums {
                                                    : x,
                          sampled_[k]);
     });
-    return (v.err2 > bound2_) | (v.orient > obound_);
+    return (err > bound_) | (v.orient > obound_);
   }
 
   /// T = double: the ratios of sample values q, qd, tau (n joints, actual joint coordinates) to the
@@ -178,7 +182,7 @@ class SampleSums {
   T done = 0.0, last_t = 0.0, last_alpha = 0.0;
   T sampled_[kSampleMetricCount > 0 ? kSampleMetricCount : 1];
   double ratio_q = 0, ratio_qd = 0, ratio_tau = 0;  // T = double only
-  T bound2_, obound_;
+  T bound_, obound_;
   const LimitTable* limits_;
   struct NoRoots {};
   std::conditional_t<one, RootSums, NoRoots> roots_;
@@ -197,7 +201,8 @@ struct RunShape {
 /// The metrics of a run from its sums, after `done` samples at step dt [s], under `o`'s bound rule:
 /// the status is the loop's stop status (singular, diverged), else the first bound crossed (unless
 /// on_violation = ignore), else ok. Under on_violation = stop, a run ended by a bound has NaN metrics
-/// but its samples and stop time.
+/// but its samples and stop time; so has a run that stopped before its first sample (done = 0: no
+/// metric computed; final_alpha NaN too).
 TrajectoryMetrics finish_run(const RunSums& s, const RunShape& shape, const TrajectoryOptions& o);
 
 }  // namespace ks

@@ -12,6 +12,7 @@
 #include "methods/global_spline.hpp"
 #include "methods/run_sums.hpp"
 #include "methods/sample_sums.hpp"
+#include "methods/singular_scale.hpp"
 #include "methods/trajectory_batch.hpp"
 #include "methods/trajectory_lanes.hpp"
 
@@ -148,7 +149,7 @@ void prepare(Batch& b, int lanes, const PlanarArm3& arm, const SampledPath& samp
     L.k[i] = o.k;
     L.null_damping[i] = o.null_damping;
     L.torque_bound[i] = o.torque_bound;
-    L.tolerance[i] = o.singular_tolerance;
+    L.tolerance[i] = o.singular_tolerance * singular_scale(arm_reach(arm), 2);  // (relative below 1 m)
     L.kp[i] = o.clik_kp;
     L.kd[i] = o.clik_kd;
     L.tracking_bound[i] = o.tracking_bound;

@@ -50,6 +50,10 @@ enum class RunStatus {
   not_converged,       ///< the optimiser stopped without meeting its tolerance (NLopt failure)
   infeasible,          ///< alpha(t) puts the wrist out of reach at a sample: the run ends there
   singular_extension,  ///< the extended task [tip; alpha] is singular at a sample: the run ends there
+  /// global_spline: the process was asked to stop (SIGINT, SIGTERM; set_optimiser_stop_flag in
+  /// methods/global_solve.hpp) during the optimisation, which ended at once; metrics NaN. Never
+  /// stored: the run is not written, and `run --resume` computes it.
+  interrupted,
 };
 
 /// What a run does when a sample crosses its tracking bound or its robot's joint limits.
@@ -90,7 +94,8 @@ struct TrajectoryOptions {
   double dt = 1e-3;                   ///< sample / integration step [s]
   Elbow elbow = Elbow::positive;      ///< branch of the start IK (the seed's sin(theta2) >= 0)
   double torque_bound = 1.0e6;        ///< |tau_i| above this [Nm] stops the run as diverged
-  /// singular when sqrt(det(J J^T)) [m^2] (local methods) or |det J3| (vertex_alpha) falls below this
+  /// singular when sqrt(det(J J^T)) [m^2] (local methods) or |det J3| (vertex_alpha) falls below this,
+  /// for arms reaching 1 m or more; below, relative to the arm's size (methods/singular_scale.hpp)
   double singular_tolerance = 1.0e-9;
   /// Closed-loop task feedback (CLIK): the commanded task acceleration is the path's plus
   /// K_D (xd_path - xd) + K_P (x_path - x), orientation rows included for pose tasks. 0 and 0 = the

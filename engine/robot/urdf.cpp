@@ -22,11 +22,13 @@
 
 namespace ks {
 
-UrdfError::UrdfError(std::string file_, int line_, std::string message_)
-    : std::runtime_error(file_ + (line_ > 0 ? ":" + std::to_string(line_) : std::string()) + ": " + message_),
+UrdfError::UrdfError(std::string file_, int line_, std::string message_, int column_)
+    : std::runtime_error(file_ + (line_ > 0 ? ":" + std::to_string(line_) : std::string()) +
+                         (line_ > 0 && column_ > 0 ? ":" + std::to_string(column_) : std::string()) + ": " + message_),
       file(std::move(file_)),
       line(line_),
-      message(std::move(message_)) {}
+      message(std::move(message_)),
+      column(column_) {}
 
 namespace {
 
@@ -112,8 +114,8 @@ struct Body {
 
 class Builder {
  public:
-  Builder(std::string_view text, std::string file, const urdf::ModelInterface& model)
-      : text_(text), file_(std::move(file)), model_(model) {}
+  Builder(std::string_view text, std::string file, const urdf::ModelInterface& model, urdf_check::LimitsOmitted omitted)
+      : text_(text), file_(std::move(file)), model_(model), omitted_(std::move(omitted)) {}
 
   [[noreturn]] void fail(int line, const std::string& message) const { throw UrdfError(file_, line, message); }
   int link_line(const std::string& name) const { return element_line(text_, "link", name); }
@@ -316,9 +318,9 @@ class Builder {
     const V3 axis(joint.axis.x, joint.axis.y, joint.axis.z);
     if (!(axis.norm() > 0.0) || !axis.allFinite()) fail(joint_line(joint.name), "joint '" + joint.name + "': zero axis");
     j.axis = axis.normalized();
-    if (joint.type != urdf::Joint::CONTINUOUS && joint.limits) {
-      j.lower = joint.limits->lower;
-      j.upper = joint.limits->upper;
+    if (joint.type != urdf::Joint::CONTINUOUS && joint.limits) {  // an omitted lower or upper: none on that side
+      if (!omitted_.lower.count(joint.name)) j.lower = joint.limits->lower;
+      if (!omitted_.upper.count(joint.name)) j.upper = joint.limits->upper;
       if (!(j.lower <= j.upper))
         fail(joint_line(joint.name), "joint '" + joint.name + "': limit lower > upper");
     }
@@ -364,6 +366,7 @@ class Builder {
   std::string_view text_;
   std::string file_;
   const urdf::ModelInterface& model_;
+  urdf_check::LimitsOmitted omitted_;
 };
 
 }  // namespace
@@ -372,7 +375,8 @@ Chain parse_urdf(std::string_view text, std::string_view base_link, std::string_
                  std::string_view file) {
   const std::string xml(text);
   const std::string file_name(file);
-  urdf_check::check_text(xml, file_name);  // XML, numbers, loops: located before urdfdom reads the text
+  // XML, numbers, limits, loops: located before urdfdom reads the text
+  urdf_check::LimitsOmitted omitted = urdf_check::check_text(xml, file_name);
   std::vector<std::string> messages;
   const urdf::ModelInterfaceSharedPtr model = parse_model(xml, messages);
   if (!model || !messages.empty()) {  // a warning or error of urdfdom's means it dropped or guessed something
@@ -389,7 +393,7 @@ Chain parse_urdf(std::string_view text, std::string_view base_link, std::string_
     }
     throw UrdfError(file_name, line, "not a valid URDF robot" + (joined.empty() ? std::string() : ": " + joined));
   }
-  return Builder(text, file_name, *model).build(base_link, tip_link, gravity);
+  return Builder(text, file_name, *model, std::move(omitted)).build(base_link, tip_link, gravity);
 }
 
 Chain load_urdf(const std::filesystem::path& file, std::string_view base_link, std::string_view tip_link,

@@ -16,11 +16,14 @@ struct UrdfError : std::runtime_error {
   std::string file;     ///< the file (or the name given to parse_urdf)
   int line = 0;         ///< 1-based line of the element at fault; 0 when unknown
   std::string message;  ///< what is wrong, without the location
-  UrdfError(std::string file, int line, std::string message);
+  int column = 0;       ///< 1-based column (characters) on that line; 0 when unknown
+  /// what(): "file:line:column: message", the line and column when known.
+  UrdfError(std::string file, int line, std::string message, int column = 0);
 };
 
 /// The chain from `base_link` to `tip_link` of the URDF text.
-///  - revolute and prismatic joints become chain joints (limits from <limit>); continuous joints
+///  - revolute and prismatic joints become chain joints (limits from <limit>; a lower or upper the
+///    <limit> omits is no limit on that side, -inf or +inf; lower >= upper given is refused); continuous joints
 ///    are revolute joints without limits;
 ///  - fixed joints are merged: the links they attach join the moving body they hang from (their
 ///    <inertial> merged into its mass properties), their transforms fold into the next joint's

@@ -5,9 +5,11 @@
 
 #include <tinyxml.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <string_view>
@@ -108,12 +110,66 @@ void check_utf8(const std::string& xml, const std::string& file) {
   }
 }
 
+// Throws at the first start tag nested deeper than kMaxElementDepth: tinyxml (and urdfdom after it)
+// descend one call per level, and a text nested tens of thousands deep overflows the stack (and takes
+// time quadratic in the depth before that). A scan of the markup only: comments, CDATA sections,
+// processing instructions and declarations are stepped over, quoted attribute values may hold '>';
+// whether the text is well-formed is tinyxml's to say.
+void check_depth(const std::string& xml, const std::string& file) {
+  const auto skip_past = [&](std::size_t from, std::string_view end) {
+    const std::size_t at = xml.find(end, from);
+    return at == std::string::npos ? xml.size() : at + end.size();
+  };
+  int depth = 0;
+  for (std::size_t i = xml.find('<'); i < xml.size(); i = xml.find('<', i)) {
+    const std::string_view rest = std::string_view(xml).substr(i);
+    if (rest.starts_with("<!--")) {
+      i = skip_past(i + 4, "-->");
+    } else if (rest.starts_with("<![CDATA[")) {
+      i = skip_past(i + 9, "]]>");
+    } else if (rest.starts_with("<?")) {
+      i = skip_past(i + 2, "?>");
+    } else if (rest.starts_with("<!")) {  // <!DOCTYPE ...> with an internal subset in [ ]
+      const std::size_t bracket = xml.find_first_of("[>", i);
+      i = bracket != std::string::npos && xml[bracket] == '[' ? skip_past(skip_past(bracket, "]"), ">")
+                                                               : skip_past(i, ">");
+    } else if (rest.starts_with("</")) {
+      --depth;
+      i = skip_past(i, ">");
+    } else {  // a start tag: up to its '>' outside quotes; "/>" closes it at once
+      std::size_t k = i + 1;
+      char quote = 0;
+      for (; k < xml.size() && (quote || xml[k] != '>'); ++k)
+        if (quote ? xml[k] == quote : xml[k] == '"' || xml[k] == '\'') quote = quote ? 0 : xml[k];
+      const bool empty = k < xml.size() && xml[k - 1] == '/';
+      if (!empty && ++depth > kMaxElementDepth) {
+        const std::size_t line_start = xml.rfind('\n', i) == std::string::npos ? 0 : xml.rfind('\n', i) + 1;
+        int column = 1;  // in characters: UTF-8 continuation bytes do not count
+        for (std::size_t c = line_start; c < i; ++c) column += (static_cast<unsigned char>(xml[c]) & 0xC0) != 0x80;
+        const int line = 1 + static_cast<int>(std::count(xml.begin(), xml.begin() + static_cast<std::ptrdiff_t>(i), '\n'));
+        std::size_t name_end = i + 1;
+        while (name_end < xml.size() && !is_space(xml[name_end]) && xml[name_end] != '>' && xml[name_end] != '/')
+          ++name_end;
+        throw UrdfError(file, line,
+                        "element <" + xml.substr(i + 1, std::min<std::size_t>(name_end - i - 1, 40)) +
+                            "> is nested " + std::to_string(depth) + " elements deep; expected at most " +
+                            std::to_string(kMaxElementDepth) + " levels of nesting (a URDF robot needs about 5)",
+                        column);
+      }
+      i = k < xml.size() ? k + 1 : xml.size();
+    }
+  }
+}
+
 class Checker {
  public:
   explicit Checker(const std::string& file) : file_(file) {}
 
   [[noreturn]] void fail(const TiXmlElement& at, const std::string& message) const {
     throw UrdfError(file_, at.Row(), message);
+  }
+  [[noreturn]] void fail_at_column(const TiXmlElement& at, const std::string& message) const {
+    throw UrdfError(file_, at.Row(), message, at.Column());
   }
 
   // The number attributes of `e` and of its descendants; `owner` names the link or joint.
@@ -131,6 +187,29 @@ class Checker {
       }
     }
     for (const TiXmlElement* c = e.FirstChildElement(); c; c = c->NextSiblingElement()) check_numbers(*c, e.Value(), owner);
+  }
+
+  // A revolute or prismatic joint's <limit>: lower <= upper, and lower < upper when both are given;
+  // the omitted bounds into `omitted`.
+  void check_limit(const TiXmlElement& joint, LimitsOmitted& omitted) const {
+    const char* type = joint.Attribute("type");
+    const char* name = joint.Attribute("name");
+    if (!type || !name || (std::strcmp(type, "revolute") != 0 && std::strcmp(type, "prismatic") != 0)) return;
+    const TiXmlElement* limit = joint.FirstChildElement("limit");
+    if (!limit) return;  // urdfdom says a revolute or prismatic joint needs one
+    const char* lower = limit->Attribute("lower");
+    const char* upper = limit->Attribute("upper");
+    if (!lower) omitted.lower.insert(name);
+    if (!upper) omitted.upper.insert(name);
+    if (!lower || !upper) return;
+    const double lo = std::strtod(lower, nullptr), up = std::strtod(upper, nullptr);  // (checked numbers)
+    const std::string at = "joint '" + std::string(name) + "': <limit lower=\"" + lower + "\" upper=\"" + upper + "\">: ";
+    const char* unit = std::strcmp(type, "revolute") == 0 ? "rad" : "m";
+    if (lo > up)
+      fail_at_column(*limit, at + "lower > upper; expected lower <= upper [" + unit + "]");
+    if (lo == up)
+      fail_at_column(*limit, at + "lower = upper, a " + type + " joint that cannot move; expected lower < upper [" + unit +
+                       "] (omit both for a joint without position limits, or make the joint fixed)");
   }
 
   struct Edge {
@@ -192,21 +271,25 @@ class Checker {
 
 }  // namespace
 
-void check_text(const std::string& xml, const std::string& file) {
+LimitsOmitted check_text(const std::string& xml, const std::string& file) {
   check_utf8(xml, file);
+  check_depth(xml, file);
   TiXmlDocument doc;  // urdfdom's own XML parser; its errors carry a line
   doc.Parse(xml.c_str());
   if (doc.Error()) throw UrdfError(file, doc.ErrorRow(), std::string("XML parse error: ") + doc.ErrorDesc());
+  LimitsOmitted omitted;
   const TiXmlElement* robot = doc.FirstChildElement("robot");
-  if (!robot) return;  // urdfdom says so
+  if (!robot) return omitted;  // urdfdom says so
   const Checker check(file);
   for (const TiXmlElement* e = robot->FirstChildElement(); e; e = e->NextSiblingElement()) {
     const bool link = std::strcmp(e->Value(), "link") == 0;
     if (!link && std::strcmp(e->Value(), "joint") != 0) continue;
     const char* name = e->Attribute("name");
     check.check_numbers(*e, "robot", std::string(link ? "link '" : "joint '") + (name ? name : "") + "'");
+    if (!link) check.check_limit(*e, omitted);
   }
   check.check_graph(*robot);
+  return omitted;
 }
 
 }  // namespace ks::urdf_check

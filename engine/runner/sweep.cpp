@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <map>
 #include <chrono>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include <memory>
 #include <ostream>
 
+#include "methods/global_solve.hpp"
 #include "methods/seed_cases.hpp"
 #include "methods/trajectory_lanes.hpp"
 #include "runner/landscape.hpp"
@@ -31,6 +33,7 @@ struct Job {
   Record row;
   store::EncodedHistory history;
   double seconds = 0;  // executing the run and encoding its history
+  bool interrupted = false;  // stopped by a signal before its end: not written
 };
 struct Batch {
   std::vector<Job> jobs;
@@ -343,6 +346,12 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
   const std::size_t full_batch = std::max<std::size_t>(options.batch, 2 * static_cast<std::size_t>(lanes));
   const std::size_t batch = std::clamp<std::size_t>((todo + 4 * threads - 1) / (4 * threads), 1, full_batch);
   bool interrupted = false;
+  std::atomic<bool> dropped{false};  // a run stopped by the signal was left out
+  // the optimiser of path-global runs ends a run in flight when the stop flag is set
+  struct StopFlagInOptimiser {
+    explicit StopFlagInOptimiser(const std::atomic<bool>* flag) { set_optimiser_stop_flag(flag); }
+    ~StopFlagInOptimiser() { set_optimiser_stop_flag(nullptr); }
+  } stop_flag_in_optimiser(options.stop);
   auto is_done = [&](std::uint64_t id) { return previous && id < previous->done.size() && previous->done[id]; };
 
   tbb::task_arena arena(threads);
@@ -385,6 +394,11 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
                   for (std::size_t i = 0; i < n; ++i) {
                     Job& j = b->jobs[i];
                     const RunOutcome& o = outcomes[i];
+                    const TrajectoryMetrics* tm = std::get_if<TrajectoryMetrics>(&o.result);
+                    if (tm && tm->status == RunStatus::interrupted) {
+                      j.interrupted = true;
+                      continue;
+                    }
                     const auto t0 = Clock::now();
                     if (!o.history.arrays.empty()) j.history = store::encode_history(o.history, options.compression, writer.history_chunk_rows());
                     j.seconds = wall[i] + std::chrono::duration<double>(Clock::now() - t0).count();
@@ -395,6 +409,10 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
             tbb::make_filter<std::shared_ptr<Batch>, void>(
                 tbb::filter_mode::serial_in_order, [&](std::shared_ptr<Batch> b) {
                   for (Job& j : b->jobs) {
+                    if (j.interrupted) {  // left undone: a resume computes it
+                      dropped.store(true);
+                      continue;
+                    }
                     // the landscape cell before the row: a commit that holds a run done holds its
                     // cell (a distributed merge copies the cells of the shards' done runs)
                     acc.add(j.id, j.ref, j.row);
@@ -410,6 +428,7 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
                   }
                 }));
   });
+  if (dropped.load()) interrupted = true;
   writer.flush();
   if (options.on_progress) options.on_progress({written, todo, std::chrono::duration<double>(Clock::now() - start).count()});
   SweepReport report;

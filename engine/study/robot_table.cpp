@@ -214,7 +214,8 @@ void Parser::parse_urdf_robot(const toml::table& t, Study& s) {
     std::string expected = "a URDF chain of revolute, continuous or prismatic joints with mass";
     if (what.starts_with("unknown base link")) where = t.get("base"), expected = "a link of the URDF";
     else if (what.starts_with("unknown tip link")) where = t.get("tip"), expected = "a link of the URDF";
-    error(*where, "URDF " + e.file + (e.line > 0 ? ":" + std::to_string(e.line) : std::string()) + ": " + what +
+    error(*where, "URDF " + e.file + (e.line > 0 ? ":" + std::to_string(e.line) : std::string()) +
+                      (e.line > 0 && e.column > 0 ? ":" + std::to_string(e.column) : std::string()) + ": " + what +
                       "; expected " + expected + hint);
   }
 }

@@ -201,6 +201,11 @@ struct Reach {
   double bound = 0.0;            ///< [m]; infinite with an unlimited prismatic joint
   Eigen::Vector3d centre;        ///< the first joint's origin (base frame)
   bool in_plane = false;         ///< measured in the base xy plane (from the first joint's axis)
+  /// in the plane, revolute joints only: no configuration puts the tip closer than this [m] (0 when
+  /// unknown); the links' lengths l_i (the offsets' xy parts, each turned freely by a joint before it)
+  /// give max(0, 2 max l_i - sum l_i), limits only keep the tip farther
+  double inner = 0.0;
+  double longest = 0.0;          ///< the longest l_i [m] (for the message)
 };
 
 /// Every joint turns about (or slides across) the base z axis: each origin maps z to +-z and each
@@ -220,11 +225,14 @@ Reach reach_of(const Chain& c, bool in_plane) {
   r.centre = c.joints.front().origin.p;
   const auto length = [&](const Eigen::Vector3d& p) { return in_plane ? p.head<2>().norm() : p.norm(); };
   r.bound = length(c.tip.p);
+  r.longest = r.bound;
+  bool revolute = true;
   for (int j = 0; j < c.dof(); ++j) {
-    if (j > 0) r.bound += length(c.joints[j].origin.p);
+    if (j > 0) r.bound += length(c.joints[j].origin.p), r.longest = std::max(r.longest, length(c.joints[j].origin.p));
     if (c.joints[j].type == JointType::prismatic)
-      r.bound += std::max(std::abs(c.joints[j].lower), std::abs(c.joints[j].upper));
+      r.bound += std::max(std::abs(c.joints[j].lower), std::abs(c.joints[j].upper)), revolute = false;
   }
+  if (in_plane && revolute) r.inner = std::max(0.0, 2.0 * r.longest - r.bound);
   return r;
 }
 
@@ -250,8 +258,18 @@ void Parser::check_task_fits_robot(const toml::table* task, Study& s) {
     Eigen::Vector3d v = s.task.vertex(i) - reach.centre;
     if (reach.in_plane) v.z() = 0.0;
     const double d = v.norm();
-    if (d <= reach.bound * (1 + 1e-12)) continue;
     const toml::node* at = vn && vn->as_array() ? vn->as_array()->get(i) : nullptr;
+    if (d < reach.inner * (1 - 1e-12)) {
+      const std::string hole = fmt(reach.inner) + " m: twice the longest link, " + fmt(reach.longest) +
+                               " m, minus the sum of the links, " + fmt(reach.bound) + " m, in the plane of motion";
+      error(at ? pos_of(at->source()) : vn ? pos_of(vn->source()) : task ? pos_of(task->source()) : Pos{1, 1},
+            "vertex " + std::to_string(i + 1) + (at ? "" : " of the default path (the seed's square)") + " is " + fmt(d) +
+                " m from " + from + ", inside the disc the robot cannot reach (no tip position closer than " + hole +
+                "); expected [task] vertices at least " + fmt(reach.inner) + " m from " + from);
+      if (!at) return;
+      continue;
+    }
+    if (d <= reach.bound * (1 + 1e-12)) continue;
     if (at) {
       error(*at, "vertex " + std::to_string(i + 1) + " is " + fmt(d) + " m from " + from +
                      ", beyond the robot's reach (at most " + bound + "); expected a vertex within " + fmt(reach.bound) +
