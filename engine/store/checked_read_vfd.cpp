@@ -7,6 +7,8 @@
 // reads global heaps like raw data), so the check sees collections whole.
 #include "store/checked_read_vfd.hpp"
 
+#include "store/h5util.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -14,6 +16,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
+#include <map>
 #include <mutex>
 #include <vector>
 
@@ -80,6 +83,23 @@ bool pread_all(int fd, unsigned char* out, std::size_t size, std::uint64_t at) {
     out += n, at += static_cast<std::uint64_t>(n), size -= static_cast<std::size_t>(n);
   }
   return true;
+}
+
+std::map<std::uint64_t, std::uint64_t> collection_objects(int fd, std::uint64_t addr, std::uint64_t eof) {
+  std::map<std::uint64_t, std::uint64_t> objects;
+  unsigned char head[16];
+  if (addr > eof || eof - addr < sizeof head || !pread_all(fd, head, sizeof head, addr)) return objects;
+  const auto read = [fd](unsigned char* to, std::size_t n, std::uint64_t at) { return pread_all(fd, to, n, at); };
+  if (std::memcmp(head, "GCOL\1\0\0\0", 8) != 0 || !global_heap_collection_is_sound(head, sizeof head, addr, eof, read))
+    return objects;
+  std::vector<unsigned char> whole(static_cast<std::size_t>(le(head + 8, 8)));
+  if (!pread_all(fd, whole.data(), whole.size(), addr)) return objects;
+  for (std::uint64_t p = 16; p + 16 <= whole.size();) {  // sound: every step advances and stays inside
+    const std::uint64_t index = le(whole.data() + p, 2), size = le(whole.data() + p + 8, 8);
+    if (index != 0) objects[index] = size;
+    p += index == 0 ? size : 16 + (size + 7) / 8 * 8;
+  }
+  return objects;
 }
 
 H5FD_t* c_open(const char* name, unsigned flags, hid_t, haddr_t maxaddr) {
@@ -192,6 +212,50 @@ hid_t make_checked_read_fapl() {
     return -1;
   }
   return fapl;
+}
+
+void check_vlen_references(hid_t dset, hid_t file_space, const std::string& path, const std::string& what) {
+  const haddr_t offset = H5Dget_offset(dset);  // contiguous, allocated datasets only
+  if (offset == HADDR_UNDEF) return;
+  struct stat st{};
+  if (::stat((path + ".journal").c_str(), &st) == 0) return;  // bytes under a journal: maybe not the committed state
+  Hid space(file_space == H5S_ALL ? H5Dget_space(dset) : H5Scopy(file_space));
+  if (!space.ok()) return;
+  const int rank = H5Sget_simple_extent_ndims(space);
+  if (rank > 1) return;
+  hsize_t first = 0, last = 0;
+  if (rank == 1) {
+    if (H5Sget_select_npoints(space) <= 0) return;
+    if (file_space == H5S_ALL) H5Sselect_all(space);
+    if (H5Sget_select_bounds(space, &first, &last) < 0) return;
+  }
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return;
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  if (::fstat(fd, &st) != 0) return;
+  const std::uint64_t eof = static_cast<std::uint64_t>(st.st_size);
+  // Each element on disk: the string's length (4 bytes), its collection's address (8) and the object's
+  // index in it (4) (HDF5 file format specification, "Variable-length data").
+  constexpr std::uint64_t kRef = 16;
+  const std::uint64_t count = last - first + 1, at = offset + first * kRef;
+  std::vector<unsigned char> refs(static_cast<std::size_t>(count * kRef));
+  if (at > eof || count * kRef > eof - at || !pread_all(fd, refs.data(), refs.size(), at))
+    throw StoreError(path, what + ": its variable-length strings lie past the end of the file (a damaged file)");
+  std::map<std::uint64_t, std::map<std::uint64_t, std::uint64_t>> collections;
+  for (std::uint64_t i = 0; i < count; ++i) {
+    const unsigned char* r = refs.data() + i * kRef;
+    const std::uint64_t length = le(r, 4), heap = le(r + 4, 8), index = le(r + 12, 4);
+    if (heap == 0) continue;  // no string stored (HDF5 reads nothing)
+    auto c = collections.find(heap);
+    if (c == collections.end()) c = collections.emplace(heap, collection_objects(fd, heap, eof)).first;
+    const auto o = c->second.find(index);
+    if (o == c->second.end() || o->second != length)
+      throw StoreError(path, what + ": the string of element " + std::to_string(first + i) +
+                                 " points to no object of its length in the file's global heap (a damaged file)");
+  }
 }
 
 }  // namespace ks::store::detail

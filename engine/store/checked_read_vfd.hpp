@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <string>
 
 namespace ks::store::detail {
 
@@ -22,5 +23,12 @@ using ReadBytes = std::function<bool(unsigned char* to, std::size_t n, std::uint
 /// true otherwise (also for bytes that start no collection).
 bool global_heap_collection_is_sound(const unsigned char* bytes, std::size_t size, std::uint64_t addr,
                                      std::uint64_t eof, const ReadBytes& read);
+
+/// Throws StoreError (naming `what`) when an element of the selection `file_space` (H5S_ALL: every
+/// element) of the contiguous variable-length string dataset `dset` of the results file `path` points
+/// to no object of its length in the file's global heap: HDF5 1.10 would copy from a null object, or
+/// past the buffer it allocated for the string. Nothing for a dataset that is not contiguous, or a file
+/// with a journal beside it (its bytes on disk may not be its committed state).
+void check_vlen_references(hid_t dset, hid_t file_space, const std::string& path, const std::string& what);
 
 }  // namespace ks::store::detail
