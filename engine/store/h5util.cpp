@@ -8,6 +8,7 @@
 #include <cstring>
 #include <unordered_set>
 
+#include "store/checked_read_vfd.hpp"
 #include "store/label_columns.hpp"
 
 namespace ks::store {
@@ -99,6 +100,7 @@ std::vector<std::string> read_vlen_strings(hid_t dset, hid_t mem_space, hid_t fi
   check(H5Pset_vlen_mem_manager(xfer, vlen_alloc, &blocks, vlen_free, &blocks), path, what);
   Hid type(utf8_vlen_type());
   std::vector<char*> ptrs(n, nullptr);
+  check_vlen_references(dset, file_space, path, what);  // HDF5 1.10 trusts them
   check(H5Dread(dset, type, mem_space, file_space, xfer, ptrs.data()), path, what);
   out.reserve(n);
   for (char* p : ptrs) out.emplace_back(p ? p : "");

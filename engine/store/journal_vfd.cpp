@@ -10,6 +10,7 @@
 // after it is replayed by the next writer's open (idempotent) once it has checked that the journal
 // belongs to the file as it is. The journal's layout, recovery and the readers' consistency stamp:
 // journal_format.cpp; the writer lock: journal_lock.cpp.
+#include "store/checked_read_vfd.hpp"
 #include "store/journal_vfd.hpp"
 
 #include <fcntl.h>
@@ -349,9 +350,19 @@ herr_t j_set_eoa(H5FD_t* file, H5FD_mem_t, haddr_t addr) { reinterpret_cast<JFil
 haddr_t j_get_eof(const H5FD_t* file, H5FD_mem_t) { return reinterpret_cast<const JFile*>(file)->eof; }
 herr_t j_get_handle(H5FD_t* file, hid_t, void** handle) { *handle = &reinterpret_cast<JFile*>(file)->fd; return 0; }
 
-herr_t j_read(H5FD_t* file, H5FD_mem_t, hid_t, haddr_t addr, size_t size, void* buffer) {
-  auto* f = reinterpret_cast<JFile*>(file);
+herr_t j_read_pages(JFile* f, haddr_t addr, size_t size, unsigned char* out);
+
+herr_t j_read(H5FD_t* file, H5FD_mem_t type, hid_t, haddr_t addr, size_t size, void* buffer) {
   auto* out = static_cast<unsigned char*>(buffer);
+  if (j_read_pages(reinterpret_cast<JFile*>(file), addr, size, out) < 0) return -1;
+  // A global heap collection read whole is checked before HDF5 parses it (checked_read_vfd.hpp).
+  auto* f = reinterpret_cast<JFile*>(file);
+  const auto read = [f](unsigned char* to, std::size_t n, std::uint64_t at) { return j_read_pages(f, at, n, to) == 0; };
+  const bool heap = type == H5FD_MEM_GHEAP || type == H5FD_MEM_DRAW;  // HDF5 reads global heaps as raw data
+  return heap && !global_heap_collection_is_sound(out, size, addr, std::max<std::uint64_t>(f->eof, f->committed), read) ? -1 : 0;
+}
+
+herr_t j_read_pages(JFile* f, haddr_t addr, size_t size, unsigned char* out) {
   std::uint64_t a = addr;
   if (!f->gathered.empty() && addr + size > f->gathered_at && addr < f->gathered_at + f->gathered.size() &&
       !write_gathered(f)) {

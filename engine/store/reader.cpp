@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "store/checked_read_vfd.hpp"
 #include "store/h5util.hpp"
 #include "store/journal_vfd.hpp"
 #include "store/reader_impl.hpp"
@@ -56,6 +57,15 @@ void ResultsReader::Impl::load() {
   }
 }
 
+namespace {
+/// True when `before`, the consistency stamp taken before a failed open, is that of a file without a
+/// journal (no writer) and the file is still as it was: the failure is the file's, not a writer's commit
+/// landing under the read.
+bool unchanged_without_writer(const std::string& path, const std::string& before) {
+  return before.rfind("static:", 0) == 0 && consistency_stamp(path) == before;
+}
+}  // namespace
+
 ResultsReader::ResultsReader(const std::string& path, V1ColumnRoles v1_roles) : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
   impl_->v1_roles = std::move(v1_roles);
@@ -84,11 +94,12 @@ void ResultsReader::refresh() {
       if (consistency_stamp(path) == before) throw StoreError(path, "not read: " + last);
       continue;  // a live writer moved on meanwhile
     }
-    Hid fapl(view.kind == ReadView::overlay ? make_journal_read_fapl() : H5Pcreate(H5P_FILE_ACCESS));
+    Hid fapl(view.kind == ReadView::overlay ? make_journal_read_fapl() : make_checked_read_fapl());
     hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, fapl);
     if (f < 0) {
       last = h5_error_text();
       if (view.kind == ReadView::overlay && !journal_last_error().empty()) last = journal_last_error();
+      if (unchanged_without_writer(path, before)) break;  // a damaged file: reading again cannot cure it
       continue;
     }
     impl_->file = Hid(f);
@@ -103,6 +114,7 @@ void ResultsReader::refresh() {
       if (e.cause().rfind("not a kinesweep", 0) == 0 || e.cause().rfind("unsupported", 0) == 0 ||
           e.cause().rfind(kBadColumnAttribute, 0) == 0)
         throw;  // re-reading cannot cure these
+      if (unchanged_without_writer(path, before)) break;
       continue;
     }
     impl_->stamp = before;
