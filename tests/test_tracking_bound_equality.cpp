@@ -20,7 +20,7 @@ using namespace ks;
 namespace {
 
 SampleValues<double> one_sample(const double* zeros, double err2) {
-  return SampleValues<double>{3, zeros, zeros, zeros, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, err2, 0.0, 0.0};
+  return SampleValues<double>{3, zeros, zeros, zeros, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, err2, 0.0, 0.0, 0.0};
 }
 
 double below(double x) { return std::nextafter(x, 0.0); }
