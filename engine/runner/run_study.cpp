@@ -10,9 +10,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <stdexcept>
 #include <optional>
 #include <ostream>
+#include <stdexcept>
 
 #include "common/shell_word.hpp"
 #include "runner/optimize_blocks.hpp"
@@ -250,6 +250,14 @@ OpenedResults open_results(const Study& study, const StudySchema& schema, const 
   OpenedResults r;
   r.histories = histories;
   if (resume && fs::exists(out)) {
+    // a file of other columns is refused before the writer opens it (which writes to it); a file the
+    // reader cannot open (one a journal must recover first) is checked once the writer has it
+    std::optional<std::vector<ColumnSpec>> readable;
+    try {
+      readable = store::ResultsReader(out).columns();
+    } catch (const std::exception&) {
+    }
+    if (readable) require_same_columns(out, *readable, schema);
     r.writer = std::move(store::ResultsWriter::open_for_resume(out, study.sha256, so).writer);
     r.histories = resume_histories(out, r.writer->recorded_histories(), histories, adopt_recorded);
     if (const std::string why = history_memory_problem(study, r.histories); !why.empty())

@@ -294,10 +294,10 @@ class Install(unittest.TestCase):
         ks = os.path.join(PREFIX, "bin", "kinesweep")
         self.assertEqual(self.complete(ks, "qu"), ["query"])
         self.assertEqual(sorted(self.complete(ks, "")),
-                         sorted(["run", "info", "query", "sensitivity", "schema", "robot", "table4", "--version",
-                                 "-h", "--help"]))
+                         sorted(["run", "info", "query", "sensitivity", "compare", "schema", "robot", "table4",
+                                 "--version", "-h", "--help"]))
         # Each subcommand's options are those its --help lists.
-        for sub in ("run", "info", "query", "schema", "robot", "sensitivity", "table4"):
+        for sub in ("run", "info", "query", "schema", "robot", "sensitivity", "compare", "table4"):
             helptext = run([ks, sub, "--help"]).stdout
             listed = set(re.findall(r"(?<![\w-])(--?[a-zA-Z][\w-]*)", helptext.split("Options:", 1)[-1]))
             offered = set(self.complete(ks, sub, "-"))
