@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <stdexcept>
 #include <vector>
 
@@ -52,6 +53,37 @@ TEST(KktResidual, NonFiniteIsNaN) {
   const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
   EXPECT_TRUE(std::isnan(kkt_residual({nan, 1.0}, {}, 0)));
   EXPECT_TRUE(std::isnan(kkt_residual({1.0, 1.0}, {inf, 0.0}, 1)));
+}
+
+TEST(KktResidual, RandomRowsOfEveryScaleStayFiniteAndNoWorseThanNoMultiplier) {
+  // property: lambda = 0 is feasible, so the least-squares residual |grad + jac^T lambda|_2 is at most
+  // |grad|_2 (and the inf-norm returned at most that); rows duplicated, opposed, zero or scaled by
+  // 1e-9 .. 1e9 (as the windowed limit and conditioning rows of a chain's optimum are) drive the
+  // active set through every multiplier dropping back to zero
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), e(-9.0, 9.0);
+  std::uniform_int_distribution<int> size(1, 6), kind(0, 5);
+  for (int trial = 0; trial < 20000; ++trial) {
+    const int n = size(rng), m = size(rng) + 2;
+    std::vector<double> g(n), jac(static_cast<std::size_t>(n * m));
+    double g2 = 0.0;
+    for (double& v : g) v = u(rng) * std::pow(10.0, e(rng)), g2 += v * v;
+    for (int row = 0; row < m; ++row) {
+      const int k = kind(rng);
+      const double scale = std::pow(10.0, e(rng));
+      for (int c = 0; c < n; ++c) {
+        double& v = jac[static_cast<std::size_t>(row * n + c)];
+        if (k == 0) v = 0.0;
+        else if (k == 1 && row > 0) v = 2.0 * jac[static_cast<std::size_t>((row - 1) * n + c)];
+        else if (k == 2 && row > 0) v = -jac[static_cast<std::size_t>((row - 1) * n + c)];
+        else if (k == 3) v = -g[c] * scale;
+        else v = u(rng) * scale;
+      }
+    }
+    const double r = kkt_residual(g, jac, static_cast<std::size_t>(m));
+    ASSERT_TRUE(std::isfinite(r)) << "trial " << trial;
+    ASSERT_LE(r, std::sqrt(g2) * (1.0 + 1e-9) + 1e-300) << "trial " << trial;
+  }
 }
 
 TEST(KktResidual, JacobianOfTheWrongSizeIsRefused) {

@@ -40,6 +40,7 @@ double kkt_residual(const std::vector<double>& grad, const std::vector<double>& 
       std::vector<Eigen::Index> P;
       for (Eigen::Index j = 0; j < m; ++j)
         if (passive[j]) P.push_back(j);
+      if (P.empty()) break;  // every multiplier dropped back to zero
       Eigen::MatrixXd AP(n, static_cast<Eigen::Index>(P.size()));
       for (std::size_t k = 0; k < P.size(); ++k) AP.col(static_cast<Eigen::Index>(k)) = A.col(P[k]);
       const Eigen::VectorXd zP = AP.colPivHouseholderQr().solve(g);
