@@ -51,7 +51,8 @@ SweepResult merge(const Study& study, const StudySchema& schema, const RunReques
   store::StoreOptions so;
   so.flush_every_runs = 0;
   so.flush_every_seconds = 30.0;
-  OpenedResults opened = open_results(study, schema, out, true, so, histories, false);
+  so.overwrite = run.overwrite;  // written aside: the previous file is replaced at the first commit
+  OpenedResults opened = open_results(study, schema, out, !run.overwrite, so, histories, false);
   std::unique_ptr<store::ResultsWriter> writer = std::move(opened.writer);
   PreviousRuns all;
   if (opened.previous) all = std::move(*opened.previous);
@@ -255,8 +256,7 @@ class MpiBackend final : public SweepBackend {
     if (msg.empty() && !shards.empty())
       msg = refuse_existing(out, true, "has shards of an unfinished distributed run (" + shards.front() + ")", run);
     if (!msg.empty()) return 1;
-    if (run.overwrite) {
-      if (exists) store::remove_results_file(out);
+    if (run.overwrite) {  // the previous file stays until the merge's first commit replaces it
       for (const auto& s : shards) store::remove_results_file(s);
     } else if (run.resume) {
       std::vector<std::string> files = shards;

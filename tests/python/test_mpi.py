@@ -270,6 +270,39 @@ class ResumeAdoptsRecordedHistories(Base):
         self.assertSameFile(self.ref, out)
         self.assertEqual(glob.glob(out + ".rank*"), [])
 
+    def test_overwrite_killed_during_the_sweep_keeps_the_previous_file(self):
+        # --overwrite under mpirun writes the merged file aside: a job killed before its merge leaves
+        # the previous file byte for byte; a complete one replaces it
+        small, other = self.write("small.toml", SWEEP), self.write("long.toml", LONG)
+        out = os.path.join(self.dir, "kept.h5")
+        self.assertEqual(run("run", small, "-o", out, "-q").returncode, 0)
+        with open(out, "rb") as f:
+            before = hashlib.sha256(f.read()).hexdigest()
+        p = subprocess.Popen([*MPIRUN, KS, "run", other, "-o", out, "-q", "--threads", "1", "--overwrite"],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        victim, deadline = None, time.time() + 60
+        while time.time() < deadline and p.poll() is None:
+            victim = rank_pid(p.pid, 1)
+            if victim and os.path.exists(out + ".rank1.h5"):
+                break
+            time.sleep(0.05)
+        self.assertIsNotNone(victim, "rank 1 not found")
+        self.assertIsNone(p.poll(), "the job finished before the kill: make LONG longer")
+        os.kill(victim, signal.SIGKILL)
+        try:
+            p.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.wait()
+        self.assertNotEqual(p.returncode, 0)
+        with open(out, "rb") as f:
+            self.assertEqual(hashlib.sha256(f.read()).hexdigest(), before)
+        r = mpirun("run", other, "-o", out, "-q", "--threads", "1", "--overwrite")
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        with h5py.File(out, "r") as f:
+            self.assertEqual(f.attrs["study_name"], "mpi_kill")
+        self.assertEqual(glob.glob(out + ".rank*"), [])
+
     def test_a_file_begun_by_one_process(self):
         out = os.path.join(self.dir, "local.h5")
         p = subprocess.Popen([KS, "run", self.study, "-o", out, "-q", "--threads", "1", "--histories", "every=3"],
