@@ -14,7 +14,7 @@ that the page stays small (the captions say where).
 
     python3 -m kinesweep.report results/examples_landscape.h5 -o report.html
 
-Open a single section with report.html#only=SECTION (study, status, best, landscapes, basins,
+Open a single section with report.html#only=SECTION (study, status, best, verdicts, landscapes, basins,
 samples, sensitivity, importance, histories, optimizations).
 """
 import argparse
@@ -28,7 +28,8 @@ from kinesweep.report_basins import basins_figure  # noqa: E402
 from kinesweep.report_grids import landscape_figure  # noqa: E402
 from kinesweep.report_page import esc, figure, page  # noqa: E402
 from kinesweep.report_samples import sampled_section  # noqa: E402
-from kinesweep.report_tables import RunsView, best_section, metadata_section, status_section  # noqa: E402
+from kinesweep.report_tables import (RunsView, best_section, metadata_section, status_section,  # noqa: E402
+                                     verdicts_section)
 from kinesweep.report_traces import best_with_history, history_figure, history_ids, optimization_figure  # noqa: E402
 
 CELL_BUDGET = 40000   # heatmap cells over all landscape and basin figures (about 40 bytes each, compressed)
@@ -300,6 +301,9 @@ def build(path, best=5, max_cells=CELL_BUDGET, title=None):
         b = best_section(view, best)
         if b:
             sections.append(("best", "Best runs per block", b))
+        verdicts = verdicts_section(res)
+        if verdicts:
+            sections.append(("verdicts", "Verdicts, like for like", verdicts))
         land, basins, sampled = grid_sections(res, max_cells)
         if land:
             sections.append(("landscapes", "Landscapes", land))

@@ -213,3 +213,31 @@ def best_section(view, n_best):
                          c for c in varying if view.is_text(c))) if len(top) else "")
                      + f'<p class="caption">{cap}</p>')
     return "".join(parts)
+
+
+def verdicts_section(res):
+    """`kinesweep compare`'s verdict table (kinesweep.compare.compare: the best good run per method,
+    per end condition and metric, its GCI and its margin to the next method) for the files whose
+    best runs were verified against their grid (a /verification group); "" otherwise."""
+    from kinesweep.compare import compare
+    if "verification" not in res.f:
+        return ""
+    metrics = [m for m in ("E", "torque_sq_integral") if m in res.columns()]
+    try:
+        rows = compare(res, metrics=metrics or None)
+    except KeyError:
+        return ""
+    if not rows:
+        return ""
+    keys = ["kind", "end", "metric", "unit", "rank", "method", "run", "value", "grid", "gci", "uncertainty",
+            "next", "margin", "margin_uncertainty", "verdict"]
+    keys = [k for k in keys if k in rows[0]]
+    columns = [(k if k != "gci" else "gci", "%" if k == "gci" else "") for k in keys]
+    body = [[r[k] if r[k] is not None else float("nan") for k in keys] for r in rows]
+    text = ("kind", "end", "metric", "unit", "method", "grid", "next", "verdict")
+    return table(columns, body, "verdict-table", text_columns=text) + (
+        '<p class="caption">Like for like (<code>kinesweep compare</code>): per end condition (at rest, free) and '
+        "metric, the best run of a good status of each method; grid: how its value behaves at dt/2, dt/4 (and 2K, "
+        "4K knots); gci: Roache's grid convergence index of the value; margin: to the next method, with the sum of "
+        "both uncertainties (GCI x value). A verdict holds over these runs, this end condition and this metric "
+        "only.</p>")

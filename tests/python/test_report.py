@@ -95,10 +95,10 @@ k = { saltelli = { from = 0, to = 0.2 } }
 K_N = { saltelli = { from = 5, to = 40 } }
 """
 
-SECTIONS = {"trajectory": ["study", "status", "best", "landscapes", "histories"],
+SECTIONS = {"trajectory": ["study", "status", "best", "verdicts", "landscapes", "histories"],
             "basins": ["study", "status", "best", "landscapes", "basins", "importance", "histories"],
-            "optimize": ["study", "status", "best", "landscapes", "optimizations"],
-            "sampled": ["study", "status", "best", "landscapes", "samples", "sensitivity", "importance"]}
+            "optimize": ["study", "status", "best", "verdicts", "landscapes", "optimizations"],
+            "sampled": ["study", "status", "best", "verdicts", "landscapes", "samples", "sensitivity", "importance"]}
 GOOD = {"trajectory": ("ok", ["E"]), "ik": ("converged", ["iterations", "error"])}
 
 
@@ -302,6 +302,27 @@ max_evaluations = 3
         for name in self.pages:
             self.check_status_table(self.pages[name], self.h5[name])
 
+    def test_verdicts_equal_kinesweep_compare(self):
+        # the report's verdict table is the engine's `kinesweep compare` (its JSON), cell for cell
+        p = self.pages["trajectory"]
+        self.assertIn("verdicts", p.sections)
+        t = p.tables["verdict-table"]
+        r = subprocess.run([KS, "compare", self.h5["trajectory"], "--format", "json", "--metric", "E", "--metric",
+                            "torque_sq_integral"], capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        want = json.loads(r.stdout)["rows"]
+        self.assertEqual(len(t["rows"]), len(want))
+        self.assertGreater(len(want), 0)
+        for got, row in zip(t["rows"], want):
+            for col, cell in zip(t["columns"], got):
+                v = row[col]
+                if isinstance(v, str):
+                    self.assertEqual(cell, v, col)
+                elif v is None:
+                    self.assertTrue(math.isnan(float(cell)), col)
+                else:
+                    self.assertEqual(float(cell), float(v), col)
+
     def test_best_rows_equal_h5py(self):
         for name, p in self.pages.items():
             with h5py.File(self.h5[name], "r") as f:
@@ -381,6 +402,7 @@ max_evaluations = 3
             d[1::3] = 0
             done[...] = d
             del f["landscapes"]
+            del f["verification"]  # (written when the sweep ends)
         with open(self.report(part), encoding="utf-8") as f:
             p = Page(f.read())
         self.assertEqual(p.sections, ["study", "status", "best", "histories"])
