@@ -2,7 +2,10 @@
 results files the regression test wrote (its work dir), each `ok` trajectory run stays within its
 own tracking bound (and orientation bound where the task has one) and within its robot's joint
 limits (every limit ratio <= 1 where the robot has limits); seed 000's Table 4 runs all stay `ok`;
-with closed-loop gains the 5R study keeps >= 90 % of its runs `ok` within 1 mm of the path.
+with closed-loop gains the 5R study keeps >= 90 % of its runs `ok` within 1 mm of the path; no `ok`
+global_spline run of any shipped study departs between its samples: its dense E (dt/16) within
+verify_tolerance of its stored E, its dense peak torque not above its stored one by more, and every
+run that does depart is `undersampled`.
 
 usage: /usr/bin/python3 test_trusted_runs.py RESULTS_DIR
 """
@@ -59,6 +62,27 @@ class TrustedRuns(unittest.TestCase):
                     self.assertTrue(np.all(runs["max_tracking_error"][off] > runs["tracking_bound"][off]), name)
                 checked += int(ok.sum())
         self.assertGreater(checked, 1000)
+
+    def test_no_ok_global_run_departs_between_its_samples(self):
+        checked = 0
+        for path in self.files():
+            runs = trajectory_runs(path)
+            if runs is None or "dense_E" not in runs:
+                continue
+            name = os.path.basename(path)
+            glob = runs["method"] == "global_spline"
+            dense = glob & ~np.isnan(runs["dense_E"].astype(float))
+            ok = dense & (runs["status"] == "ok")
+            tol = runs["verify_tolerance"].astype(float)
+            with self.subTest(study=name):
+                E, dE = runs["E"][ok], runs["dense_E"][ok]
+                self.assertTrue(np.all(np.abs(dE - E) <= tol[ok] * E), name)
+                tau, dtau = runs["tau_inf"][ok], runs["dense_tau_inf"][ok]
+                self.assertTrue(np.all(dtau <= tau * (1 + tol[ok])), name)
+                departs = dense & (runs["dense_departure"] > tol)
+                self.assertTrue(np.all(runs["status"][departs] != "ok"), name)
+                checked += int(ok.sum())
+        self.assertGreater(checked, 20)
 
     def test_table4_runs_stay_ok(self):
         runs = trajectory_runs(os.path.join(RESULTS, "thesis_table4.h5"))
