@@ -22,14 +22,6 @@
 
 namespace ks {
 
-UrdfError::UrdfError(std::string file_, int line_, std::string message_, int column_)
-    : std::runtime_error(file_ + (line_ > 0 ? ":" + std::to_string(line_) : std::string()) +
-                         (line_ > 0 && column_ > 0 ? ":" + std::to_string(column_) : std::string()) + ": " + message_),
-      file(std::move(file_)),
-      line(line_),
-      message(std::move(message_)),
-      column(column_) {}
-
 namespace {
 
 using V3 = Eigen::Vector3d;

@@ -8,18 +8,9 @@
 #include <string_view>
 
 #include "model/chain.hpp"
+#include "robot/urdf_error.hpp"
 
 namespace ks {
-
-/// A URDF file that cannot be read or does not describe a chain the engine can simulate.
-struct UrdfError : std::runtime_error {
-  std::string file;     ///< the file (or the name given to parse_urdf)
-  int line = 0;         ///< 1-based line of the element at fault; 0 when unknown
-  std::string message;  ///< what is wrong, without the location
-  int column = 0;       ///< 1-based column (characters) on that line; 0 when unknown
-  /// what(): "file:line:column: message", the line and column when known.
-  UrdfError(std::string file, int line, std::string message, int column = 0);
-};
 
 /// The chain from `base_link` to `tip_link` of the URDF text.
 ///  - revolute and prismatic joints become chain joints (limits from <limit>; a lower or upper the

@@ -15,7 +15,7 @@
 #include <string_view>
 #include <vector>
 
-#include "robot/urdf.hpp"
+#include "robot/urdf_error.hpp"
 
 namespace ks::urdf_check {
 

@@ -10,7 +10,7 @@ namespace ks::urdf_check {
 /// Elements nested deeper than this are refused before any XML parser reads the text.
 inline constexpr int kMaxElementDepth = 256;
 
-/// Throws UrdfError (robot/urdf.hpp) at the line of the element at fault:
+/// Throws UrdfError (robot/urdf_error.hpp) at the line of the element at fault:
 ///  - an element nested more than kMaxElementDepth deep (at its line and column; checked first, by
 ///    a scan of the markup, so that no parser recurses that deep);
 ///  - the text is not well-formed XML (tinyxml, the parser urdfdom uses);

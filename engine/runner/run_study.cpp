@@ -19,7 +19,7 @@
 #include "runner/resume_edited.hpp"
 #include "runner/dry_run.hpp"
 #include "runner/sweep_backend.hpp"
-#include "verify/gci_best.hpp"
+#include "runner/verify_best.hpp"
 
 namespace ks {
 

@@ -23,7 +23,7 @@ struct RunRequest {
   /// and a plain resume takes the policy the file records instead.
   bool histories_given = false;
   /// After the sweep and the optimisation blocks: verify each trajectory block's best runs of each
-  /// method against its grid (verify/gci_best.hpp) into /verification, and print it.
+  /// method against its grid (runner/verify_best.hpp) into /verification, and print it.
   bool verify_best = true;
   /// threads (per process or rank; 0: all cores, shared fairly between the ranks on a node),
   /// histories, compression, stop (e.g. set by SIGINT), on_progress (the whole job's progress).

@@ -1,5 +1,5 @@
-// The best runs of a results file against their grid (see gci_best.hpp).
-#include "verify/gci_best.hpp"
+// The best runs of a results file against their grid (runner/verify_best.hpp).
+#include "runner/verify_best.hpp"
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
