@@ -12,7 +12,7 @@
 
 #include "cli/query_util.hpp"
 #include "schema/params.hpp"
-#include "verify/gci_best.hpp"
+#include "runner/verify_best.hpp"
 #include "store/store.hpp"
 
 namespace ks::cli {
