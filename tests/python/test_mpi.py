@@ -57,6 +57,21 @@ def descendants(root):
     return out
 
 
+def start_with_rank1(test, study, out, *args):
+    """mpirun of `kinesweep run STUDY -o OUT` (2 ranks, 1 thread each) once rank 1 has made its
+    shard: (the mpirun process, rank 1's pid); the test fails when rank 1 does not show up."""
+    p = subprocess.Popen([*MPIRUN, KS, "run", study, "-o", out, "-q", "--threads", "1", *args],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    victim, deadline = None, time.time() + 60
+    while time.time() < deadline and p.poll() is None:
+        victim = rank_pid(p.pid, 1)
+        if victim and os.path.exists(out + ".rank1.h5"):
+            break
+        time.sleep(0.05)
+    test.assertIsNotNone(victim, "rank 1 not found")
+    return p, victim
+
+
 def rank_pid(mpirun_pid, rank):
     for pid in descendants(mpirun_pid):
         try:
@@ -172,15 +187,7 @@ class KillOneRank(Base):
         ref, out = os.path.join(self.dir, "ref.h5"), os.path.join(self.dir, "killed.h5")
         r = run("run", study, "-o", ref, "-q")
         self.assertEqual(r.returncode, 0, r.stderr)
-        p = subprocess.Popen([*MPIRUN, KS, "run", study, "-o", out, "-q", "--threads", "1"],
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        victim, deadline = None, time.time() + 60
-        while time.time() < deadline and p.poll() is None:
-            victim = rank_pid(p.pid, 1)
-            if victim and os.path.exists(out + ".rank1.h5"):
-                break
-            time.sleep(0.05)
-        self.assertIsNotNone(victim, "rank 1 not found")
+        p, victim = start_with_rank1(self, study, out)
         # let rank 1 commit some runs (shards commit every 512 runs or 2 s): wait until its shard
         # shows done runs (a read that meets a commit under way raises or is retried)
         deadline = time.time() + 120
@@ -278,15 +285,7 @@ class ResumeAdoptsRecordedHistories(Base):
         self.assertEqual(run("run", small, "-o", out, "-q").returncode, 0)
         with open(out, "rb") as f:
             before = hashlib.sha256(f.read()).hexdigest()
-        p = subprocess.Popen([*MPIRUN, KS, "run", other, "-o", out, "-q", "--threads", "1", "--overwrite"],
-                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        victim, deadline = None, time.time() + 60
-        while time.time() < deadline and p.poll() is None:
-            victim = rank_pid(p.pid, 1)
-            if victim and os.path.exists(out + ".rank1.h5"):
-                break
-            time.sleep(0.05)
-        self.assertIsNotNone(victim, "rank 1 not found")
+        p, victim = start_with_rank1(self, other, out, "--overwrite")
         self.assertIsNone(p.poll(), "the job finished before the kill: make LONG longer")
         os.kill(victim, signal.SIGKILL)
         try:
