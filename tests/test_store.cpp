@@ -84,8 +84,9 @@ TEST(StoreEncode, DeflateStreamDecodesToTheRawArray) {
         ASSERT_EQ(back.arrays.size(), h.arrays.size());
         for (std::size_t k = 0; k < h.arrays.size(); ++k) {
           ASSERT_EQ(back.arrays[k].data.size(), h.arrays[k].data.size());
-          if (!h.arrays[k].data.empty())  // memcmp of an empty vector's null data is undefined
+          if (!h.arrays[k].data.empty()) {  // memcmp of an empty vector's null data is undefined
             EXPECT_EQ(0, std::memcmp(back.arrays[k].data.data(), h.arrays[k].data.data(), 8 * h.arrays[k].data.size()));
+          }
         }
       }
   }
