@@ -232,7 +232,7 @@ def verdicts_section(res):
     keys = ["kind", "end", "metric", "unit", "rank", "method", "run", "value", "grid", "gci", "uncertainty",
             "next", "margin", "margin_uncertainty", "verdict"]
     keys = [k for k in keys if k in rows[0]]
-    columns = [(k if k != "gci" else "gci", "%" if k == "gci" else "") for k in keys]
+    columns = [(k, "%" if k == "gci" else "") for k in keys]
     body = [[r[k] if r[k] is not None else float("nan") for k in keys] for r in rows]
     text = ("kind", "end", "metric", "unit", "method", "grid", "next", "verdict")
     return table(columns, body, "verdict-table", text_columns=text) + (
