@@ -7,12 +7,12 @@
 include(CMakePackageConfigHelpers)
 
 set_target_properties(kinesweep_engine PROPERTIES EXPORT_NAME engine)
-foreach(part IN LISTS KS_PARTS ITEMS ks_model)
+foreach(part IN LISTS KS_PARTS ITEMS ks_model ks_hdf5)
   string(REGEX REPLACE "^ks_" "" short ${part})
   set_target_properties(${part} PROPERTIES EXPORT_NAME ${short})
 endforeach()
 install(TARGETS kinesweep RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-install(TARGETS kinesweep_engine ks_model ${KS_PARTS} EXPORT kinesweepTargets
+install(TARGETS kinesweep_engine ks_model ks_hdf5 ${KS_PARTS} EXPORT kinesweepTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/kinesweep
         FILES_MATCHING PATTERN "*.hpp" PATTERN "cli" EXCLUDE PATTERN "package" EXCLUDE)
