@@ -103,6 +103,123 @@ def _grid(rows, run, metric):
     return "converged", gci
 
 
+CHUNK = 1 << 20  # rows read at a time by compare (bounded memory; the result does not depend on it)
+
+
+def _text_codes(d, v):
+    """(codes, labels) of a text column's values `v` read from dataset `d`: enum codes and their labels
+    (a code without one, the missing value, decodes to ""), or, for stored strings, the indices of
+    their decoded texts in a list."""
+    labels = enum_labels(d)
+    if labels is not None:
+        return v.astype(np.int64), labels + [""] * (256 ** d.dtype.itemsize - len(labels))
+    texts, codes = np.unique(text_values(d, v).astype(str), return_inverse=True)
+    return codes, list(texts)
+
+
+def _small_unique(key):
+    """(the distinct values, ascending, and each element's index among them) of non-negative int64
+    codes: by counting when their range is small, else np.unique."""
+    top = int(key.max()) + 1 if len(key) else 1
+    if top > 4 * len(key) + 65536:
+        u, inv = np.unique(key, return_inverse=True)
+        return u, inv.reshape(-1)
+    present = np.flatnonzero(np.bincount(key, minlength=top))
+    lut = np.zeros(top, dtype=np.int64)
+    lut[present] = np.arange(len(present))
+    return present, lut[key]
+
+
+def _best_per_group(r, names, by, wanted, end, where):
+    """{(kind, end condition, metric): {group text: (value, run id)}}: the lowest value (then lowest
+    run id) of each group among the done rows (meeting `where`) of a good status, read CHUNK rows at
+    a time; text is decoded per distinct combination of codes, not per row."""
+    g = r.f["runs"]
+    done = g["done"][()].astype(bool)
+    mask = r._where_rows(where, done, True)
+    kinds = r.run_kinds()
+    row_kinds = None if len(kinds) == 1 else r.row_kinds(done_only=False)
+    good = {k: set(r.kind_meaning(k).get("good_statuses", [])) for k in kinds}
+    text = [c for c in ("status", "method", "spline", "end_state", "end") if c in names]
+    by_text = enum_labels(g[by]) is not None or g[by].dtype.kind in "OSU"
+    best = {}
+    for a in range(0, len(mask), CHUNK):
+        sel = mask[a:a + CHUNK]
+        if not sel.any():
+            continue
+        ids = g["run_id"][a:a + len(sel)][sel].astype(np.int64)
+        kind_names = [kinds[0]] if row_kinds is None else sorted(set(row_kinds[ids].tolist()))
+        kind_code = (np.zeros(len(ids), dtype=np.int64) if row_kinds is None
+                     else np.searchsorted(np.array(kind_names, dtype=object), row_kinds[ids]).astype(np.int64))
+        codes, labels = [kind_code], [kind_names]
+        for c in text:
+            cc, lab = _text_codes(g[c], g[c][a:a + len(sel)][sel])
+            codes.append(cc)
+            labels.append(lab)
+        key = np.zeros(len(ids), dtype=np.int64)
+        sizes = [len(lab) for lab in labels]
+        for cc, size in zip(codes, sizes):
+            key = key * size + cc
+        present, which = _small_unique(key)
+        combos = []
+        for k in present.tolist():
+            combo = []
+            for size in reversed(sizes):
+                k, c = divmod(k, size)
+                combo.append(c)
+            combos.append(combo[::-1])
+        # Each combination of kind and text codes: its end condition, or None when its rows are left out.
+        ends = []
+        for combo in combos:
+            vals = {c: labels[j + 1][combo[j + 1]] for j, c in enumerate(text)}
+            kind = labels[0][combo[0]]
+            if kind not in wanted or vals["status"] not in good.get(kind, ()):
+                ends.append(None)
+                continue
+            e = ""
+            if kind == "trajectory":
+                e = end_condition(vals.get("method", ""), vals.get("spline", ""), vals.get("end_state", ""),
+                                  vals.get("end", ""))
+            if end not in (None, "any") and e != end:
+                ends.append(None)
+                continue
+            ends.append((kind, "any" if end == "any" else e))
+        # The groups: by their text as the CLI writes it (numbers that print alike are one group).
+        raw = g[by][a:a + len(sel)][sel]
+        if by_text:
+            gc, glab = _text_codes(g[by], raw)
+            present = _small_unique(gc)[0]
+            gtext = {int(c): _s(glab[c]) for c in present}
+        else:
+            present, gc = np.unique(raw, return_inverse=True)
+            gtext = {i: _group_text(x) for i, x in enumerate(present)}
+        gnames = sorted(set(gtext.values()))
+        gmap = np.zeros(max(gtext) + 1 if gtext else 1, dtype=np.int64)
+        for c, tx in gtext.items():
+            gmap[c] = gnames.index(tx)
+        group = gmap[gc.reshape(-1)]
+        for (kind, e) in sorted({x for x in ends if x is not None}):
+            rows_ke = np.isin(which, [i for i, x in enumerate(ends) if x == (kind, e)])
+            for m in wanted[kind]:
+                col = g[m][a:a + len(sel)][sel]
+                v = col.astype(float)
+                ok = rows_ke & np.isfinite(v)
+                if col.dtype.kind in "iu":
+                    ok &= col != -1  # the missing value
+                if not ok.any():
+                    continue
+                vi, ii, gi = v[ok], ids[ok], group[ok]
+                order = np.lexsort((ii, vi, gi))
+                first = order[np.r_[True, gi[order][1:] != gi[order][:-1]]]
+                cur = best.setdefault((kind, e, m), {})
+                for j in first:
+                    name, val, run = gnames[gi[j]], float(vi[j]), int(ii[j])
+                    old = cur.get(name)
+                    if old is None or val < old[0] or (val == old[0] and run < old[1]):
+                        cur[name] = (val, run)
+    return best
+
+
 def compare(results, by="method", metrics=None, end=None, where=None):
     """The verdict table (list of dicts, keys: kind, end, metric, unit, rank, <by>, run, value, grid,
     gci [%], uncertainty, next, margin, margin_uncertainty, verdict) of a results file (path or
@@ -126,33 +243,7 @@ def compare(results, by="method", metrics=None, end=None, where=None):
                 raise KeyError(f"{m!r} is not a numeric metric of {kind} runs; expected one of {', '.join(numeric)}")
     needed = ["run_id", "status", by] + [c for c in ("method", "spline", "end_state", "end") if c in columns]
     needed += sorted({m for ms in wanted.values() for m in ms})
-    t = r.runs(columns=list(dict.fromkeys(needed)), where=where)
-    ids = np.asarray(t["run_id"], dtype=np.int64)
-    row_kind = r.row_kinds(done_only=False)[ids]
-    group_text = np.array([_group_text(x) for x in t[by]], dtype=object)
-    best = {}
-    for i in range(len(ids)):
-        kind = row_kind[i]
-        if kind not in wanted:
-            continue
-        if t["status"][i] not in r.kind_meaning(kind).get("good_statuses", []):
-            continue
-        e = ""
-        if kind == "trajectory":
-            e = end_condition(t["method"][i] if "method" in t else "", t["spline"][i] if "spline" in t else "",
-                              t["end_state"][i] if "end_state" in t else "", t["end"][i] if "end" in t else "")
-        if end not in (None, "any") and e != end:
-            continue
-        if end == "any":
-            e = "any"
-        for m in wanted[kind]:
-            v = float(t[m][i])
-            if not math.isfinite(v) or (t[m].dtype.kind in "iu" and v == -1):  # the missing value
-                continue
-            key, g = (kind, e, m), group_text[i]
-            cur = best.setdefault(key, {}).get(g)
-            if cur is None or v < cur[0] or (v == cur[0] and ids[i] < cur[1]):
-                best[key][g] = (v, int(ids[i]))
+    best = _best_per_group(r, list(dict.fromkeys(needed)), by, wanted, end, where)
     rows = verification(r)
     out = []
     for key in sorted(best):
