@@ -74,7 +74,7 @@ def fit_importance(table, params, metric, status=None, good=("ok", "converged"),
     trustworthy (r2 >= POOR_R2), note, encoding ({param: "numeric" | "ordinal: a=0, b=1, ..."}),
     model (its settings) and parameters: one dict per parameter, most important first: name, mean,
     std (over the permutation repeats), fraction, fraction_std."""
-    RandomForestRegressor, sk_permutation_importance, train_test_split = _sklearn()
+    _sklearn()
     params = list(params)
     if not params:
         raise ImportanceError("no parameter to rank (the block sweeps none)")
@@ -106,20 +106,35 @@ def fit_importance(table, params, metric, status=None, good=("ok", "converged"),
     if missing:
         excluded[f"no value of {metric} or a parameter"] = missing
     keep &= finite
-    idx = np.flatnonzero(keep)
-    used = len(idx)
-    subsampled = used > max_rows
-    if subsampled:
-        idx = np.sort(np.random.default_rng(random_state).choice(idx, max_rows, replace=False))
-    out = {"metric": metric, "rows": int(n), "used": int(used), "excluded": excluded,
-           "subsampled": int(len(idx)) if subsampled else None, "encoding": encoding,
-           "model": {"estimator": "RandomForestRegressor", "n_estimators": n_estimators,
-                     "random_state": random_state, "test_fraction": test_fraction, "n_repeats": n_repeats,
-                     "scoring": "R²"}}
+    idx = _subsample(np.flatnonzero(keep), max_rows, random_state)
+    out = _summary(metric, n, int(np.sum(keep)), excluded, idx, encoding, n_estimators, random_state,
+                   test_fraction, n_repeats)
+    return _fit(out, x_all[idx], y_all[idx], params, metric, n_estimators, n_repeats, test_fraction, random_state,
+                min_runs)
+
+
+def _subsample(idx, max_rows, random_state):
+    """The rows used: all of `idx`, or a random max_rows of them (ascending; fixed seed)."""
+    if len(idx) > max_rows:
+        return np.sort(np.random.default_rng(random_state).choice(idx, max_rows, replace=False))
+    return idx
+
+
+def _summary(metric, n, used, excluded, idx, encoding, n_estimators, random_state, test_fraction, n_repeats):
+    return {"metric": metric, "rows": int(n), "used": int(used), "excluded": excluded,
+            "subsampled": int(len(idx)) if used > len(idx) else None, "encoding": encoding,
+            "model": {"estimator": "RandomForestRegressor", "n_estimators": n_estimators,
+                      "random_state": random_state, "test_fraction": test_fraction, "n_repeats": n_repeats,
+                      "scoring": "R²"}}
+
+
+def _fit(out, x, y, params, metric, n_estimators, n_repeats, test_fraction, random_state, min_runs):
+    """The forest and the permutation importances of the rows chosen (x, y), added to `out`."""
+    RandomForestRegressor, sk_permutation_importance, train_test_split = _sklearn()
+    used = out["used"]
     if used < min_runs:
         raise ImportanceError(f"{used} runs with a good status and a value of {metric}; a fit needs at least "
                               f"{min_runs}")
-    x, y = x_all[idx], y_all[idx]
     if np.ptp(y) == 0:
         raise ImportanceError(f"{metric} takes one value ({y[0]:g}) over the {len(y)} good runs: nothing to explain")
     x_tr, x_te, y_tr, y_te = train_test_split(x, y, test_size=test_fraction, random_state=random_state)
@@ -145,6 +160,52 @@ def fit_importance(table, params, metric, status=None, good=("ok", "converged"),
     return out
 
 
+CHUNK = 1 << 20  # rows read at a time from a file (bounded memory; the numbers do not depend on it)
+
+
+def _chunks(d, sel):
+    """(start, values of the selected rows) of dataset `d` over the rows where the bool array `sel`
+    holds, CHUNK rows read at a time."""
+    for a in range(0, len(sel), CHUNK):
+        s = sel[a:a + CHUNK]
+        if s.any():
+            yield a, d[a:a + len(s)][s]
+
+
+def _take(d, rows):
+    """The values of dataset `d` at ascending row indices `rows`, CHUNK rows read at a time."""
+    parts = []
+    for a in range(0, int(rows[-1]) + 1 if len(rows) else 0, CHUNK):
+        lo, hi = np.searchsorted(rows, [a, a + CHUNK])
+        if hi > lo:
+            parts.append(d[a:min(a + CHUNK, len(d))][rows[lo:hi] - a])
+    return np.concatenate(parts) if parts else d[0:0]
+
+
+def _varies_in(d, sel):
+    """Whether dataset `d` takes more than one value over the rows `sel` (NaN is no value; a labelled
+    text column compares its codes), read CHUNK rows at a time."""
+    from kinesweep.kinds import enum_labels
+    if enum_labels(d) is None and d.dtype.kind not in "fiub":
+        return _varies(text_values_of(d)[sel])
+    seen = None
+    for _, v in _chunks(d, sel):
+        if v.dtype.kind == "f":
+            v = v[~np.isnan(v)]
+        if not len(v):
+            continue
+        lo, hi = v.min(), v.max()
+        if lo != hi or (seen is not None and seen != lo):
+            return True
+        seen = lo
+    return False
+
+
+def text_values_of(d):
+    from kinesweep.kinds import text_values
+    return text_values(d)
+
+
 def _varies(v):
     """Whether a column takes more than one value (NaN, a parameter not applying, is no value)."""
     if v.dtype == object:
@@ -154,21 +215,104 @@ def _varies(v):
     return len(np.unique(v)) > 1
 
 
+def _block_mask(res, block):
+    """Which rows of /runs are `block`'s (bool, all rows, done or not): the block column's codes
+    compared, not its decoded text."""
+    from kinesweep.kinds import enum_labels, text_values
+    d = res.f["runs"]["block"]
+    labels = enum_labels(d)
+    if labels is None:
+        return text_values(d) == block
+    if block not in labels:
+        return np.zeros(d.shape[0], dtype=bool)
+    return d[()] == labels.index(block)
+
+
 def _block_rows(res, block):
     """The run kind of `block`, which done rows are its (a bool array over runs()' rows) and how many
     of its rows are not done."""
-    t = res.runs(columns=["block"], done_only=False)
-    mine = t["block"] == block
-    return res._block_kind(block), mine[t["done"]], int(np.sum(mine & ~t["done"]))
+    done = res.f["runs"]["done"][()].astype(bool)
+    mine = _block_mask(res, block)
+    return res._block_kind(block), mine[done], int(np.sum(mine & ~done))
 
 
 def block_parameters(res, block, rows=None):
     """The parameters `block` sweeps: those of its run kind taking more than one value among its done
-    runs, in file order ([] for a block without done runs). Read one column at a time."""
+    runs, in file order ([] for a block without done runs). Read one column at a time, in chunks."""
     kind, inblock, _ = _block_rows(res, block) if rows is None else (res._block_kind(block), rows, 0)
     if not inblock.any():
         return []
-    return [c for c in res.parameters(kind) if _varies(res.runs(columns=[c])[c][inblock])]
+    g = res.f["runs"]
+    sel = np.zeros(g["done"].shape[0], dtype=bool)
+    sel[np.flatnonzero(g["done"][()].astype(bool))[inblock]] = True
+    return [c for c in res.parameters(kind) if _varies_in(g[c], sel)]
+
+
+def _file_rows(res, sel, params, metric, good, max_rows, random_state):
+    """fit_importance's preparation read from the file: the rows `sel` (bool over /runs) of a good
+    status (compared by code) with a finite metric and parameters, counted, and only the subsample
+    used read in full (angles in degrees, as runs(degrees=True)). Returns (out without the fit, x, y),
+    or None when a column is stored as strings (then the caller decodes every row)."""
+    from kinesweep.kinds import _s, enum_labels
+    from kinesweep.read import RAD2DEG
+    g = res.f["runs"]
+
+    def scale(c):
+        return RAD2DEG if _s(g[c].attrs.get("unit", "")) == "rad" else None
+
+    st_d = g["status"]
+    st_labels = enum_labels(st_d)
+    if st_labels is None or any(enum_labels(g[p]) is None and g[p].dtype.kind not in "fiub" for p in params):
+        return None
+    if enum_labels(g[metric]) is not None or g[metric].dtype.kind not in "fiub":
+        raise KeyError(f"{metric!r} is a text column: no importance of it")
+    table = np.array(st_labels + [""] * (256 ** st_d.dtype.itemsize - len(st_labels)), dtype=object)
+    st = np.concatenate([v for _, v in _chunks(st_d, sel)] or [np.zeros(0, dtype=st_d.dtype)]).astype(np.int64)
+    n = len(st)
+    good_code = np.array([x in good for x in table.tolist()])
+    keep = good_code[st]
+    counts = np.bincount(st[~keep], minlength=len(table))
+    excluded = {}
+    for label in sorted({table[c] for c in np.flatnonzero(counts)}):
+        excluded[str(label)] = int(sum(counts[c] for c in np.flatnonzero(counts) if table[c] == label))
+    finite = np.ones(n, dtype=bool)
+    encoding, codes = {}, {}
+    for c in [metric] + list(params):
+        labels = enum_labels(g[c])
+        if labels is not None:  # a text parameter: its codes in sorted order of the values among good rows
+            table_c = labels + [""] * (256 ** g[c].dtype.itemsize - len(labels))
+            v = np.concatenate([x for _, x in _chunks(g[c], sel)]).astype(np.int64)
+            present = np.flatnonzero(np.bincount(v[keep], minlength=len(table_c)))
+            values = sorted({table_c[k] for k in present})
+            code = {x: i for i, x in enumerate(values)}
+            codes[c] = np.array([code.get(x, np.nan) for x in table_c], dtype=float)
+            encoding[c] = "ordinal: " + ", ".join(f"{x}={i}" for x, i in code.items())
+            finite &= np.isfinite(codes[c][v])
+            continue
+        if c != metric:
+            encoding[c] = "numeric"
+        pos = 0
+        for _, v in _chunks(g[c], sel):
+            if v.dtype.kind == "f":
+                finite[pos:pos + len(v)] &= np.isfinite(v)
+            pos += len(v)
+    missing = int(np.sum(keep & ~finite))
+    if missing:
+        excluded[f"no value of {metric} or a parameter"] = missing
+    keep &= finite
+    used = int(np.sum(keep))
+    idx = _subsample(np.flatnonzero(keep), max_rows, random_state)
+    rows = np.flatnonzero(sel)[idx]
+
+    def read(c):
+        v = _take(g[c], rows)
+        if c in codes:
+            return codes[c][v.astype(np.int64)]
+        k = scale(c)
+        return (v * k if k is not None else v).astype(float)
+
+    x = np.column_stack([read(p) for p in params]) if params else np.empty((len(idx), 0))
+    return {"n": n, "used": used, "excluded": excluded, "idx": idx, "encoding": encoding}, x, read(metric)
 
 
 def permutation_importance(results, block=None, metric=None, params=None, **kw):
@@ -203,15 +347,41 @@ def permutation_importance(results, block=None, metric=None, params=None, **kw):
         raise KeyError(f"{metric!r} is not a metric of {kind} runs" + (f"; did you mean '{close}'?" if close else "")
                        + f"; metrics: {', '.join(metrics)}")
     params = block_parameters(res, block, inblock) if params is None else list(params)
-    names = list(dict.fromkeys(["status", metric] + params))
-    runs = res.runs(columns=names, degrees=True)
-    if runs[metric].dtype == object:
-        raise KeyError(f"{metric!r} is a text column: no importance of it")
-    sub = {c: runs[c][inblock] for c in names}
-    out = fit_importance(sub, params, metric, status="status", good=tuple(meaning.get("good_statuses", ["ok"])), **kw)
-    out.update(block=block, kind=kind, unit=runs.units[metric], units={p: runs.units[p] for p in params},
-               not_done=not_done)
+    good = tuple(meaning.get("good_statuses", ["ok"]))
+    g = res.f["runs"]
+    units = {}
+    for c in [metric] + params:
+        u = kswhere_unit(g[c])
+        units[c] = "deg" if u == "rad" else u
+    prepared = None
+    if params and "status" in g:
+        _sklearn()
+        sel = np.zeros(g["done"].shape[0], dtype=bool)
+        sel[np.flatnonzero(g["done"][()].astype(bool))[inblock]] = True
+        prepared = _file_rows(res, sel, params, metric, good, kw.get("max_rows", MAX_ROWS), kw.get("random_state", SEED))
+    if prepared is None:  # strings stored as such (older files): every row decoded
+        names = list(dict.fromkeys(["status", metric] + params))
+        runs = res.runs(columns=names, degrees=True)
+        if runs[metric].dtype == object:
+            raise KeyError(f"{metric!r} is a text column: no importance of it")
+        sub = {c: runs[c][inblock] for c in names}
+        out = fit_importance(sub, params, metric, status="status", good=good, **kw)
+    else:
+        p, x, y = prepared
+        f = dict(n_estimators=N_ESTIMATORS, n_repeats=N_REPEATS, test_fraction=TEST_FRACTION, random_state=SEED,
+                 min_runs=MIN_RUNS)
+        f.update({k: v for k, v in kw.items() if k != "max_rows"})
+        out = _summary(metric, p["n"], p["used"], p["excluded"], p["idx"], p["encoding"], f["n_estimators"],
+                       f["random_state"], f["test_fraction"], f["n_repeats"])
+        out = _fit(out, x, y, params, metric, f["n_estimators"], f["n_repeats"], f["test_fraction"],
+                   f["random_state"], f["min_runs"])
+    out.update(block=block, kind=kind, unit=units[metric], units={p: units[p] for p in params}, not_done=not_done)
     return out
+
+
+def kswhere_unit(d):
+    from kinesweep.kinds import _s
+    return _s(d.attrs.get("unit", ""))
 
 
 def format_table(r):
