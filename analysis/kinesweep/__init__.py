@@ -13,11 +13,11 @@ Submodules (each importable alone):
     solutions   clustering joint vectors into named IK solutions
     compare     `kinesweep compare`'s verdict table (compare) and the /verification table (verification)
     plotting    shared matplotlib helpers of the plot commands
-Commands (`python3 -m kinesweep.NAME --help`; in a source tree, analysis/NAME.py is the same):
+Commands (`python3 -m kinesweep.NAME --help`; in a source tree with analysis/ on PYTHONPATH):
     plot_landscape, plot_histories, plot_cases, plot_basins, plot_convergence, plot_runs,
     compare_landscapes, importance, report, make_examples
-`python3 -m kinesweep` lists them. The former module names (ksread, kswhere, kshistory, kslive,
-kstypes, kssolutions, ksplot) remain importable from analysis/ as aliases of these modules.
+`python3 -m kinesweep` lists them. Old scripts that import the former flat names (ksread, kswhere,
+kshistory, kslive, kstypes, kssolutions, ksplot, plot_landscape, ...) run after `import kinesweep.compat`.
 """
 COMMANDS = ("plot_landscape", "plot_histories", "plot_cases", "plot_basins", "plot_convergence", "plot_runs",
             "compare_landscapes", "importance", "report", "make_examples")

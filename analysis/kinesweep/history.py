@@ -1,5 +1,5 @@
 """The /histories layouts of a results file (engine/store/FORMAT.md). The only module that knows them:
-ksread's Results (has_history, history_arrays, history_ids, history) and the test helpers read
+kinesweep.read's Results (has_history, history_arrays, history_ids, history) and the test helpers read
 histories through Histories. Run with Debian's interpreter: /usr/bin/python3.
 
 format_version 1 and 2: one group per run with a history, /histories/<zero-padded run id>/<array>,

@@ -1,4 +1,4 @@
-"""The plain data types ksread returns: Table (a /runs table or a history), Axis and Landscape (a
+"""The plain data types kinesweep.read returns: Table (a /runs table or a history), Axis and Landscape (a
 block's gridded metrics), with their conversions to pandas and xarray (each an optional dependency,
 imported when asked for), and FormatVersionError (a file of a format_version the readers do not read).
 Run with Debian's interpreter: /usr/bin/python3.

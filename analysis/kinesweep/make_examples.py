@@ -19,7 +19,7 @@ ROOT = os.path.dirname(PACKAGE_PARENT)  # the source tree: studies/, results/exa
 
 # Sweep then polish for Table 4's row 1h on a 0.25 deg x 0.02 landscape near the reach boundary (where
 # the optimum is), with a small GA-like global stage too (the picture shows all three stages):
-# analysis/plot_landscape.py --optimization 1h overlays it. 49 x 26 runs + ~500 evaluations, < 1 s.
+# `python3 -m kinesweep.plot_landscape --optimization 1h` overlays it. 49 x 26 runs + ~500 evaluations, < 1 s.
 OPTIMIZATION_STUDY = """
 [study]
 name = "examples_optimization"
@@ -79,27 +79,27 @@ def main():
                    stdout=subprocess.DEVNULL)
     py = sys.executable
     jobs = [
-        ("plot_landscape.py", h5["examples_landscape"], "landscape_E_weighted.png",
+        ("plot_landscape", h5["examples_landscape"], "landscape_E_weighted.png",
          ["--fix", "method=local_weighted", "--log", "--thesis"]),
-        ("plot_landscape.py", h5["examples_landscape"], "landscape_tau_inf_unweighted.png",
+        ("plot_landscape", h5["examples_landscape"], "landscape_tau_inf_unweighted.png",
          ["--fix", "method=local_unweighted", "--metric", "tau_inf", "--log", "--thesis"]),
-        ("plot_landscape.py", h5["examples_basins"], "landscape_convergence.png",
+        ("plot_landscape", h5["examples_basins"], "landscape_convergence.png",
          ["--metric", "convergence", "--x", "q0_1", "--y", "q0_2", "--levels", "0"]),
-        ("plot_histories.py", h5["thesis_table4"], "histories_1a_1c_1e.png", ["--preset", "1a,1c,1e"]),
-        ("plot_cases.py", h5["thesis_table4"], "cases_E.png", []),
-        ("plot_basins.py", h5["examples_basins"], "basins.png", ["--size", "1200x500"]),
-        ("plot_convergence.py", h5["examples_convergence"], "convergence.png", []),
-        ("plot_landscape.py", h5["examples_optimization"], "landscape_optimization.png",
+        ("plot_histories", h5["thesis_table4"], "histories_1a_1c_1e.png", ["--preset", "1a,1c,1e"]),
+        ("plot_cases", h5["thesis_table4"], "cases_E.png", []),
+        ("plot_basins", h5["examples_basins"], "basins.png", ["--size", "1200x500"]),
+        ("plot_convergence", h5["examples_convergence"], "convergence.png", []),
+        ("plot_landscape", h5["examples_optimization"], "landscape_optimization.png",
          ["--optimization", "1h", "--log"]),
-        ("plot_runs.py", h5["examples_lhs"], "runs_scatter_lhs.png",
+        ("plot_runs", h5["examples_lhs"], "runs_scatter_lhs.png",
          ["--view", "scatter", "--x", "alpha1A", "--y", "k", "--facet", "method", "--size", "1100x500"]),
-        ("plot_runs.py", h5["examples_lhs"], "runs_slice_lambda.png",
+        ("plot_runs", h5["examples_lhs"], "runs_slice_lambda.png",
          ["--view", "slice", "--block", "lm_lambda", "--size", "1100x450"]),
-        ("plot_runs.py", h5["examples_lhs"], "runs_parcoords.png", ["--view", "parcoords"]),
+        ("plot_runs", h5["examples_lhs"], "runs_parcoords.png", ["--view", "parcoords"]),
     ]
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [PACKAGE_PARENT, os.environ.get("PYTHONPATH")])))
-    for script, f, out, extra in jobs:
-        subprocess.run([py, "-m", "kinesweep." + script[:-3], f, "-o", os.path.join(a.out, out), *extra], check=True,
+    for command, f, out, extra in jobs:
+        subprocess.run([py, "-m", "kinesweep." + command, f, "-o", os.path.join(a.out, out), *extra], check=True,
                        env=env)
         shrink(os.path.join(a.out, out))
     return 0

@@ -21,7 +21,7 @@ from kinesweep import read as ksread  # noqa: E402
 DEFAULT_SIZE = "1200x500"  # one row of panels; more rows get more height
 MAX_ROWS = 6  # rows of panels: one per value of a second remaining dim
 SOLUTION_COLOURS = ["#1f77b4", "#2ca02c", "#ff7f0e", "#17becf", "#bcbd22", "#8c564b"]
-# The failed statuses in the colours of every plot and the report (kstypes.STATUS_COLOURS).
+# The failed statuses in the colours of every plot and the report (kinesweep.kinds.STATUS_COLOURS).
 FAIL_COLOURS = dict(ksread.STATUS_COLOURS, **{"converged, other solution": ksread.OTHER_SOLUTION_COLOUR})
 
 

@@ -120,7 +120,7 @@ class Results:
             version = int(self.meta.get("format_version", -1))
             if version not in FORMAT_VERSIONS:
                 engine = self.meta.get("engine_version", "?")
-                what = (f"{path}: results file format v{version} (written by kinesweep {engine}); ksread reads "
+                what = (f"{path}: results file format v{version} (written by kinesweep {engine}); kinesweep.read reads "
                         f"v{min(FORMAT_VERSIONS)} to v{max(FORMAT_VERSIONS)} only")
                 if version < min(FORMAT_VERSIONS):
                     what += (" (v1 files have no role/kinds attributes on their /runs columns). `kinesweep query` "
@@ -187,7 +187,7 @@ class Results:
         """What runs of `kind` mean, as the file records it (/kinds/<kind>): {"statuses": in code
         order, "good_statuses", "ranking": [objective, tie...] (best = lowest among good runs, then
         by run id), "key_metrics", "objectives", "history_arrays", ...}, each a list of str. Files
-        from before /kinds: the engine's declarations (kstypes.KIND_MEANING); {} for an unknown kind."""
+        from before /kinds: the engine's declarations (kinesweep.kinds.KIND_MEANING); {} for an unknown kind."""
         g = self.f.get("kinds")
         if g is not None and kind in g:
             return {k: [_s(x) for x in v] for k, v in g[kind].attrs.items()}

@@ -1,6 +1,6 @@
-"""IK basins for analysis/report.py: each cell of an IK block's grid of initial guesses coloured by the
+"""IK basins for kinesweep.report: each cell of an IK block's grid of initial guesses coloured by the
 solution its run converged to (named as /runs' solution column names them, where the engine names the
-solutions; else the converged final iterates named by kssolutions.cluster_solutions),
+solutions; else the converged final iterates named by kinesweep.solutions.cluster_solutions),
 failed runs in their status colours; hover with the iterations and status. Run with /usr/bin/python3."""
 import numpy as np
 
@@ -55,7 +55,7 @@ def basins_figure(res, ls, cap):
     revolute = [u == "rad" for u in units]
     # The solutions as /runs names them (the engine's index of the known solution reached, as
     # plot_basins shows them); clusters of the final iterates where the engine names none.
-    labels, named_by = None, "named by kssolutions.cluster_solutions"
+    labels, named_by = None, "named by kinesweep.solutions.cluster_solutions"
     if "solution" in ls.metrics:
         s = np.asarray(ls.metrics["solution"], dtype=float).ravel()
         if s.size == len(rows) and np.isfinite(s).any():

@@ -1,4 +1,4 @@
-"""Gridded figures of analysis/report.py: which landscape axes go on x and y, which of the other dims
+"""Gridded figures of kinesweep.report: which landscape axes go on x and y, which of the other dims
 become facets or a dropdown (and which are held at the best cell, said in the caption), subsampling
 of big grids, and the landscape heatmaps (metric colour, failed cells in their status colours, hover
 with the cell's parameters and metrics). Plain plotly dicts. Run with /usr/bin/python3."""

@@ -1,4 +1,4 @@
-"""The HTML of analysis/report.py: the page skeleton (style, table of contents, the script that draws
+"""The HTML of kinesweep.report: the page skeleton (style, table of contents, the script that draws
 the figures and records JavaScript errors), tables and figure placeholders. Plotly's JavaScript is
 embedded (gzip in base64, with each figure's data), so the page works offline. Run with /usr/bin/python3."""
 import html

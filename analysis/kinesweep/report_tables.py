@@ -1,4 +1,4 @@
-"""The tables of analysis/report.py: the file's metadata and run counts, status counts per block, and
+"""The tables of kinesweep.report: the file's metadata and run counts, status counts per block, and
 the best runs of each block (parameters and metrics, units in the headers, angles in degrees).
 Run with /usr/bin/python3."""
 import numpy as np

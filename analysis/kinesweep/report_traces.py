@@ -1,4 +1,4 @@
-"""Line figures of analysis/report.py: the history of each block's best run (joint torques against
+"""Line figures of kinesweep.report: the history of each block's best run (joint torques against
 time; IK: ‖F‖ against iteration) and the optimisation traces (objective against evaluation number by
 stage, best so far). Plain plotly dicts. Run with /usr/bin/python3."""
 import numpy as np

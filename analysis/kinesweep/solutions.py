@@ -1,5 +1,5 @@
 """Naming IK solutions where no closed form is known (chain robots): the engine's cluster_solutions
-(engine/ik/chain_ik.hpp), for the analysis scripts; re-exported by ksread. Run with /usr/bin/python3."""
+(engine/ik/chain_ik.hpp), for the analysis scripts; re-exported by kinesweep.read. Run with /usr/bin/python3."""
 import numpy as np
 
 

@@ -15,7 +15,7 @@ just written, repeated --repeat times (min and median of each):
   info
   pandas  kinesweep.read.open_results(F).to_pandas() (all columns; timed inside the interpreter;
           peak RSS of that interpreter, pandas imported; the frame's bytes)
-  plot    analysis/plot_landscape.py F, and report: analysis/report.py F (wall, peak RSS, output size)
+  plot    python3 -m kinesweep.plot_landscape F, and report: kinesweep.report F (wall, peak RSS, output size)
   merge   (--mpi, trajectory) `mpirun -np 2 kinesweep run` with one thread per rank: the merge time it
           prints against a `cp` of its two shard files (hard-linked as they appear, so the copy reads
           the shards as the merge found them; coreutils' cp copies inside the kernel) and against `dd
@@ -39,6 +39,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ANALYSIS = os.path.join(HERE, "..", "..", "analysis")
+ANALYSIS_ENV = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [ANALYSIS, os.environ.get("PYTHONPATH")])))
 
 TRAJECTORY = """[study]
 name = "scale_trajectory"
@@ -72,12 +73,12 @@ q0_2 = {{ from = -180, to = 180, count = {b} }}
 METRIC = {"trajectory": "E", "ik": "iterations"}
 
 
-def timed(cmd):
+def timed(cmd, env=None):
     """(wall seconds, peak RSS bytes) of a command; its output discarded. The peak is GNU time's
     (the rusage of a child forked from this interpreter would count the interpreter's pages)."""
     t0 = time.perf_counter()
     p = subprocess.run(["/usr/bin/time", "-f", "%M", *cmd], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                       text=True)
+                       text=True, env=env)
     seconds = time.perf_counter() - t0
     if p.returncode != 0:
         raise SystemExit(f"failed: {' '.join(cmd)}\n{p.stderr}")
@@ -243,11 +244,11 @@ def main():
                 t, r = timed([sys.executable, "-c", PANDAS, out])
                 rss.append(r)
                 report("pandas", ours, base, rss, f"   frame {frame / 1e6:.0f} MB (peak/frame {max(rss) / frame:.2f})")
-                for name, script in (("plot", "plot_landscape.py"), ("report", "report.py")):
+                for name, command in (("plot", "plot_landscape"), ("report", "report")):
                     ours, rss = [], []
                     page = out + "." + name + (".png" if name == "plot" else ".html")
                     for _ in range(args.repeat):
-                        t, r = timed([sys.executable, os.path.join(ANALYSIS, script), out, "-o", page])
+                        t, r = timed([sys.executable, "-m", "kinesweep." + command, out, "-o", page], env=ANALYSIS_ENV)
                         ours.append(t)
                         rss.append(r)
                     mn, md = stats(ours)

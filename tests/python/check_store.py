@@ -23,7 +23,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
-from kslive import stamp  # noqa: E402  FORMAT.md, "Reading while a sweep runs"
+from kinesweep.live import stamp  # noqa: E402  FORMAT.md, "Reading while a sweep runs"
 from kinesweep.kinds import enum_labels, text_values  # noqa: E402
 
 FORMAT_VERSION = 5

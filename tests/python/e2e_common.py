@@ -10,8 +10,9 @@ import unittest
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
-from kshistory import Histories, group_name  # noqa: E402  the /histories layouts (format_version 1 to 4)
+ANALYSIS = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
+sys.path.insert(0, ANALYSIS)
+from kinesweep.history import Histories, group_name  # noqa: E402  the /histories layouts (format_version 1 to 4)
 from kinesweep.kinds import enum_labels, text_values  # noqa: E402  /runs text columns (FORMAT.md, "/runs")
 
 # A trajectory landscape (561 runs) and an IK basin (441 runs): about a second on 2 cores.
@@ -188,15 +189,25 @@ def shipped_results(test, directory):
     return found
 
 
+def analysis_command(name, *args):
+    """The command line of `python3 -m kinesweep.NAME ARGS...` under this interpreter (Debian's); run it
+    with env=ANALYSIS_ENV."""
+    return [sys.executable, "-m", "kinesweep." + name, *args]
+
+
+# The environment of analysis_command: analysis/ first on PYTHONPATH (the source tree's package).
+ANALYSIS_ENV = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [ANALYSIS, os.environ.get("PYTHONPATH")])))
+
+
 def report_page(test, results, directory):
-    """analysis/report.py on `results` (the test fails unless it exits 0): the page's html and its
+    """kinesweep.report on `results` (the test fails unless it exits 0): the page's html and its
     figures' data islands, id -> the JSON text (gzip and base64 undone)."""
     import base64
     import gzip
     import re
     page = os.path.join(directory, "report.html")
-    script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis", "report.py")
-    r = subprocess.run(["/usr/bin/python3", script, results, "-o", page], capture_output=True, text=True, timeout=300)
+    r = subprocess.run(analysis_command("report", results, "-o", page), env=ANALYSIS_ENV, capture_output=True,
+                       text=True, timeout=300)
     test.assertEqual(r.returncode, 0, r.stderr)
     with open(page, encoding="utf-8") as fh:
         html = fh.read()

@@ -19,7 +19,7 @@ Items (one manifest entry each, with the dtype class f/i/s and the shape or row 
   hashed.
 --record writes MANIFEST; otherwise the hashes are compared with it, every mismatch, missing or extra
 item is printed, and the exit status is 1 if there is any. Only the storage-specific reading lives in
-decode_text() and history_arrays() (which reads through analysis/kshistory.py, the one reader of the
+decode_text() and history_arrays() (which reads through kinesweep.history, the one reader of the
 /histories layouts): adapt those when the file format changes.
 """
 import argparse
@@ -37,7 +37,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
-from kshistory import Histories  # noqa: E402  the /histories layouts of format_version 1 to 3
+from kinesweep.history import Histories  # noqa: E402  the /histories layouts of format_version 1 to 3
 
 # --histories per study; every other study runs with "none".
 FULL_HISTORIES = {"thesis_table4", "ik_scara", "examples_convergence"}

@@ -1,4 +1,4 @@
-"""End-to-end tests of analysis/: run the engine on small studies, then every plot script on the
+"""End-to-end tests of analysis/: run the engine on small studies, then every plot command on the
 output; the PNG exists, has the requested size, is not blank, and the numbers the script plotted
 (--print-data) equal the file's as read here with h5py.
 
@@ -17,6 +17,7 @@ import h5py
 import numpy as np
 
 from e2e_common import OPTIMIZE as OPTIMIZE_COMMON, axis_dataset_name, history, runs_column
+from e2e_common import ANALYSIS_ENV, analysis_command
 
 KS = None
 ROOT = None
@@ -91,11 +92,10 @@ class AnalysisTest(unittest.TestCase):
     def tearDownClass(cls):
         cls.tmp.cleanup()
 
-    def plot(self, script, h5, *extra, size=(640, 480)):
-        png = os.path.join(self.tmp.name, f"{script}_{abs(hash(extra))}.png")
-        r = subprocess.run([sys.executable, os.path.join(ROOT, "analysis", script), h5, "-o", png,
-                            "--size", f"{size[0]}x{size[1]}", "--print-data", *extra],
-                           capture_output=True, text=True)
+    def plot(self, command, h5, *extra, size=(640, 480)):
+        png = os.path.join(self.tmp.name, f"{command}_{abs(hash(extra))}.png")
+        r = subprocess.run(analysis_command(command, h5, "-o", png, "--size", f"{size[0]}x{size[1]}", "--print-data",
+                                            *extra), capture_output=True, text=True, env=ANALYSIS_ENV)
         self.assertEqual(r.returncode, 0, r.stderr)
         self.check_png(png, size)
         return json.loads(r.stdout)
@@ -114,7 +114,7 @@ class AnalysisTest(unittest.TestCase):
 
     # -------------------------------------------------------------------------------------------
     def test_landscape_fixed_method(self):
-        d = self.plot("plot_landscape.py", self.files["landscape"], "--fix", "method=local_unweighted", "--thesis")
+        d = self.plot("plot_landscape", self.files["landscape"], "--fix", "method=local_unweighted", "--thesis")
         with h5py.File(self.files["landscape"], "r") as f:
             g = f["landscapes"]["local"]
             self.assertEqual([h5str(x) for x in g.attrs["axes"]], ["method", "alpha1A", "k"])
@@ -135,7 +135,7 @@ class AnalysisTest(unittest.TestCase):
         self.assertEqual(d["thesis"][0]["case"], "2h")
 
     def test_landscape_reduced_min_and_log(self):
-        d = self.plot("plot_landscape.py", self.files["landscape"], "--metric", "tau_inf", "--log",
+        d = self.plot("plot_landscape", self.files["landscape"], "--metric", "tau_inf", "--log",
                       "--x", "k", "--y", "alpha1A", "--reduce", "min")
         self.assertEqual(d["reduce"], "min")
         with h5py.File(self.files["landscape"], "r") as f:
@@ -149,7 +149,7 @@ class AnalysisTest(unittest.TestCase):
         self.nan_equal(d["z"], want)
 
     def test_landscape_convergence_fraction(self):
-        d = self.plot("plot_landscape.py", self.files["basins"], "--metric", "convergence")
+        d = self.plot("plot_landscape", self.files["basins"], "--metric", "convergence")
         with h5py.File(self.files["basins"], "r") as f:
             g = f["landscapes"]["basins"]
             want = g["converged"][()].mean(axis=0).T  # method x q0_1 x q0_2 -> q0_2 rows, q0_1 columns
@@ -159,19 +159,19 @@ class AnalysisTest(unittest.TestCase):
 
     def test_landscape_svg_and_errors(self):
         svg = os.path.join(self.tmp.name, "l.svg")
-        r = subprocess.run([sys.executable, os.path.join(ROOT, "analysis", "plot_landscape.py"),
-                            self.files["landscape"], "-o", svg, "--fix", "method=local_weighted"],
-                           capture_output=True, text=True)
+        r = subprocess.run(analysis_command("plot_landscape", self.files["landscape"], "-o", svg,
+                                            "--fix", "method=local_weighted"),
+                           capture_output=True, text=True, env=ANALYSIS_ENV)
         self.assertEqual(r.returncode, 0, r.stderr)
         with open(svg) as f:
             self.assertIn("<svg", f.read(2000))
-        r = subprocess.run([sys.executable, os.path.join(ROOT, "analysis", "plot_landscape.py"),
-                            self.files["landscape"], "--fix", "method=nope"], capture_output=True, text=True)
+        r = subprocess.run(analysis_command("plot_landscape", self.files["landscape"], "--fix", "method=nope"),
+                           capture_output=True, text=True, env=ANALYSIS_ENV)
         self.assertNotEqual(r.returncode, 0)
         self.assertIn("local_weighted", r.stderr)
 
     def test_landscape_optimization_overlay(self):
-        d = self.plot("plot_landscape.py", self.files["optimize"], "--optimization", "h1")
+        d = self.plot("plot_landscape", self.files["optimize"], "--optimization", "h1")
         o = d["optimization"]
         with h5py.File(self.files["optimize"], "r") as f:
             g = f["optimizations"]["h1"]
@@ -193,20 +193,20 @@ class AnalysisTest(unittest.TestCase):
         self.assertEqual(o["best"]["y"], bx[1])
         self.assertEqual(o["best"]["objective"], bobj)
         # Swapped axes: the overlay follows them.
-        d = self.plot("plot_landscape.py", self.files["optimize"], "--optimization", "h1", "--x", "k", "--y", "alpha1A")
+        d = self.plot("plot_landscape", self.files["optimize"], "--optimization", "h1", "--x", "k", "--y", "alpha1A")
         np.testing.assert_array_equal(d["optimization"]["points"]["x"], x[:, 1])
         # Without --optimization: no overlay; a name that is not there, or other variables: an error.
-        self.assertIsNone(self.plot("plot_landscape.py", self.files["optimize"])["optimization"])
+        self.assertIsNone(self.plot("plot_landscape", self.files["optimize"])["optimization"])
         for name, want in (("nope", "h1, k_only"), ("k_only", "not the plotted axes")):
-            r = subprocess.run([sys.executable, os.path.join(ROOT, "analysis", "plot_landscape.py"),
-                                self.files["optimize"], "--optimization", name, "-o",
-                                os.path.join(self.tmp.name, "bad.png")], capture_output=True, text=True)
+            r = subprocess.run(analysis_command("plot_landscape", self.files["optimize"], "--optimization", name, "-o",
+                                                os.path.join(self.tmp.name, "bad.png")),
+                               capture_output=True, text=True, env=ANALYSIS_ENV)
             self.assertNotEqual(r.returncode, 0)
             self.assertIn(want, r.stderr)
 
     def test_reader_optimization(self):
         sys.path.insert(0, os.path.join(ROOT, "analysis"))
-        import ksread
+        from kinesweep import read as ksread
         with h5py.File(self.files["optimize"], "r") as f:
             g = f["optimizations"]["h1"]
             x = g["evaluations"]["x"][()]
@@ -240,7 +240,7 @@ class AnalysisTest(unittest.TestCase):
                 r.optimization("nope")
 
     def test_histories(self):
-        d = self.plot("plot_histories.py", self.files["table4"], "--preset", "1a,2d", "--what", "tau,q,qd")
+        d = self.plot("plot_histories", self.files["table4"], "--preset", "1a,2d", "--what", "tau,q,qd")
         with h5py.File(self.files["table4"], "r") as f:
             preset = runs_column(f["runs"]["preset"]).tolist()
             for case in ("1a", "2d"):
@@ -254,7 +254,7 @@ class AnalysisTest(unittest.TestCase):
                 np.testing.assert_allclose(got["q"], h["q"] * D, rtol=1e-13)
 
     def test_cases(self):
-        d = self.plot("plot_cases.py", self.files["table4"])
+        d = self.plot("plot_cases", self.files["table4"])
         with h5py.File(self.files["table4"], "r") as f:
             preset = runs_column(f["runs"]["preset"]).tolist()
             E = f["runs"]["E"][()]
@@ -267,12 +267,12 @@ class AnalysisTest(unittest.TestCase):
                   re.finditer(r'\{"(\w+)",\s*"[^"]*",\s*\w+,\s*[-\d.]+,\s*[-\d.]+,\s*(?:\w+|\{[^}]*\}),\s*([\d.]+)', src)}
         self.assertEqual(len(thesis), 21)
         np.testing.assert_array_equal(d["thesis"], [thesis[c] for c in preset])
-        d = self.plot("plot_cases.py", self.files["table4"], "--metric", "tau2_inf", "--cases", "1a,2d", "--log")
+        d = self.plot("plot_cases", self.files["table4"], "--metric", "tau2_inf", "--cases", "1a,2d", "--log")
         self.assertEqual(d["cases"], ["1a", "2d"])
         self.assertEqual(d["thesis"], [32.31, 2135.90])
 
     def test_basins(self):
-        d = self.plot("plot_basins.py", self.files["basins"], size=(900, 400))
+        d = self.plot("plot_basins", self.files["basins"], size=(900, 400))
         names = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution"]
         with h5py.File(self.files["basins"], "r") as f:
             g = f["landscapes"]["basins"]
@@ -288,7 +288,7 @@ class AnalysisTest(unittest.TestCase):
             self.assertAlmostEqual(p["converged_fraction"], float(np.mean(st[m] == 0)))
 
     def test_convergence(self):
-        d = self.plot("plot_convergence.py", self.files["convergence"])
+        d = self.plot("plot_convergence", self.files["convergence"])
         with h5py.File(self.files["convergence"], "r") as f:
             method = runs_column(f["runs"]["method"]).tolist()
             lam = f["runs"]["lambda"][()]
@@ -301,17 +301,15 @@ class AnalysisTest(unittest.TestCase):
                 if got["lambda"] is not None:
                     self.assertEqual(got["lambda"], lam[int(run)])
 
-    def test_help_of_every_script(self):
-        for s in ("plot_landscape.py", "plot_histories.py", "plot_cases.py", "plot_basins.py",
-                  "plot_convergence.py", "make_examples.py"):
-            r = subprocess.run([sys.executable, os.path.join(ROOT, "analysis", s), "--help"],
-                               capture_output=True, text=True)
+    def test_help_of_every_command(self):
+        for s in ("plot_landscape", "plot_histories", "plot_cases", "plot_basins", "plot_convergence", "make_examples"):
+            r = subprocess.run(analysis_command(s, "--help"), capture_output=True, text=True, env=ANALYSIS_ENV)
             self.assertEqual(r.returncode, 0, (s, r.stderr))
             self.assertIn("usage:", r.stdout)
 
     def test_reader_module(self):
         sys.path.insert(0, os.path.join(ROOT, "analysis"))
-        import ksread
+        from kinesweep import read as ksread
         with h5py.File(self.files["landscape"], "r") as f:
             done = f["runs"]["done"][()] == 1
             E, alpha = f["runs"]["E"][()][done], f["runs"]["alpha1A"][()][done]

@@ -1,7 +1,7 @@
 """The /histories layouts of format_version 2 (one group per run) and 3 and 4 (one shared row space,
-FORMAT.md) read the same through every Python reader: ksread (has_history, history_arrays, history_ids,
-history_count, history, read_history), kshistory, regression_hashes' per-array hashes, check_store's
-history check, report_traces and the plot scripts (plot_histories, plot_convergence).
+FORMAT.md) read the same through every Python reader: kinesweep.read (has_history, history_arrays, history_ids,
+history_count, history, read_history), kinesweep.history, regression_hashes' per-array hashes, check_store's
+history check, report_traces and the plot commands (plot_histories, plot_convergence).
 
 The test writes the files itself with h5py, from histories it generates (the oracle): trajectory and
 IK runs, an IK array of another column count (dataset `F.2` holding array F), a run without a history,
@@ -250,7 +250,7 @@ class HistoryLayouts(unittest.TestCase):
             self.assertEqual(int(g["start"][3]), g["q"].shape[0])  # the 0-row run starts at the very end
 
     def test_ksread(self):
-        import ksread
+        from kinesweep import read as ksread
         want_ids = sorted(self.hist)
         for name, path in self.files.items():
             with self.subTest(file=name), ksread.open_results(path) as r:
@@ -277,7 +277,7 @@ class HistoryLayouts(unittest.TestCase):
 
     def test_ksread_runs_the_same_in_every_file(self):
         """/runs reads the same whatever the format: the v4 file's enum codes as their labels."""
-        import ksread
+        from kinesweep import read as ksread
         with h5py.File(self.v4, "r") as f:
             for name, labels in LABELS.items():
                 self.assertIsNotNone(h5py.check_enum_dtype(f["runs"][name].dtype), name)
@@ -292,7 +292,7 @@ class HistoryLayouts(unittest.TestCase):
                 self.assertEqual(r.row_kinds(done_only=False).tolist(), [RUNS[i][0] for i in range(N)])
 
     def test_kshistory_items_in_run_id_order(self):
-        import kshistory
+        from kinesweep import history as kshistory
         for name, path in self.files.items():
             with self.subTest(file=name), h5py.File(path, "r") as f:
                 items = list(kshistory.Histories(f).items())
@@ -346,16 +346,17 @@ class HistoryLayouts(unittest.TestCase):
             del check_store.failures[:]
 
     def test_report_history_ids(self):
-        import ksread
+        from kinesweep import read as ksread
         from kinesweep import report_traces
         for name, path in self.files.items():
             with self.subTest(file=name), ksread.open_results(path) as r:
                 self.assertEqual(report_traces.history_ids(r), set(self.hist))
 
-    def plot(self, script, path, *extra):
-        png = os.path.join(self.tmp.name, f"{script}_{os.path.basename(path)}.png")
-        r = subprocess.run([sys.executable, os.path.join(ROOT, "analysis", script), path, "-o", png,
-                            "--size", "400x300", "--print-data", *extra], capture_output=True, text=True)
+    def plot(self, command, path, *extra):
+        from e2e_common import ANALYSIS_ENV, analysis_command
+        png = os.path.join(self.tmp.name, f"{command}_{os.path.basename(path)}.png")
+        r = subprocess.run(analysis_command(command, path, "-o", png, "--size", "400x300", "--print-data", *extra),
+                           capture_output=True, text=True, env=ANALYSIS_ENV)
         self.assertEqual(r.returncode, 0, r.stderr)
         d = json.loads(r.stdout)
         del d["file"], d["output"]
@@ -369,7 +370,7 @@ class HistoryLayouts(unittest.TestCase):
         """Default runs: the first three done runs with a time array (0, 3 with 0 rows, 5; not 1: no
         history); then two runs named, arrays in degrees where their unit is rad."""
         for extra, ids in (((), [0, 3, 5]), (("--runs", "7,0", "--radians"), [7, 0])):
-            got = {n: self.plot("plot_histories.py", p, "--what", "tau,q,qd", *extra) for n, p in self.files.items()}
+            got = {n: self.plot("plot_histories", p, "--what", "tau,q,qd", *extra) for n, p in self.files.items()}
             for name, d in got.items():
                 with self.subTest(file=name, extra=extra):
                     self.assertEqual(d, got["v2"])
@@ -386,7 +387,7 @@ class HistoryLayouts(unittest.TestCase):
     def test_plot_convergence(self):
         """One line per (method, lambda) among the done IK runs with a history: lm 0.1 -> run 2,
         newton -> 4, lm 0.01 -> 8 (lm_adaptive's run 9 has none; run 6 is not done)."""
-        got = {n: self.plot("plot_convergence.py", p) for n, p in self.files.items()}
+        got = {n: self.plot("plot_convergence", p) for n, p in self.files.items()}
         for name, d in got.items():
             with self.subTest(file=name):
                 self.assertEqual(d, got["v2"])
@@ -399,8 +400,8 @@ class HistoryLayouts(unittest.TestCase):
     def test_other_versions(self):
         """v1 keeps the group layout (kshistory reads it; ksread refuses v1 for its /runs); a version
         newer than 4 is refused by both, naming the version; a file without /histories has none."""
-        import kshistory
-        import ksread
+        from kinesweep import history as kshistory
+        from kinesweep import read as ksread
         v1 = os.path.join(self.tmp.name, "v1.h5")
         write_v2(v1, self.hist, version=1)
         with h5py.File(v1, "r") as f:

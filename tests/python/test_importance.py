@@ -18,7 +18,7 @@ import unittest
 
 import numpy as np
 
-from e2e_common import TempDirTest, report_page
+from e2e_common import ANALYSIS_ENV, TempDirTest, analysis_command, report_page
 
 KS = None
 SOURCE = None
@@ -129,8 +129,8 @@ class ExamplesLhs(TempDirTest):
         cls.tmpc.cleanup()
 
     def command(self, *args):
-        return subprocess.run(["/usr/bin/python3", os.path.join(SOURCE, "analysis", "importance.py"), self.h5, *args],
-                              capture_output=True, text=True, timeout=300)
+        return subprocess.run(analysis_command("importance", self.h5, *args), capture_output=True, text=True,
+                              timeout=300, env=ANALYSIS_ENV)
 
     def test_alpha1A_ranks_above_k_and_every_swept_parameter_is_listed(self):
         r = self.lhs

@@ -1,6 +1,6 @@
 """`cmake --install` into a clean prefix, then use what it installed as a user would: an external CMake
 project finds the package and links the engine; the installed binary runs a shipped study; the man
-page renders; bash completion completes; ksread imports and an installed plot script runs.
+page renders; bash completion completes; the package imports and an installed plot command runs.
 
 usage: /usr/bin/python3 test_install.py BUILD_DIR REPO_ROOT
 """
@@ -122,7 +122,8 @@ class Install(unittest.TestCase):
                     "share/doc/kinesweep/analysis.md", "share/doc/kinesweep/FORMAT.md", "share/doc/kinesweep/README.md",
                     "share/doc/kinesweep/LICENSE", "share/doc/kinesweep/CITATION.cff",
                     os.path.join(python_dir(), "kinesweep", "__init__.py"),
-                    os.path.join(python_dir(), "kinesweep", "plot_landscape.py")]:
+                    os.path.join(python_dir(), "kinesweep", "plot_landscape.py"),
+                    os.path.join(python_dir(), "kinesweep", "compat.py")]:
             self.assertTrue(os.path.exists(os.path.join(PREFIX, rel)), rel)
         self.assertTrue(glob.glob(os.path.join(PREFIX, "lib", "libks_*.a")))
         self.assertFalse(os.path.exists(os.path.join(PREFIX, "include", "kinesweep", "cli")))

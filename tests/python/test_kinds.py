@@ -65,7 +65,7 @@ class Kinds(TempDirTest):
         cls.shared.cleanup()
 
     def test_the_file_records_each_kind_it_holds(self):
-        import kstypes
+        from kinesweep import kinds as kstypes
         with h5py.File(self.out, "r") as f:
             self.assertEqual(sorted(f["kinds"]), ["ik", "trajectory"])
             for kind in ("trajectory", "ik"):
@@ -95,13 +95,13 @@ class Kinds(TempDirTest):
             h = history(f, traj)
             self.assertEqual(list(h), strings(t["history_arrays"]))
             self.assertEqual(h["q"].shape[1], 4)  # the 4R arm's joints
-            from kshistory import Histories
+            from kinesweep.history import Histories
             units = [u for _n, _a, u in Histories(f).read(traj)]
             self.assertEqual(units, strings(t["history_units"]))
             self.assertEqual(list(history(f, ik)), strings(f["kinds"]["ik"].attrs["history_arrays"]))
 
     def test_ksread_reads_the_meaning_and_falls_back_for_older_files(self):
-        import ksread
+        from kinesweep import read as ksread
         with ksread.open_results(self.out) as res:
             m = res.kind_meaning("ik")
             self.assertEqual(m["ranking"], ["iterations", "error"])
@@ -118,8 +118,8 @@ class Kinds(TempDirTest):
 
 
     def test_every_metric_has_one_display_name_that_the_readers_use(self):
-        import ksread
-        import kstypes
+        from kinesweep import read as ksread
+        from kinesweep import kinds as kstypes
         with h5py.File(self.out, "r") as f:
             shown = {}
             for c in strings(f["runs"].attrs["columns"]):

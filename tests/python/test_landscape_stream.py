@@ -34,7 +34,7 @@ k = { from = 0, to = 1, step = 0.05 }
 
 def done_count(path):
     sys.path.insert(0, ANALYSIS)
-    import ksread
+    from kinesweep import read as ksread
     try:
         with ksread.open_results(path) as r:
             return len(r.runs(["run_id"])["run_id"])
@@ -79,8 +79,8 @@ class LandscapeStream(TempDirTest):
         self.assertTrue(np.all(np.isnan(flat_E[~done])) and np.all(np.isnan(flat_ok[~done])))
 
         png = os.path.join(self.dir, "partial.png")
-        r = subprocess.run(["/usr/bin/python3", os.path.join(ANALYSIS, "plot_landscape.py"), out, "-o", png],
-                           capture_output=True, text=True)
+        r = subprocess.run(["/usr/bin/python3", "-m", "kinesweep.plot_landscape", out, "-o", png],
+                           capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=ANALYSIS))
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertGreater(os.path.getsize(png), 1000)
 

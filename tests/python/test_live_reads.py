@@ -1,5 +1,5 @@
 """Reading a results file while a sweep writes it: ksread's calls never raise and never go back in
-time (each is one committed state: analysis/kslive.py), and a plain h5py read guarded by the stamp
+time (each is one committed state: kinesweep.live), and a plain h5py read guarded by the stamp
 check of FORMAT.md ("Reading while a sweep runs") gets a consistent snapshot.
 
 usage: /usr/bin/python3 test_live_reads.py KINESWEEP_BINARY ANALYSIS_DIR
@@ -51,8 +51,8 @@ class LiveReads(TempDirTest):
                                 stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
 
     def test_ksread_reads_a_file_being_written_without_failing(self):
-        import kslive
-        import ksread
+        from kinesweep import live as kslive
+        from kinesweep import read as ksread
         reopened = []
         original = ksread.Results._reopen
 

@@ -1,5 +1,5 @@
-"""Tests of analysis/plot_runs.py (runs from /runs: scatter, slice, parallel coordinates), its row filter
-analysis/kswhere.py and ksplot.is_log_spaced. The engine runs small random-axis, Latin-hypercube and IK
+"""Tests of kinesweep.plot_runs (runs from /runs: scatter, slice, parallel coordinates), its row filter
+kinesweep.where and kinesweep.plotting.is_log_spaced. The engine runs small random-axis, Latin-hypercube and IK
 studies; every view's PNG exists, has the requested size and is not blank, and the numbers it plotted
 (--print-data) equal the file's /runs as read here with h5py, masked by done and by the --where filter
 computed here with numpy. The filter is also compared with `kinesweep query --where` on the same file.
@@ -18,7 +18,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import run_study_text, runs_column
+from e2e_common import ANALYSIS_ENV, analysis_command, run_study_text, runs_column
 
 KS = None
 ROOT = None
@@ -111,8 +111,8 @@ class WhereTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         sys.path.insert(0, os.path.join(ROOT, "analysis"))
-        import ksread
-        import kswhere
+        from kinesweep import read as ksread
+        from kinesweep import where as kswhere
         cls.kswhere = kswhere
         rng = np.random.default_rng(7)
         n = 200
@@ -197,7 +197,7 @@ class WhereTest(unittest.TestCase):
 
     def test_is_log_spaced(self):
         sys.path.insert(0, os.path.join(ROOT, "analysis"))
-        import ksplot
+        from kinesweep import plotting as ksplot
         rng = np.random.default_rng(3)
         self.assertTrue(ksplot.is_log_spaced(np.repeat([1e-3, 1e-2, 0.1, 1, 10, 100], 4)))
         self.assertTrue(ksplot.is_log_spaced(10 ** rng.uniform(-3, 2, 50)))
@@ -230,16 +230,15 @@ class PlotRunsTest(unittest.TestCase):
     def tearDownClass(cls):
         cls.tmp.cleanup()
 
-    def run_script(self, h5, *extra, size=(720, 540)):
+    def run_command(self, h5, *extra, size=(720, 540)):
         PlotRunsTest.n += 1
         png = os.path.join(self.tmp.name, f"plot_runs_{self.n}.png")
-        r = subprocess.run([sys.executable, os.path.join(ROOT, "analysis", "plot_runs.py"), h5, "-o", png,
-                            "--size", f"{size[0]}x{size[1]}", "--print-data", *extra],
-                           capture_output=True, text=True)
+        r = subprocess.run(analysis_command("plot_runs", h5, "-o", png, "--size", f"{size[0]}x{size[1]}",
+                                            "--print-data", *extra), capture_output=True, text=True, env=ANALYSIS_ENV)
         return r, png
 
     def plot(self, h5, *extra, size=(720, 540)):
-        r, png = self.run_script(h5, *extra, size=size)
+        r, png = self.run_command(h5, *extra, size=size)
         self.assertEqual(r.returncode, 0, r.stderr)
         import matplotlib.image as mpimg
         self.assertTrue(os.path.exists(png), png)
@@ -413,7 +412,7 @@ class PlotRunsTest(unittest.TestCase):
         self.check_panel(d["panels"][0], cols, units, mask, "alpha1A", "E")
 
     def test_nothing_to_draw(self):
-        r, png = self.run_script(self.files["random"], "-w", "E<-1")
+        r, png = self.run_command(self.files["random"], "-w", "E<-1")
         self.assertEqual(r.returncode, 1, r.stderr)
         self.assertIn("nothing to draw", r.stderr)
         self.assertFalse(os.path.exists(png))
@@ -426,14 +425,13 @@ class PlotRunsTest(unittest.TestCase):
                             (["-w", "E<50 | alpha1a>3"], "did you mean 'alpha1A'?"),
                             (["-w", "E<fifty"], "is not a number"),
                             (["--facet", "E"], "a facet column is text")):
-            r, png = self.run_script(self.files["random"], *extra)
+            r, png = self.run_command(self.files["random"], *extra)
             self.assertEqual(r.returncode, 2, (extra, r.stderr))
             self.assertIn(text, r.stderr, extra)
             self.assertFalse(os.path.exists(png), extra)
 
     def test_help(self):
-        r = subprocess.run([sys.executable, os.path.join(ROOT, "analysis", "plot_runs.py"), "--help"],
-                           capture_output=True, text=True)
+        r = subprocess.run(analysis_command("plot_runs", "--help"), capture_output=True, text=True, env=ANALYSIS_ENV)
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertIn("--view", r.stdout)
 

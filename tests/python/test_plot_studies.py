@@ -1,10 +1,10 @@
 """Every shipped study (studies/*.toml, the examples_*.toml among them) plus a random-axis study, a
-Latin-hypercube study and a planar 3R IK study, each drawn by every plot script that applies to its
-file: the picture exists and is not blank, and where a script does not apply it exits non-zero with a
+Latin-hypercube study and a planar 3R IK study, each drawn by every plot command that applies to its
+file: the picture exists and is not blank, and where a command does not apply it exits non-zero with a
 message (never a traceback). What applies is decided from the file, read here with h5py: landscapes
 with two swept numeric axes (plot_landscape), IK landscapes over (q0_1, q0_2) (plot_basins), trajectory
 histories (plot_histories), IK histories (plot_convergence), preset rows (plot_cases), landscapes over
-(alpha1A, k) (compare_landscapes). Then the scripts' choices are checked against the file: the default
+(alpha1A, k) (compare_landscapes). Then the commands' choices are checked against the file: the default
 block (file order), log-scaled axes, faceting, round contour levels, joint units, one colour per run.
 
 usage: /usr/bin/python3 test_plot_studies.py KINESWEEP_BINARY REPO_ROOT
@@ -24,7 +24,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import Histories, axis_dataset_name, runs_column
+from e2e_common import ANALYSIS_ENV, Histories, analysis_command, axis_dataset_name, runs_column
 from regression_hashes import FULL_HISTORIES
 
 KS = None
@@ -93,7 +93,7 @@ q0_2 = { from = -180, to = 180, count = 15 }
 """
 
 
-DEFAULT_PLOTS = ("plot_landscape.py", "plot_basins.py", "plot_histories.py", "plot_convergence.py", "plot_cases.py")
+DEFAULT_PLOTS = ("plot_landscape", "plot_basins", "plot_histories", "plot_convergence", "plot_cases")
 
 
 def h5str(v):
@@ -150,9 +150,9 @@ class PlotStudiesTest(unittest.TestCase):
             r = subprocess.run(cmd, capture_output=True, text=True)
             assert r.returncode == 0, f"{name}: {r.stderr}"
             cls.files[name] = out
-        # Every script's default picture of every file, two at a time (the checks read these results).
+        # Every command's default picture of every file, two at a time (the checks read these results).
         cls.cache = {}
-        jobs = [(s, h5, (), None if s == "plot_basins.py" else (800, 600)) for h5 in cls.files.values()
+        jobs = [(s, h5, (), None if s == "plot_basins" else (800, 600)) for h5 in cls.files.values()
                 for s in DEFAULT_PLOTS]
         from concurrent.futures import ThreadPoolExecutor
         with ThreadPoolExecutor(max_workers=int(THREADS)) as pool:
@@ -166,18 +166,16 @@ class PlotStudiesTest(unittest.TestCase):
         else:
             shutil.rmtree(cls.tmp.name, ignore_errors=True)
 
-    def script(self, script, *args):
-        return subprocess.run([sys.executable, os.path.join(ROOT, "analysis", script), *args],
-                              capture_output=True, text=True)
+    def command(self, command, *args):
+        return subprocess.run(analysis_command(command, *args), capture_output=True, text=True, env=ANALYSIS_ENV)
 
     @classmethod
-    def run_plot(cls, script, h5, extra, size):
-        png = os.path.join(cls.tmp.name, "png", f"{os.path.basename(h5)}_{script}_{abs(hash(extra))}.png")
+    def run_plot(cls, command, h5, extra, size):
+        png = os.path.join(cls.tmp.name, "png", f"{os.path.basename(h5)}_{command}_{abs(hash(extra))}.png")
         args = [h5, "-o", png, "--print-data", *extra]
         if size:
             args += ["--size", f"{size[0]}x{size[1]}"]
-        return png, subprocess.run([sys.executable, os.path.join(ROOT, "analysis", script), *args],
-                                   capture_output=True, text=True)
+        return png, subprocess.run(analysis_command(command, *args), capture_output=True, text=True, env=ANALYSIS_ENV)
 
     def plot(self, script, h5, *extra, size=(800, 600), expect_ok=True):
         """Run a script with --print-data; when it succeeds check the picture; returns (rc, data, stderr)."""
@@ -205,9 +203,8 @@ class PlotStudiesTest(unittest.TestCase):
         for name, h5 in sorted(self.files.items()):
             with self.subTest(study=name), h5py.File(h5, "r") as f:
                 drawn[name] = self.check_study(name, h5, f)
-        # Every script drew something somewhere.
-        for s in ("plot_landscape.py", "plot_basins.py", "plot_histories.py", "plot_cases.py",
-                  "plot_convergence.py"):
+        # Every command drew something somewhere.
+        for s in ("plot_landscape", "plot_basins", "plot_histories", "plot_cases", "plot_convergence"):
             self.assertTrue(any(s in v for v in drawn.values()), s)
 
     def check_study(self, name, h5, f):
@@ -217,7 +214,7 @@ class PlotStudiesTest(unittest.TestCase):
         # plot_landscape: the first landscape in file order with two swept numeric axes.
         first = next((b for b in lands if len(numeric(axes[b])) >= 2), None)
         if first is None:
-            rc, _, err = self.plot("plot_landscape.py", h5, expect_ok=False)
+            rc, _, err = self.plot("plot_landscape", h5, expect_ok=False)
             self.assertNotEqual(rc, 0)
             self.assertIn("landscape", err)
         else:
@@ -226,27 +223,27 @@ class PlotStudiesTest(unittest.TestCase):
             x, y = numeric(axes[first])[:2]
             rest = [(n, cat, size) for n, cat, size, _ in axes[first] if n not in (x, y) and size > 1]
             facet = len(rest) == 1 and rest[0][1] and rest[0][2] <= 6
-            rc, d, err = self.plot("plot_landscape.py", h5, expect_ok=ik or facet or not rest)
+            rc, d, err = self.plot("plot_landscape", h5, expect_ok=ik or facet or not rest)
             if rc == 2:
                 self.assertIn("--fix", err)
                 self.assertIn("--reduce", err)
                 for n, _, _ in rest:
                     self.assertIn(n, err)
-                rc, d, err = self.plot("plot_landscape.py", h5, "--reduce", "min")
+                rc, d, err = self.plot("plot_landscape", h5, "--reduce", "min")
                 self.assertEqual(d["reduce"], "min")
             self.assertEqual(d["block"], first)
             self.assertEqual((d["x"]["name"], d["y"]["name"]), (x, y))
             self.assertEqual(d["facet"], rest[0][0] if facet and not ik else None)
-            drawn.append("plot_landscape.py")
+            drawn.append("plot_landscape")
         # plot_basins: the first IK landscape in file order over (q0_1, q0_2).
         basins = [b for b in lands if "converged" in f["landscapes"][b]
                   and len([n for n in numeric(axes[b]) if n.startswith("q0_")]) >= 2]
-        rc, d, err = self.plot("plot_basins.py", h5, size=None, expect_ok=bool(basins))
+        rc, d, err = self.plot("plot_basins", h5, size=None, expect_ok=bool(basins))
         if basins:
             self.assertEqual(d["block"], basins[0])
             self.assertEqual([d["x"]["name"], d["y"]["name"]],
                              [n for n in numeric(axes[basins[0]]) if n.startswith("q0_")][:2])
-            drawn.append("plot_basins.py")
+            drawn.append("plot_basins")
         else:
             self.assertNotEqual(rc, 0)
             self.assertIn("IK landscape", err)
@@ -254,7 +251,7 @@ class PlotStudiesTest(unittest.TestCase):
         hist = Histories(f)
         traj = [int(i) for i in hist.ids() if "t" in hist.names(i)]
         ikh = [int(i) for i in hist.ids() if "norm_F" in hist.names(i)]
-        rc, d, err = self.plot("plot_histories.py", h5, expect_ok=bool(traj))
+        rc, d, err = self.plot("plot_histories", h5, expect_ok=bool(traj))
         if traj:
             self.assertEqual(sorted(int(r) for r in d["runs"]), sorted(traj)[:3])
             # at most 4 panels a row (the 7-DOF arm: 4 + 3), the legend in a panel of its own when one is free
@@ -263,22 +260,22 @@ class PlotStudiesTest(unittest.TestCase):
             self.assertEqual(d["panels"]["cols"], min(4, joints))
             self.assertEqual(d["panels"]["rows"], -(-joints // 4))
             self.assertEqual(d["panels"]["legend_apart"], joints % 4 != 0 and joints > 4)
-            drawn.append("plot_histories.py")
+            drawn.append("plot_histories")
         else:
             self.assertNotEqual(rc, 0)
-        rc, d, err = self.plot("plot_convergence.py", h5, expect_ok=bool(ikh))
+        rc, d, err = self.plot("plot_convergence", h5, expect_ok=bool(ikh))
         if ikh:
             self.assertTrue(set(int(r) for r in d["runs"]) <= set(ikh))
-            drawn.append("plot_convergence.py")
+            drawn.append("plot_convergence")
         else:
             self.assertNotEqual(rc, 0)
         # plot_cases: rows with a preset.
         presets = [p for p, done in zip(runs_column(f["runs"]["preset"]), f["runs"]["done"][()])
                    if done and p] if "preset" in f["runs"] else []
-        rc, d, err = self.plot("plot_cases.py", h5, expect_ok=bool(presets))
+        rc, d, err = self.plot("plot_cases", h5, expect_ok=bool(presets))
         if presets:
             self.assertEqual(d["cases"], list(dict.fromkeys(presets)))
-            drawn.append("plot_cases.py")
+            drawn.append("plot_cases")
         else:
             self.assertNotEqual(rc, 0)
             self.assertIn("no Table 4 preset rows", err)
@@ -289,21 +286,21 @@ class PlotStudiesTest(unittest.TestCase):
         trios = [["redundancy_3r", "redundancy_4r", "redundancy_5r"], ["examples_landscape", "landscape_alpha_k"]]
         for names in trios:
             png = os.path.join(self.tmp.name, "png", f"compare_{names[0]}.png")
-            r = self.script("compare_landscapes.py", *[self.files[n] for n in names], "-o", png,
-                            "--fix", "method=local_weighted", "--print-data")
+            r = self.command("compare_landscapes", *[self.files[n] for n in names], "-o", png,
+                             "--fix", "method=local_weighted", "--print-data")
             self.assertEqual(r.returncode, 0, r.stderr)
             self.check_png(png, None)
             self.assertEqual(len(json.loads(r.stdout)["minima"]), len(names))
         # optimize_polish's first landscape (k_1b) has no alpha1A: the first one over (alpha1A, k) is used.
         png = os.path.join(self.tmp.name, "png", "compare_polish.png")
-        r = self.script("compare_landscapes.py", self.files["optimize_polish"], "-o", png, "--print-data")
+        r = self.command("compare_landscapes", self.files["optimize_polish"], "-o", png, "--print-data")
         self.assertEqual(r.returncode, 0, r.stderr)
         self.check_png(png, None)
 
-    # --- the scripts' choices, checked against the file ----------------------------------------
+    # --- the commands' choices, checked against the file ----------------------------------------
     def test_blocks_in_file_order(self):
         sys.path.insert(0, os.path.join(ROOT, "analysis"))
-        import ksread
+        from kinesweep import read as ksread
         for name in ("ik_scara", "optimize_polish", "arm7_square", "random_axes"):
             with h5py.File(self.files[name], "r") as f:
                 want = file_blocks(f)
@@ -320,19 +317,19 @@ class PlotStudiesTest(unittest.TestCase):
             lam = f["landscapes"]["damped"]["lambda"][()]
         self.assertGreaterEqual(lam.max() / lam.min(), 100)
         np.testing.assert_allclose(np.diff(np.log10(lam)), np.log10(lam[1] / lam[0]))  # evenly spaced in log
-        _, d, _ = self.plot("plot_landscape.py", h5, "--block", "damped", "--metric", "iterations", "--x", "lambda",
+        _, d, _ = self.plot("plot_landscape", h5, "--block", "damped", "--metric", "iterations", "--x", "lambda",
                             "--y", "q0_1", "--fix", "method=lm", "--reduce", "mean")
         self.assertEqual((d["xscale"], d["yscale"]), ("log", "linear"))
         self.assertEqual(d["reduce"], "mean")
-        _, d, _ = self.plot("plot_basins.py", h5, "--x", "lambda", "--y", "q0_1", "--fix", "q0_2=45", size=None)
+        _, d, _ = self.plot("plot_basins", h5, "--x", "lambda", "--y", "q0_1", "--fix", "q0_2=45", size=None)
         self.assertEqual((d["xscale"], d["yscale"]), ("log", "linear"))
         self.assertEqual(d["block"], "damped")
         # The default basins of ik_scara: the first block (damped), one row of panels per lambda.
-        _, d, _ = self.plot("plot_basins.py", h5, size=None)
+        _, d, _ = self.plot("plot_basins", h5, size=None)
         self.assertEqual((d["block"], d["panel_axis"], d["rows"]), ("damped", "method", "lambda"))
         self.assertEqual(len(d["panels"]), 2 * len(lam))
         sys.path.insert(0, os.path.join(ROOT, "analysis"))
-        import ksplot
+        from kinesweep import plotting as ksplot
         self.assertTrue(ksplot.is_log_spaced(lam))
         self.assertFalse(ksplot.is_log_spaced(np.linspace(1e-3, 100, 6)))
         self.assertFalse(ksplot.is_log_spaced([-1, 1, 10, 100]))
@@ -344,7 +341,7 @@ class PlotStudiesTest(unittest.TestCase):
                 problem = {p for p, b in zip(runs_column(f["runs"]["problem"]), runs_column(f["runs"]["block"]))
                            if b == block}
                 unit3 = h5str(f["runs"]["q_final_3"].attrs["unit"])
-            _, d, _ = self.plot("plot_basins.py", self.files[name], size=None)
+            _, d, _ = self.plot("plot_basins", self.files[name], size=None)
             self.assertTrue(d["solutions"])
             for text in d["solutions"].values():
                 if problem == {"scara"}:
@@ -356,7 +353,7 @@ class PlotStudiesTest(unittest.TestCase):
 
     def test_facets_and_reduce(self):
         h5 = self.files["landscape_alpha_k"]
-        _, d, _ = self.plot("plot_landscape.py", h5, size=(1200, 500))
+        _, d, _ = self.plot("plot_landscape", h5, size=(1200, 500))
         with h5py.File(h5, "r") as f:
             g = f["landscapes"]["local"]
             labels = h5str(g[axis_dataset_name("method")].attrs["unit"])[len("labels:"):].split(",")
@@ -368,19 +365,19 @@ class PlotStudiesTest(unittest.TestCase):
             got = np.array([[np.nan if v is None else v for v in row] for row in p["z"]], dtype=float)
             np.testing.assert_array_equal(got, E[m].T)
         # No facet possible (two remaining dims): exit 2 naming them and the options.
-        r = self.script("plot_landscape.py", self.files["ik_scara"], "--metric", "iterations",
-                        "-o", os.path.join(self.tmp.name, "x.png"))
+        r = self.command("plot_landscape", self.files["ik_scara"], "--metric", "iterations",
+                         "-o", os.path.join(self.tmp.name, "x.png"))
         self.assertEqual(r.returncode, 2, r.stderr)
         for word in ("method", "q0_2", "--fix", "--reduce"):
             self.assertIn(word, r.stderr)
         # --fix keeps its meaning; --reduce is said in the data (and the title).
-        _, d, _ = self.plot("plot_landscape.py", h5, "--fix", "method=local_unweighted")
+        _, d, _ = self.plot("plot_landscape", h5, "--fix", "method=local_unweighted")
         self.assertIsNone(d["facet"])
         np.testing.assert_array_equal(np.array([[np.nan if v is None else v for v in row] for row in d["z"]],
                                                dtype=float), E[labels.index("local_unweighted")].T)
 
     def test_round_levels_and_log_colour_bar(self):
-        _, d, _ = self.plot("plot_landscape.py", self.files["examples_landscape"], "--fix", "method=local_weighted")
+        _, d, _ = self.plot("plot_landscape", self.files["examples_landscape"], "--fix", "method=local_weighted")
         lv = np.array(d["levels"])
         self.assertGreaterEqual(len(lv), 3)
         step = np.diff(lv)
@@ -389,12 +386,12 @@ class PlotStudiesTest(unittest.TestCase):
         self.assertTrue(any(abs(mant - m) < 1e-9 for m in (1, 2, 2.5, 5)), step[0])
         np.testing.assert_allclose(lv / step[0], np.round(lv / step[0]), atol=1e-9)  # multiples of the step
         # Integer metric: integer levels.
-        _, d, _ = self.plot("plot_landscape.py", self.files["examples_basins"], "--metric", "iterations",
+        _, d, _ = self.plot("plot_landscape", self.files["examples_basins"], "--metric", "iterations",
                             "--fix", "method=newton")
         self.assertTrue(d["levels"])
         self.assertTrue(all(float(v).is_integer() for v in d["levels"]), d["levels"])
         # Log colour scale: several labelled ticks, each 1, 2 or 5 (or 1..9) times a power of ten.
-        _, d, _ = self.plot("plot_landscape.py", self.files["examples_landscape"], "--fix", "method=local_weighted",
+        _, d, _ = self.plot("plot_landscape", self.files["examples_landscape"], "--fix", "method=local_weighted",
                             "--log", "--metric", "tau_inf")
         ticks = d["colorbar"]["ticks"]
         self.assertGreaterEqual(len(ticks), 3, d["colorbar"])
@@ -409,7 +406,7 @@ class PlotStudiesTest(unittest.TestCase):
         note on stderr; no two drawn lines hold the same data, and runs drawn on separate lines have
         histories that differ (read with h5py)."""
         h5 = self.files["ik_scara"]
-        _, d, err = self.plot("plot_convergence.py", h5)
+        _, d, err = self.plot("plot_convergence", h5)
         lines = d["lines"]
         drawn = [(tuple(ln["x"]), tuple(ln["y"])) for ln in lines]
         self.assertEqual(len(drawn), len(set(drawn)), "two drawn lines hold identical data")
@@ -432,7 +429,7 @@ class PlotStudiesTest(unittest.TestCase):
 
     def test_convergence_runs_own_colours(self):
         h5 = self.files["ik_scara"]
-        _, d, _ = self.plot("plot_convergence.py", h5, "--runs", "0,1,2")
+        _, d, _ = self.plot("plot_convergence", h5, "--runs", "0,1,2")
         with h5py.File(h5, "r") as f:
             method = runs_column(f["runs"]["method"])[:3].tolist()
             q01 = f["runs"]["q0_1"][:3] * 180 / math.pi
@@ -447,7 +444,7 @@ class PlotStudiesTest(unittest.TestCase):
 
     def test_cases_without_presets(self):
         for name in ("examples_landscape", "ik_scara"):
-            r = self.script("plot_cases.py", self.files[name], "-o", os.path.join(self.tmp.name, "c.png"))
+            r = self.command("plot_cases", self.files[name], "-o", os.path.join(self.tmp.name, "c.png"))
             self.assertNotEqual(r.returncode, 0)
             self.assertIn("no Table 4 preset rows", r.stderr)
             self.assertIn("thesis_table4.toml", r.stderr)

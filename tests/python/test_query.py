@@ -84,7 +84,7 @@ def sha256(path):
 
 def import_ksread():
     sys.path.insert(0, os.path.join(ROOT, "analysis"))
-    import ksread
+    from kinesweep import read as ksread
     return ksread
 
 

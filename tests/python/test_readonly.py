@@ -62,7 +62,7 @@ class ReadOnly(TempDirTest):
         codes = [run("info", out).returncode,
                  run("query", out, "--where", "status=ok", "--limit", "5").returncode]
         sys.path.insert(0, os.path.join(ROOT, "analysis"))
-        import ksread
+        from kinesweep import read as ksread
         try:
             with ksread.open_results(out) as r:
                 r.runs()

@@ -1,4 +1,4 @@
-"""End-to-end tests of analysis/report.py: run the engine on small studies (a trajectory landscape
+"""End-to-end tests of kinesweep.report: run the engine on small studies (a trajectory landscape
 with full histories, an IK basins grid, a study with an [[optimize]] block), write the reports and
 check them: the sections present, the tables' numbers against h5py's reading of the file, no network
 references, a file a sweep is still writing, the size caps, and in headless Chromium (skipped when
@@ -23,7 +23,7 @@ from html.parser import HTMLParser
 import h5py
 import numpy as np
 
-from e2e_common import OPTIMIZE, Histories, is_text, run_study_text, runs_column
+from e2e_common import ANALYSIS_ENV, OPTIMIZE, Histories, analysis_command, is_text, run_study_text, runs_column
 from kinesweep import read as ksread  # noqa: E402 (e2e_common puts analysis/ on the path)
 
 KS = None
@@ -212,8 +212,8 @@ class ReportTest(unittest.TestCase):
     @classmethod
     def report(cls, h5, *extra):
         out = os.path.splitext(h5)[0] + "".join(extra).replace("-", "_") + ".html"
-        r = subprocess.run([sys.executable, os.path.join(ROOT, "analysis", "report.py"), h5, "-o", out, *extra],
-                           capture_output=True, text=True)
+        r = subprocess.run(analysis_command("report", h5, "-o", out, *extra), capture_output=True, text=True,
+                           env=ANALYSIS_ENV)
         assert r.returncode == 0, r.stderr
         return out
 

@@ -13,7 +13,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import Histories, TempDirTest, history, runs_column, runs_columns
+from e2e_common import ANALYSIS_ENV, Histories, TempDirTest, analysis_command, history, runs_column, runs_columns
 
 KS = None
 STUDIES = None
@@ -154,8 +154,8 @@ class ChainStudies(TempDirTest):
         # the basins plot names the solutions by clustering (no closed form for a 7-DOF arm); a pose
         # target leaves redundancy 1, a continuum, named by the joints that stay discrete (the elbow)
         png = os.path.join(self.dir, "basins.png")
-        r = subprocess.run(["/usr/bin/python3", os.path.join(REPO, "analysis", "plot_basins.py"), out, "--x", "q0_2",
-                            "--y", "q0_4", "-o", png, "--print-data"], capture_output=True, text=True)
+        r = subprocess.run(analysis_command("plot_basins", out, "--x", "q0_2", "--y", "q0_4", "-o", png,
+                                            "--print-data"), capture_output=True, text=True, env=ANALYSIS_ENV)
         self.assertEqual(r.returncode, 0, r.stderr)
         data = json.loads(r.stdout)
         self.assertTrue(data["clustered"])
@@ -167,7 +167,7 @@ class ChainStudies(TempDirTest):
 class ClusterSolutions(unittest.TestCase):
     def test_every_member_is_near_its_clusters_first_and_firsts_are_apart(self):
         sys.path.insert(0, os.path.join(REPO, "analysis"))
-        import ksread
+        from kinesweep import read as ksread
         rng = np.random.default_rng(7)
         centres = rng.uniform(-np.pi, np.pi, size=(5, 3))
         q = centres[rng.integers(0, 5, 400)] + rng.uniform(-4e-4, 4e-4, size=(400, 3))
@@ -191,7 +191,7 @@ class ClusterSolutions(unittest.TestCase):
         takes the lowest-labelled cluster whose first member is within tolerance among those opened
         before it, else opens one (the rule written row by row here as the oracle)."""
         sys.path.insert(0, os.path.join(REPO, "analysis"))
-        import ksread
+        from kinesweep import read as ksread
 
         def row_by_row(q, rev, tol):
             labels, firsts = np.full(len(q), -1), []

@@ -142,7 +142,7 @@ class SchemaWalk(TempDirTest):
                     if line.strip().startswith(head):
                         lines[(label, kind)] = [c.split(" [")[0] for c in line.strip()[len(head):].split(", ")]
         sys.path.insert(0, os.path.join(REPO, "analysis"))
-        import ksread
+        from kinesweep import read as ksread
         with ksread.open_results(out) as r:
             roles = r.roles()
             for (kind, family), table in self.tables.items():

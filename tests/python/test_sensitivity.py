@@ -20,7 +20,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import TempDirTest, report_page, runs_column
+from e2e_common import ANALYSIS_ENV, TempDirTest, analysis_command, report_page, runs_column
 
 KS = None
 SOURCE = None
@@ -216,8 +216,8 @@ class Sensitivity(TempDirTest):
                         v = [x for x in trace.get(key, []) if isinstance(x, (int, float))]
                         d = np.diff(v)
                         self.assertTrue(len(v) < 2 or np.all(d > 0) or np.all(d < 0), f"{study} {fid} {key}")
-            r = subprocess.run(["/usr/bin/python3", os.path.join(SOURCE, "analysis", "plot_landscape.py"), out, "-o",
-                                os.path.join(self.dir, "p.png")], capture_output=True, text=True, timeout=300)
+            r = subprocess.run(analysis_command("plot_landscape", out, "-o", os.path.join(self.dir, "p.png")),
+                               capture_output=True, text=True, timeout=300, env=ANALYSIS_ENV)
             self.assertEqual(r.returncode, 1)
             self.assertIn("is not a grid axis", r.stderr)
 

@@ -14,7 +14,7 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import TempDirTest, report_page, runs_column
+from e2e_common import ANALYSIS_ENV, TempDirTest, analysis_command, report_page, runs_column
 
 KS = SOURCE = None
 
@@ -41,9 +41,8 @@ class SolutionNames(TempDirTest):
             for s, theta in names.items():
                 self.assertIn(s, want, fid)
                 self.assertAlmostEqual(theta, want[s], delta=0.1, msg=f"{fid} solution {s}")
-        r = subprocess.run(["/usr/bin/python3", os.path.join(SOURCE, "analysis", "plot_basins.py"), out, "-o",
-                            os.path.join(self.dir, "b.png"), "--print-data"], capture_output=True, text=True,
-                           timeout=300)
+        r = subprocess.run(analysis_command("plot_basins", out, "-o", os.path.join(self.dir, "b.png"), "--print-data"),
+                           capture_output=True, text=True, timeout=300, env=ANALYSIS_ENV)
         self.assertEqual(r.returncode, 0, r.stderr)
         labels = json.loads(r.stdout)["solutions"]
         for s, label in labels.items():

@@ -1,5 +1,5 @@
 """The --where language's shared cases (tests/query/where_cases.json), run by both implementations
-on one results file: `kinesweep query --where ... --format json` and analysis/kswhere.select (also
+on one results file: `kinesweep query --where ... --format json` and kinesweep.where.select (also
 through the reader's row filter, to_pandas(where=) and runs(where=)). Each must select the rows the
 case's numpy oracle selects, or refuse with the case's message and
 suggestion.
@@ -32,7 +32,7 @@ class WhereCases(unittest.TestCase):
         cls.out = os.path.join(cls.tmp.name, "where_cases.h5")
         r = subprocess.run([KS, "run", study, "-o", cls.out, "-q"], capture_output=True, text=True, timeout=300)
         assert r.returncode == 0, r.stderr
-        import ksread
+        from kinesweep import read as ksread
         with ksread.open_results(cls.out) as res:
             cls.table = res.runs(degrees=True)
 
@@ -47,8 +47,8 @@ class WhereCases(unittest.TestCase):
         return subprocess.run(args, capture_output=True, text=True, timeout=120)
 
     def test_every_case_in_both_implementations(self):
-        import ksread
-        import kswhere
+        from kinesweep import read as ksread
+        from kinesweep import where as kswhere
         c = {k: (np.asarray(v, dtype=object) if np.asarray(v).dtype.kind in "OUS" else np.asarray(v))
              for k, v in self.table.items()}
         ids = np.asarray(self.table["run_id"])

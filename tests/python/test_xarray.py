@@ -80,7 +80,7 @@ class Xarray(StudyFileTest):
                                               np.asarray(metrics[list(metrics)[0]][1].flat[0])))
 
     def test_ksread_to_xarray_has_labels_for_string_axes_and_units(self):
-        import ksread
+        from kinesweep import read as ksread
         with ksread.open_results(self.h5) as r:
             ds = r.to_xarray("local")
             deg = r.to_xarray("local", degrees=True)
@@ -100,7 +100,7 @@ class Xarray(StudyFileTest):
         self.assertTrue(bitwise_equal(np.asarray(cell.values), np.asarray(metrics["E"][1][i, 2, 1])))
 
     def test_ksread_to_pandas_is_the_runs_table(self):
-        import ksread
+        from kinesweep import read as ksread
         with ksread.open_results(self.h5) as r:
             df = r.to_pandas()
         done = self.runs["done"].astype(bool)
