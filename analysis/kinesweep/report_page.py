@@ -90,11 +90,24 @@ LOADER = """
 """
 
 
-def gzip_island(element_id, text):
+# zlib level of the figures' data: 6 takes half the time of 9 for about 1 % more bytes (a 3.8 MB
+# landscape figure: 0.27 s, 1.256 MB against 0.51 s, 1.245 MB).
+FIGURE_LEVEL = 6
+
+
+def gzip_island(element_id, text, level=9):
     """A script element holding `text` gzip-compressed in base64 (inflated by LOADER)."""
+    return island(element_id, gzip_base64(text, level))
+
+
+def gzip_base64(text, level=9):
     import base64
     import gzip
-    data = base64.b64encode(gzip.compress(text.encode("utf-8"), compresslevel=9, mtime=0)).decode("ascii")
+    return base64.b64encode(gzip.compress(text.encode("utf-8"), compresslevel=level, mtime=0)).decode("ascii")
+
+
+def island(element_id, data):
+    """The script element of gzip_island from its base64 data (compressed already)."""
     return f'<script type="application/gzip" id="{esc(element_id)}">{data}</script>'
 
 
@@ -149,11 +162,33 @@ def table(columns, rows, css_id=None, text_columns=()):
     return "".join(out)
 
 
+def _floats(values):
+    """A list of Python floats to 7 significant digits, NaN and infinities as None."""
+    isfinite = math.isfinite
+    return [float(f"{v:.7g}") if isfinite(v) else None for v in values]
+
+
 def _clean(o):
+    t = type(o)
+    if t is float:
+        return float(f"{o:.7g}") if math.isfinite(o) else None
+    if t is list or t is tuple:
+        if all(type(v) is float for v in o):  # the common case, without a call per number
+            return _floats(o)
+        return [_clean(v) for v in o]
+    if t is dict:
+        return {str(k): _clean(v) for k, v in o.items()}
+    if t is str or t is int or t is bool or o is None:
+        return o
+    if isinstance(o, np.ndarray):
+        if o.dtype.kind == "f" and o.ndim >= 1:
+            flat = _floats(o.ravel().tolist())
+            for n in reversed(o.shape[1:]):  # nested as tolist() would (rows of the last axis first)
+                flat = [flat[i:i + n] for i in range(0, len(flat), n)]
+            return flat
+        return _clean(o.tolist())
     if isinstance(o, dict):
         return {str(k): _clean(v) for k, v in o.items()}
-    if isinstance(o, np.ndarray):
-        return _clean(o.tolist())
     if isinstance(o, (list, tuple)):
         return [_clean(v) for v in o]
     if isinstance(o, (float, np.floating)):
@@ -171,18 +206,19 @@ def figure(fid, fig, caption, title=None):
     null; gzip in base64) and its caption. Floats are kept to 7 significant digits."""
     text = json.dumps(_clean(fig), allow_nan=False, separators=(",", ":"))
     h = f"<h3>{esc(title)}</h3>" if title else ""
-    return (f'{h}<div class="plot" id="{esc(fid)}"></div>{gzip_island(fid + "-data", text)}'
+    return (f'{h}<div class="plot" id="{esc(fid)}"></div>{gzip_island(fid + "-data", text, FIGURE_LEVEL)}'
             f'<p class="caption">{caption}</p>')
 
 
-def page(title, subtitle, sections, plotly_js):
-    """The whole page: sections = [(id, heading, body html)], in order; the table of contents lists them."""
+def page(title, subtitle, sections, plotly_js, plotly_base64=None):
+    """The whole page: sections = [(id, heading, body html)], in order; the table of contents lists them.
+    plotly_base64: plotly_js compressed already (gzip_base64), e.g. from a cache."""
     toc = "".join(f'<li><a href="#{esc(sid)}">{esc(head)}</a></li>' for sid, head, _ in sections)
     body = "".join(f'<section id="{esc(sid)}"><h2>{esc(head)}</h2>{html_}</section>' for sid, head, html_ in sections)
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             f"<title>{esc(title)}</title><style>{STYLE}</style>"
             f"<script>{ERROR_COLLECTOR}</script>"
-            f"{gzip_island('plotly-js', plotly_js)}</head><body>"
+            f"{island('plotly-js', plotly_base64) if plotly_base64 else gzip_island('plotly-js', plotly_js)}</head><body>"
             f"<header><h1>{esc(title)}</h1><p class=\"sub\">{subtitle}</p></header>"
             f"<nav><strong>Contents</strong><ul>{toc}</ul></nav>{body}"
             "<pre id=\"ks-status\" data-ready=\"0\"></pre>"
