@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "chain_fixtures.hpp"
-#include "methods/chain_resolution.hpp"
+#include "methods/chain/resolution.hpp"
 #include "model/chain_dynamics.hpp"
 #include "model/chain_kinematics.hpp"
 #include "model/chain_plane.hpp"

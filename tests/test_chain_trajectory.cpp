@@ -8,8 +8,8 @@
 #include <cmath>
 #include <random>
 
-#include "methods/chain_trajectory.hpp"
-#include "methods/seed_cases.hpp"
+#include "methods/chain/trajectory.hpp"
+#include "methods/closed_form/seed_cases.hpp"
 #include "model/chain_dynamics.hpp"
 
 using namespace ks;

@@ -10,10 +10,10 @@
 #include <random>
 #include <vector>
 
-#include "methods/chain_trajectory.hpp"
-#include "methods/sample_metrics.hpp"
-#include "methods/trajectory.hpp"
-#include "methods/trajectory_lanes.hpp"
+#include "methods/chain/trajectory.hpp"
+#include "methods/metrics/sample_metrics.hpp"
+#include "methods/base/trajectory.hpp"
+#include "methods/closed_form/lanes.hpp"
 #include "model/kinematics.hpp"
 
 using namespace ks;

@@ -1,4 +1,4 @@
-// The end-state metrics (methods/sample_metrics.hpp): end_qd_max and end_kinetic_energy of a run equal
+// The end-state metrics (methods/metrics/sample_metrics.hpp): end_qd_max and end_kinetic_energy of a run equal
 // max_i |qd_i| and qd^T M(q) qd / 2 recomputed from the run's stored last sample, with M(q) from
 // Orocos KDL (an independent model of the same arm), in every trajectory loop: the closed-form 3R
 // kernel (local and vertex_alpha runs), the fixed-size planar-chain loop, the general chain loop,
@@ -12,12 +12,12 @@
 
 #include "kdl_arm.hpp"
 #include "kdl_chain.hpp"
-#include "methods/chain_trajectory.hpp"
-#include "methods/global_spline.hpp"
-#include "methods/path_global_chain.hpp"
-#include "methods/sample_metrics.hpp"
-#include "methods/seed_cases.hpp"
-#include "methods/trajectory.hpp"
+#include "methods/chain/trajectory.hpp"
+#include "methods/path_global/solve_closed_form.hpp"
+#include "methods/path_global/chain.hpp"
+#include "methods/metrics/sample_metrics.hpp"
+#include "methods/closed_form/seed_cases.hpp"
+#include "methods/base/trajectory.hpp"
 
 using namespace ks;
 

@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "methods/alpha_basis.hpp"
-#include "methods/global_spline.hpp"
-#include "methods/path_global.hpp"
-#include "methods/sample_sums.hpp"
-#include "methods/trajectory.hpp"
+#include "methods/path_global/alpha_basis.hpp"
+#include "methods/path_global/solve_closed_form.hpp"
+#include "methods/path_global/closed_form.hpp"
+#include "methods/metrics/sample_sums.hpp"
+#include "methods/base/trajectory.hpp"
 
 using namespace ks;
 

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "store/journal_vfd.hpp"
+#include "store/journal/vfd.hpp"
 
 namespace {
 namespace fs = std::filesystem;

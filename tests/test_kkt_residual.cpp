@@ -1,4 +1,4 @@
-// kkt_residual (methods/global_solve.hpp) at the edges of the free set: no variable, no row, rows of
+// kkt_residual (methods/path_global/slsqp.hpp) at the edges of the free set: no variable, no row, rows of
 // zeros, every variable held by a bound, non-finite entries. Each expected value is the definition's
 // min over lambda >= 0 of |grad + jac^T lambda|_inf worked out by hand.
 #include <gtest/gtest.h>
@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "methods/global_solve.hpp"
+#include "methods/path_global/slsqp.hpp"
 
 namespace ks {
 namespace {

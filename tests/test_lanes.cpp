@@ -10,7 +10,7 @@
 #include <random>
 #include <vector>
 
-#include "methods/resolution.hpp"
+#include "methods/base/resolution.hpp"
 #include "model/lanes.hpp"
 #include "model/trig.hpp"
 

@@ -11,10 +11,10 @@
 #include <random>
 
 #include "kdl_chain.hpp"
-#include "methods/chain_resolution.hpp"
-#include "methods/chain_start.hpp"
-#include "methods/chain_trajectory.hpp"
-#include "methods/seed_cases.hpp"
+#include "methods/chain/resolution.hpp"
+#include "methods/chain/start.hpp"
+#include "methods/chain/trajectory.hpp"
+#include "methods/closed_form/seed_cases.hpp"
 #include "model/chain_dynamics.hpp"
 #include "robot/urdf.hpp"
 

@@ -12,8 +12,8 @@
 #include <set>
 #include <sstream>
 
-#include "methods/seed_cases.hpp"
-#include "methods/trajectory.hpp"
+#include "methods/closed_form/seed_cases.hpp"
+#include "methods/base/trajectory.hpp"
 #include "optimize/optimize.hpp"
 #include "runner/optimize_blocks.hpp"
 #include "runner/run_study.hpp"

@@ -10,10 +10,10 @@
 #include <random>
 #include <vector>
 
-#include "methods/alpha_basis.hpp"
-#include "methods/global_spline.hpp"
-#include "methods/path_global.hpp"
-#include "methods/trajectory.hpp"
+#include "methods/path_global/alpha_basis.hpp"
+#include "methods/path_global/solve_closed_form.hpp"
+#include "methods/path_global/closed_form.hpp"
+#include "methods/base/trajectory.hpp"
 #include "model/dynamics.hpp"
 
 using namespace ks;

@@ -7,11 +7,11 @@
 #include <numbers>
 #include <vector>
 
-#include "methods/alpha_basis.hpp"
-#include "methods/chain_start.hpp"
-#include "methods/global_spline.hpp"
-#include "methods/path_global.hpp"
-#include "methods/path_global_planar.hpp"
+#include "methods/path_global/alpha_basis.hpp"
+#include "methods/chain/start.hpp"
+#include "methods/path_global/solve_closed_form.hpp"
+#include "methods/path_global/closed_form.hpp"
+#include "methods/path_global/planar_chart.hpp"
 
 using namespace ks;
 

@@ -12,11 +12,11 @@
 
 #include <Eigen/QR>
 
-#include "methods/alpha_basis.hpp"
-#include "methods/chain_start.hpp"
-#include "methods/chain_trajectory.hpp"
-#include "methods/global_solve.hpp"
-#include "methods/path_global_joints.hpp"
+#include "methods/path_global/alpha_basis.hpp"
+#include "methods/chain/start.hpp"
+#include "methods/chain/trajectory.hpp"
+#include "methods/path_global/slsqp.hpp"
+#include "methods/path_global/joint_chart.hpp"
 #include "robot/urdf.hpp"
 
 using namespace ks;

@@ -8,13 +8,13 @@
 #include <limits>
 #include <vector>
 
-#include "methods/alpha_basis.hpp"
-#include "methods/global_spline.hpp"
-#include "methods/path_global.hpp"
-#include "methods/path_global_verify.hpp"
-#include "methods/chain_start.hpp"
-#include "methods/path_global_chain.hpp"
-#include "methods/path_global_planar.hpp"
+#include "methods/path_global/alpha_basis.hpp"
+#include "methods/path_global/solve_closed_form.hpp"
+#include "methods/path_global/closed_form.hpp"
+#include "methods/path_global/verify.hpp"
+#include "methods/chain/start.hpp"
+#include "methods/path_global/chain.hpp"
+#include "methods/path_global/planar_chart.hpp"
 #include "model/chain_dynamics.hpp"
 #include "model/dynamics.hpp"
 

@@ -10,9 +10,9 @@
 #include <cmath>
 #include <random>
 
-#include "methods/chain_trajectory.hpp"
-#include "methods/fixed_ldlt.hpp"
-#include "methods/seed_cases.hpp"
+#include "methods/chain/trajectory.hpp"
+#include "methods/base/fixed_ldlt.hpp"
+#include "methods/closed_form/seed_cases.hpp"
 #include "model/chain_dynamics.hpp"
 #include "model/planar_chain_dynamics.hpp"
 

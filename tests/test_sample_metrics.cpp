@@ -1,4 +1,4 @@
-// The table of per-sample metrics (methods/sample_metrics.hpp): each entry's run value equals its
+// The table of per-sample metrics (methods/metrics/sample_metrics.hpp): each entry's run value equals its
 // reduction recomputed from the run's full history, in every trajectory loop (closed-form 3R, the
 // fixed-size planar chain, the general chain) and lanes equal single runs bit for bit; every entry
 // is a /runs column of every trajectory block.
@@ -8,11 +8,11 @@
 #include <cstring>
 #include <set>
 
-#include "methods/chain_trajectory.hpp"
-#include "methods/sample_metrics.hpp"
-#include "methods/seed_cases.hpp"
-#include "methods/trajectory.hpp"
-#include "methods/trajectory_lanes.hpp"
+#include "methods/chain/trajectory.hpp"
+#include "methods/metrics/sample_metrics.hpp"
+#include "methods/closed_form/seed_cases.hpp"
+#include "methods/base/trajectory.hpp"
+#include "methods/closed_form/lanes.hpp"
 #include "model/chain_dynamics.hpp"
 #include "schema/params.hpp"
 

@@ -1,4 +1,4 @@
-// The singularity tolerance relative to the arm's size (methods/singular_scale.hpp): the seed's arm
+// The singularity tolerance relative to the arm's size (methods/base/singular_scale.hpp): the seed's arm
 // and a planar 4R scaled down to millimetres and micrometres, on their path scaled alike, end as the
 // metre-size arm does (the inertia-weighted resolution at k = 0 is invariant under a uniform scaling:
 // the joint motion is the same), and a path that truly meets a singularity still stops there; arms
@@ -7,11 +7,11 @@
 
 #include <vector>
 
-#include "methods/chain_start.hpp"
-#include "methods/chain_trajectory.hpp"
-#include "methods/seed_cases.hpp"
-#include "methods/singular_scale.hpp"
-#include "methods/trajectory.hpp"
+#include "methods/chain/start.hpp"
+#include "methods/chain/trajectory.hpp"
+#include "methods/closed_form/seed_cases.hpp"
+#include "methods/base/singular_scale.hpp"
+#include "methods/base/trajectory.hpp"
 
 using namespace ks;
 

@@ -1,4 +1,4 @@
-// The start solve (methods/chain_start.hpp) prefers a start within the joint limits when one with the
+// The start solve (methods/chain/start.hpp) prefers a start within the joint limits when one with the
 // same tip pose exists: on planar 4R and 5R arms with asymmetric limits, every target is the tip
 // pose of a configuration drawn within the limits (so such a start exists by construction), and the
 // start found from the default guess must be within the limits and on the target.
@@ -7,8 +7,8 @@
 #include <random>
 #include <vector>
 
-#include "methods/chain_resolution.hpp"
-#include "methods/chain_start.hpp"
+#include "methods/chain/resolution.hpp"
+#include "methods/chain/start.hpp"
 #include "model/chain_kinematics.hpp"
 
 using namespace ks;

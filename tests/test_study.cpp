@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "common/did_you_mean.hpp"
-#include "methods/seed_cases.hpp"
+#include "methods/closed_form/seed_cases.hpp"
 #include "study/sha256.hpp"
 #include "study/study.hpp"
 #include "study_errors.hpp"

@@ -7,9 +7,9 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "methods/resolution.hpp"
-#include "methods/seed_cases.hpp"
-#include "methods/trajectory.hpp"
+#include "methods/base/resolution.hpp"
+#include "methods/closed_form/seed_cases.hpp"
+#include "methods/base/trajectory.hpp"
 #include "model/dynamics.hpp"
 #include "random_state.hpp"
 

@@ -8,10 +8,10 @@
 #include <cmath>
 #include <cstring>
 
-#include "methods/chain_trajectory.hpp"
-#include "methods/seed_cases.hpp"
-#include "methods/trajectory.hpp"
-#include "methods/trajectory_lanes.hpp"
+#include "methods/chain/trajectory.hpp"
+#include "methods/closed_form/seed_cases.hpp"
+#include "methods/base/trajectory.hpp"
+#include "methods/closed_form/lanes.hpp"
 #include "model/chain_dynamics.hpp"
 
 using namespace ks;

@@ -1,4 +1,4 @@
-// Runs in SIMD lanes (methods/trajectory_lanes.hpp) against the single-run path: every metric and
+// Runs in SIMD lanes (methods/closed_form/lanes.hpp) against the single-run path: every metric and
 // every history array bit for bit, for random batches mixing starts, gains, elbows, bounds and
 // tolerances (so runs stop at different samples, or never start), every method and integrator, full
 // and part-filled batches, and the seed's Table 4 cases.
@@ -12,8 +12,8 @@
 #include <set>
 #include <vector>
 
-#include "methods/seed_cases.hpp"
-#include "methods/trajectory_lanes.hpp"
+#include "methods/closed_form/seed_cases.hpp"
+#include "methods/closed_form/lanes.hpp"
 
 using namespace ks;
 

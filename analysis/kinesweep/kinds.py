@@ -53,7 +53,7 @@ STATUS_COLOURS = {"unreachable_start": "#b0b0b0", "singular": "#7b3294", "diverg
                   "no_solution": "#8f8f8f", "out_of_limits": "#fdae61",
                   "max_evaluations": "#b35806", "not_converged": "#fee090", "infeasible": "#4d4d4d",
                   "singular_extension": "#542788"}
-# Seed 000, Table 4 (copied from engine/methods/seed_cases.cpp, checked against it by the tests):
+# Seed 000, Table 4 (copied from engine/methods/closed_form/seed_cases.cpp, checked against it by the tests):
 # case -> (method, k, alpha1A [deg], thesis E [Nm], thesis (|tau1|inf, |tau2|inf, |tau3|inf) [Nm]).
 THESIS_TABLE4 = {
     "1a": ("local_weighted", 0.0, 0.0, 51.03, (82.63, 32.31, 8.77)),

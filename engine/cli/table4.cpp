@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <string>
 
-#include "methods/seed_cases.hpp"
+#include "methods/closed_form/seed_cases.hpp"
 
 namespace ks {
 

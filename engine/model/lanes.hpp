@@ -13,7 +13,7 @@
 // ~150 lines of intrinsics with nothing to audit behind them and no new build dependency.
 //
 // F64x4 exists where __AVX2__ is defined, F64x8 where __AVX512F__ and __AVX512DQ__ are: the lane
-// kernels are compiled in their own translation units with those flags (methods/trajectory_lanes_x*.cpp).
+// kernels are compiled in their own translation units with those flags (methods/closed_form/lanes_x*.cpp).
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>

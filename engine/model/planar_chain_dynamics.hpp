@@ -1,6 +1,6 @@
 #pragma once
 // Dynamics and tip kinematics of a planar chain of N revolute joints (N a compile-time constant), in
-// one pass over fixed-size arrays: the inner loop of a trajectory run (methods/planar_chain_run.hpp).
+// one pass over fixed-size arrays: the inner loop of a trajectory run (methods/chain/planar_run.hpp).
 // Vectors in the base frame; composite inertias about the base origin for M and g (as in
 // model/chain_dynamics.cpp's planar algebra), and c and the tip's J̇ u̇ from the bodies' accelerations
 // at zero joint accelerations, one outward and one inward pass; the chain's constants read once per run into PlanarChainConstants and the frames carried as the cosine and sine of each
@@ -10,7 +10,7 @@
 // direction of joint i's axis along z, i.e. as if every axis were +z. With D = diag(sigma) (D = D^-1),
 // the chain's own quantities are q = D u, tau = D tau_u, M = D M_u D, J = J_u D: the run maps its
 // inputs and outputs exactly (a multiplication by +-1), and every redundancy resolution of
-// methods/chain_resolution.hpp gives the same joint motion in either coordinates.
+// methods/chain/resolution.hpp gives the same joint motion in either coordinates.
 #include <cmath>
 
 #include "model/chain.hpp"

@@ -23,7 +23,7 @@
 #include <thread>
 
 #include "common/human_units.hpp"
-#include "methods/trajectory_lanes.hpp"
+#include "methods/closed_form/lanes.hpp"
 #include "runner/landscape.hpp"
 #include "store/store.hpp"
 

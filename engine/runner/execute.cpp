@@ -15,9 +15,9 @@
 
 #include "ik/chain_ik.hpp"
 #include "ik/solve.hpp"
-#include "methods/chain_trajectory.hpp"
-#include "methods/trajectory.hpp"
-#include "methods/trajectory_lanes.hpp"
+#include "methods/chain/trajectory.hpp"
+#include "methods/base/trajectory.hpp"
+#include "methods/closed_form/lanes.hpp"
 #include "schema/history_arrays.hpp"
 
 namespace ks {

@@ -15,7 +15,7 @@
 #include <ostream>
 #include <sstream>
 
-#include "methods/seed_cases.hpp"
+#include "methods/closed_form/seed_cases.hpp"
 #include "runner/execute.hpp"
 
 namespace ks {

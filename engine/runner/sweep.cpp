@@ -15,9 +15,9 @@
 #include <memory>
 #include <ostream>
 
-#include "methods/global_solve.hpp"
-#include "methods/seed_cases.hpp"
-#include "methods/trajectory_lanes.hpp"
+#include "methods/path_global/slsqp.hpp"
+#include "methods/closed_form/seed_cases.hpp"
+#include "methods/closed_form/lanes.hpp"
 #include "runner/landscape.hpp"
 
 namespace ks {

@@ -11,7 +11,7 @@
 
 #include "common/angles.hpp"
 #include "ik/solve.hpp"
-#include "methods/trajectory.hpp"
+#include "methods/base/trajectory.hpp"
 #include "model/arm.hpp"
 #include "model/chain.hpp"
 #include "store/record.hpp"

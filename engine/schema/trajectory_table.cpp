@@ -2,8 +2,8 @@
 #include <algorithm>
 #include <limits>
 
-#include "methods/sample_metrics.hpp"
-#include "methods/seed_cases.hpp"
+#include "methods/metrics/sample_metrics.hpp"
+#include "methods/closed_form/seed_cases.hpp"
 #include "schema/kind_tables.hpp"
 #include "schema/table_builders.hpp"
 
@@ -20,7 +20,7 @@ const EffectRule kVertexOnly{"method", {"vertex_alpha"}};
 const EffectRule kVertexAngles{"method", {"vertex_alpha", "global_spline"}};
 const EffectRule kGlobalOnly{"method", {"global_spline"}};
 
-/// global_spline's own parameters (methods/path_global_options.hpp).
+/// global_spline's own parameters (methods/base/path_global_options.hpp).
 void global_params(std::vector<ParamDef>& t, const RobotShape& robot) {
   t.push_back(named<Run>("spline", names_of<AlphaSpline>(AlphaSpline::cubic, AlphaSpline::vertex_quintic),
                          "global_spline: alpha(t) as a clamped cubic B-spline (knots) or a quintic per path "

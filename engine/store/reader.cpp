@@ -7,7 +7,7 @@
 
 #include "store/checked_read_vfd.hpp"
 #include "store/h5util.hpp"
-#include "store/journal_vfd.hpp"
+#include "store/journal/vfd.hpp"
 #include "store/reader_impl.hpp"
 #include "store/runs_read.hpp"
 #include "store/store.hpp"

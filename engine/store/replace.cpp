@@ -8,8 +8,8 @@
 #include <cstring>
 #include <filesystem>
 
-#include "store/journal_format.hpp"
-#include "store/journal_vfd.hpp"
+#include "store/journal/format.hpp"
+#include "store/journal/vfd.hpp"
 #include "store/store.hpp"
 
 namespace ks::store {

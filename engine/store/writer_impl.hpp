@@ -11,7 +11,7 @@
 
 #include "store/h5util.hpp"
 #include "store/history_datasets.hpp"
-#include "store/journal_vfd.hpp"
+#include "store/journal/vfd.hpp"
 #include "store/label_columns.hpp"
 #include "store/runs_chunks.hpp"
 #include "store/store.hpp"

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "store/h5util.hpp"
-#include "store/journal_format.hpp"
-#include "store/journal_vfd.hpp"
+#include "store/journal/format.hpp"
+#include "store/journal/vfd.hpp"
 #include "store/label_columns.hpp"
 #include "store/runs_read.hpp"
 #include "store/store.hpp"

@@ -4,7 +4,7 @@
 #include <map>
 #include <set>
 
-#include "methods/seed_cases.hpp"
+#include "methods/closed_form/seed_cases.hpp"
 #include "study/parser.hpp"
 
 namespace ks::study_parse {

@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-#include "methods/trajectory.hpp"
+#include "methods/base/trajectory.hpp"
 #include "model/arm.hpp"
 #include "model/chain.hpp"
 #include "model/chain_plane.hpp"

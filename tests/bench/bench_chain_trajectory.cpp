@@ -1,5 +1,5 @@
-// Time of one run of the generic chain trajectory (methods/chain_trajectory.hpp) beside the closed
-// form's (methods/trajectory.hpp), in one binary: the seed's case 1a (local_weighted, 2001 steps of
+// Time of one run of the generic chain trajectory (methods/chain/trajectory.hpp) beside the closed
+// form's (methods/base/trajectory.hpp), in one binary: the seed's case 1a (local_weighted, 2001 steps of
 // semi-implicit Euler) on the closed-form 3R, on the same arm as a generic planar chain, on a planar
 // 5R and on the 7-DOF arm7.urdf following a square in space (position, and position with the
 // orientation held). The paths are sampled once, as a sweep does. Target: the generic 3R within twice
@@ -8,8 +8,8 @@
 
 #include <algorithm>
 
-#include "methods/chain_trajectory.hpp"
-#include "methods/seed_cases.hpp"
+#include "methods/chain/trajectory.hpp"
+#include "methods/closed_form/seed_cases.hpp"
 #include "robot/urdf.hpp"
 
 using namespace ks;

@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <vector>
 
-#include "methods/seed_cases.hpp"
-#include "methods/trajectory_lanes.hpp"
+#include "methods/closed_form/seed_cases.hpp"
+#include "methods/closed_form/lanes.hpp"
 
 using namespace ks;
 

@@ -3,8 +3,11 @@
 (NAME.hpp, NAME.cpp, with NAME_impl.hpp) a module; `#include "room/name.hpp"` an arrow. Checks that
 the rooms form no circle (an arrow path from a room back to itself); prints the rooms by floor
 (floor 0 includes no other room; a room's floor is one above the highest floor it includes) with
-their arrows, the drawing README shows. --modules also lists the circles of modules (a.cpp includes
-b.hpp while b.cpp includes a.hpp, or longer) and counts them as failures.
+their arrows, the drawing README shows. A room with sub-folders (methods/, store/) is a house of its
+own: each sub-folder a room inside it, the files directly in the room its top floor's room; the same
+check (no circle, so every include goes from a higher floor to a lower one) holds inside it, and
+--draw prints its floors too. --modules also lists the circles of modules (a.cpp includes b.hpp while
+b.cpp includes a.hpp, or longer) and counts them as failures.
 
 usage: /usr/bin/python3 check_rooms.py ENGINE_DIR [--draw] [--modules]
 exit status 0 when there is no circle, 1 otherwise (each circle named).
@@ -19,7 +22,7 @@ INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 
 def graph(engine):
     """(room arrows, module arrows): room -> rooms it includes; module -> modules it includes."""
-    rooms, modules = defaultdict(set), defaultdict(set)
+    rooms, modules, inner = defaultdict(set), defaultdict(set), defaultdict(lambda: defaultdict(set))
     for d, _, files in os.walk(engine):
         for f in files:
             if not f.endswith((".hpp", ".cpp", ".h")):
@@ -28,8 +31,10 @@ def graph(engine):
             if "/" not in rel:
                 continue
             room, module = rel.split("/")[0], re.sub(r"_impl$", "", os.path.splitext(rel)[0])
+            sub = os.path.dirname(rel)
             rooms[room]
             modules[module]
+            inner[room][sub]
             with open(os.path.join(d, f), encoding="utf-8", errors="replace") as fh:
                 for inc in INCLUDE.findall(fh.read()):
                     target = re.sub(r"_impl$", "", os.path.splitext(inc)[0])
@@ -37,9 +42,11 @@ def graph(engine):
                         continue
                     if inc.split("/")[0] != room:
                         rooms[room].add(inc.split("/")[0])
+                    elif os.path.dirname(inc) != sub:
+                        inner[room][sub].add(os.path.dirname(inc))
                     if target != module:
                         modules[module].add(target)
-    return rooms, modules
+    return rooms, modules, {r: dict(g) for r, g in inner.items() if len(g) > 1}
 
 
 def circles(arrows):
@@ -91,13 +98,16 @@ def floors(arrows):
 
 def main():
     engine = sys.argv[1]
-    rooms, modules = graph(engine)
-    bad = circles(rooms) + (circles(modules) if "--modules" in sys.argv else [])
+    rooms, modules, inner = graph(engine)
+    bad = circles(rooms) + [c for g in inner.values() for c in circles(g)]
+    bad += circles(modules) if "--modules" in sys.argv else []
     if "--draw" in sys.argv:
-        level = floors(rooms)
-        for f in sorted(set(level.values()), reverse=True):
-            names = sorted(r for r in rooms if level[r] == f)
-            print(f"floor {f}: " + "   ".join(f"{r} -> {', '.join(sorted(rooms[r])) or '(nothing)'}" for r in names))
+        for title, g in [("engine", rooms)] + [(r + "/", inner[r]) for r in sorted(inner)]:
+            print(f"{title}:")
+            level = floors(g)
+            for f in sorted(set(level.values()), reverse=True):
+                names = sorted(r for r in g if level[r] == f)
+                print(f"  floor {f}: " + "   ".join(f"{r} -> {', '.join(sorted(g[r])) or '(nothing)'}" for r in names))
     for c in bad:
         print("circle: " + " -> ".join(c + [c[0]]), file=sys.stderr)
     return 1 if bad else 0

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The objects of a lane kernel (engine/methods/trajectory_lanes_x4.cpp, _x8.cpp: built with -mavx2,
+"""The objects of a lane kernel (engine/methods/closed_form/lanes_x4.cpp, _x8.cpp: built with -mavx2,
 or -mavx512f -mavx512dq) must define no inline function or template instance that another object may
 define too: the linker keeps one copy of such (weak) symbols, and if it kept this object's copy, code
 built for older processors would run instructions they lack. Every weak function defined here must be

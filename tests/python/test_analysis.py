@@ -260,8 +260,8 @@ class AnalysisTest(unittest.TestCase):
             E = f["runs"]["E"][()]
         self.assertEqual(d["cases"], preset)
         np.testing.assert_array_equal(d["kinesweep"], E)
-        # The thesis' values: parsed from the engine's own table (engine/methods/seed_cases.cpp).
-        with open(os.path.join(ROOT, "engine", "methods", "seed_cases.cpp")) as f:
+        # The thesis' values: parsed from the engine's own table (engine/methods/closed_form/seed_cases.cpp).
+        with open(os.path.join(ROOT, "engine", "methods", "closed_form", "seed_cases.cpp")) as f:
             src = f.read()
         thesis = {m.group(1): float(m.group(2)) for m in
                   re.finditer(r'\{"(\w+)",\s*"[^"]*",\s*\w+,\s*[-\d.]+,\s*[-\d.]+,\s*(?:\w+|\{[^}]*\}),\s*([\d.]+)', src)}
