@@ -184,12 +184,14 @@ def reduce_grid(ls, args):
     good = 0  # ok / converged
     if metric == "convergence":
         z = np.nanmean(arrange(ls.metrics[ls.statuses[0]]), axis=3)
-        cat = np.full(z.shape, -1)
+        cat = np.full(z.shape, -1, dtype=np.int8)
         if multi:
             notes.append(f"mean over {', '.join(multi)}")
         reduce = "mean" if multi else None
     else:
-        vals = np.where(status == good, arrange(ls.metrics[metric]), np.nan)
+        grid = ls.metrics.read(metric) if hasattr(ls.metrics, "read") else ls.metrics[metric]  # not kept
+        vals = np.where(status == good, arrange(grid), np.nan)
+        del grid
         if vals.shape[3] == 1:  # nothing to reduce: the grid itself (no copy)
             z = vals[..., 0]
         else:
@@ -219,7 +221,7 @@ def failed_category(status, none, good):
     """Per cell (panels x ny x nx) of `status` (same x cells reduced): -1 where `none` is false (the
     cell has a value), else the most common failed status of its runs (the smallest code on a tie),
     -2 when it has no run at all."""
-    cat = np.full(none.shape, -1)
+    cat = np.full(none.shape, -1, dtype=np.int8)  # status codes are small
     if not none.any():
         return cat
     st = status[none]  # cells without a value x their runs
@@ -337,7 +339,8 @@ def main(argv=None):
         if metric == "convergence" and has_values:
             ax.plot([], [], ls="none", label=f"mean convergence fraction {np.nanmean(z):.0%}")
         elif has_values:
-            i, j = np.unravel_index(np.nanargmin(z), z.shape)
+            # nanargmin's first minimum, without its copy of the grid
+            i, j = np.unravel_index(int(np.flatnonzero(z == np.nanmin(z))[0]), z.shape)
             best = {"value": z[i, j], "x": xa.values[j], "y": ya.values[i], "i": int(i), "j": int(j)}
             xs = xa.labels[j] if xa.categorical else f"{ksplot.fmt_num(xa.values[j])}{'°' if xa.unit == 'deg' else ''}"
             ys = ya.labels[i] if ya.categorical else f"{ksplot.fmt_num(ya.values[i])}{'°' if ya.unit == 'deg' else ''}"
@@ -372,9 +375,6 @@ def main(argv=None):
     cb.set_label(label)
     if args.log:
         ksplot.log_colorbar_ticks(cb, norm.vmin, norm.vmax)
-    fig.canvas.draw()  # the colour bar's ticks, as drawn
-    cticks = [t for t in cb.ax.yaxis.get_majorticklocs() if norm.vmin <= t <= norm.vmax]
-    clabels = [t.get_text() for t in cb.ax.yaxis.get_majorticklabels() if t.get_text()]
     what = ls.label(metric)
     sub = "; ".join(d["notes"] + ([f"one panel per {d['facet']}"] if d["facet"] else []))
     title = args.title or (f"{what} over {xa.name} × {ya.name} — block {ls.block}{(' (' + sub + ')') if sub else ''}"
@@ -385,7 +385,14 @@ def main(argv=None):
         if args.print_data:
             pan["masked_status"] = [[(statuses[c] if c >= 0 else None) for c in row] for row in cat]
     first = panels[0]
-    return ksplot.finish(fig, args, f"landscape_{ls.block}_{metric}",
+    # Saved first: the colour bar's ticks are read as the saving drew them (no draw of its own).
+    out = ksplot.save(fig, args, f"landscape_{ls.block}_{metric}")
+    if not args.print_data:
+        print(out)
+        return 0
+    cticks = [t for t in cb.ax.yaxis.get_majorticklocs() if norm.vmin <= t <= norm.vmax]
+    clabels = [t.get_text() for t in cb.ax.yaxis.get_majorticklabels() if t.get_text()]
+    ksplot.print_json(
         {"file": args.file, "block": ls.block, "metric": metric, "unit": unit,
          "reduce": d["reduce"], "fixed": d["fixed"], "facet": d["facet"], "levels": levels,
          "x": {"name": xa.name, "unit": xa.unit, "values": xa.values, "labels": xa.labels, "log": xlog},
@@ -393,7 +400,8 @@ def main(argv=None):
          "z": first["z"], "masked_status": first.get("masked_status"), "best": first["best"], "panels": panels,
          "draw_stride": step,
          "thesis": thesis, "optimization": opt, "xscale": axs.flat[0].get_xscale(),
-         "yscale": axs.flat[0].get_yscale(), "colorbar": {"ticks": cticks, "labels": clabels}})
+         "yscale": axs.flat[0].get_yscale(), "colorbar": {"ticks": cticks, "labels": clabels}, "output": out})
+    return 0
 
 
 def thesis_overlay(ax, method, metric, label, xa, patheffects):
