@@ -9,6 +9,7 @@ from kinesweep.report_page import esc, fmt, table
 
 
 POINT_READ_ROWS = 4096  # up to this many rows are read by index; more, as whole columns
+SCAN_ROWS = 1 << 16     # rows of the file per slice when a column is scanned (RunsView.chunks)
 
 
 class RunsView:
@@ -62,6 +63,25 @@ class RunsView:
         if self.units.get(c) == "deg" and v.dtype.kind == "f":
             v = v * RAD2DEG
         return v
+
+    def chunks(self, c, rows, size=SCAN_ROWS):
+        """Column c at ascending `rows`, as values() gives them, a piece at a time: each piece the rows
+        within `size` consecutive rows of the file, read as one slice (memory: one slice)."""
+        d = self.g[c]
+        rows = np.asarray(rows, dtype=np.int64)
+        text = enum_labels(d) is not None or d.dtype.kind in "OSU"
+        deg = self.units.get(c) == "deg"
+        lo = 0
+        while lo < len(rows):
+            start = int(rows[lo])
+            hi = int(np.searchsorted(rows, start + size))
+            v = d[start:int(rows[hi - 1]) + 1][rows[lo:hi] - start]
+            if text:
+                v = text_values(d, v)
+            elif deg and v.dtype.kind == "f":
+                v = v * RAD2DEG
+            yield v
+            lo = hi
 
     def value(self, c, row):
         return self.values(c, [row])[0]
@@ -154,30 +174,47 @@ def held(v):
 def varying_parameters(view, block, rows):
     """The block's parameters (of its kind) that take more than one value over its done rows, and the
     fixed ones; parameters without a value in any of the rows are neither. (Floats compare rounded to
-    12 decimals; NaN is no value.)"""
+    12 decimals; NaN is no value.) Read a slice at a time; a parameter stops being read at the first
+    slice that shows two values."""
     kind = view.kind(block)
     varying, fixed = [], []
     for c in view.res.parameters(kind or None):
-        v = view.values(c, rows)
-        if len(v) and not held(v).any():
-            continue
-        if v.dtype.kind == "f":
-            f = np.round(v[np.isfinite(v)], 12)
-            varies = f.size > 1 and f.min() != f.max()
-        else:
-            varies = len(v) > 1 and not np.all(v == v[0])
-        (varying if varies else fixed).append(c)
+        if _varies(view, c, rows):
+            varying.append(c)
+        elif _held(view, c, rows):
+            fixed.append(c)
     return varying, fixed
 
 
+def _varies(view, c, rows):
+    first = lo = hi = None
+    for v in view.chunks(c, rows):
+        if v.dtype.kind == "f":
+            f = np.round(v[np.isfinite(v)], 12)
+            if f.size:
+                lo = f.min() if lo is None else min(lo, f.min())
+                hi = f.max() if hi is None else max(hi, f.max())
+                if lo != hi:
+                    return True
+        elif len(v):
+            first = v[0] if first is None else first
+            if not np.all(v == first):
+                return True
+    return False
+
+
+def _held(view, c, rows):
+    """Whether the column holds a value in one of `rows` (or `rows` is empty), read until it does."""
+    if not len(rows):
+        return True
+    return any(held(v).any() for v in view.chunks(c, rows))
+
+
 def shown_metrics(view, block, rows):
-    """The metrics of the block's kind that hold a value in one of `rows` at least."""
+    """The metrics of the block's kind that hold a value in one of `rows` at least (each read until
+    it does)."""
     kind = view.kind(block)
-    out = []
-    for c in view.res.metrics(kind or None):
-        if held(view.values(c, rows)).any():
-            out.append(c)
-    return out
+    return [c for c in view.res.metrics(kind or None) if len(rows) and _held(view, c, rows)]
 
 
 def best_section(view, n_best):
