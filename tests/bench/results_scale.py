@@ -2,7 +2,7 @@
 IK basin study (histories none), each command against a plain h5py read of the columns it touches,
 in the same script.
 
-usage: /usr/bin/python3 tests/bench/results_scale.py build/kinesweep [--before OLD_KINESWEEP]
+usage: /usr/bin/python3 tests/bench/results_scale.py build/kinesweep [--before OLD_KINESWEEP] [--analysis-before DIR]
            [--runs 100000 1000000] [--kinds trajectory ik] [--repeat 3] [--mpi] [--workdir DIR] [--keep]
 
 For each study kind and run count: `kinesweep run` (wall time, peak RSS, file bytes per run;
@@ -15,7 +15,10 @@ just written, repeated --repeat times (min and median of each):
   info
   pandas  kinesweep.read.open_results(F).to_pandas() (all columns; timed inside the interpreter;
           peak RSS of that interpreter, pandas imported; the frame's bytes)
-  plot    python3 -m kinesweep.plot_landscape F, and report: kinesweep.report F (wall, peak RSS, output size)
+  plot    python3 -m kinesweep.plot_landscape F, and report: kinesweep.report F (wall, peak RSS, output size),
+          each alternated with a fresh interpreter's h5py read of the datasets it draws (plot: the
+          landscape grid of the default metric and status_code; report: /runs block, status, done,
+          run_id and the metric, and every dataset of the landscape), the ratio over that read
   merge   (--mpi, trajectory) `mpirun -np 2 kinesweep run` with one thread per rank: the merge time it
           prints against a `cp` of its two shard files (hard-linked as they appear, so the copy reads
           the shards as the merge found them; coreutils' cp copies inside the kernel) and against `dd
@@ -71,6 +74,14 @@ q0_1 = {{ from = -180, to = 180, count = {a} }}
 q0_2 = {{ from = -180, to = 180, count = {b} }}
 """
 METRIC = {"trajectory": "E", "ik": "iterations"}
+# The plain read a plot or the report is measured against: a fresh interpreter importing h5py and
+# reading the datasets it draws whole (the commands start an interpreter too).
+READ = """
+import sys, h5py
+with h5py.File(sys.argv[1], "r") as f:
+    for name in sys.argv[2:]:
+        f[name][()]
+"""
 
 
 def timed(cmd, env=None):
@@ -174,6 +185,9 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--workdir")
     ap.add_argument("--keep", action="store_true", help="keep the files written")
+    ap.add_argument("--analysis-before", metavar="DIR",
+                    help="also time plot_landscape and the report of another analysis/ directory (PYTHONPATH=DIR), "
+                         "alternated with this one's")
     ap.add_argument("--mpi", action="store_true", help="also time the merge of `mpirun -np 2` (trajectory) against cp")
     args = ap.parse_args()
     work = args.workdir or tempfile.mkdtemp(prefix="ks_scale_")
@@ -244,16 +258,37 @@ def main():
                 t, r = timed([sys.executable, "-c", PANDAS, out])
                 rss.append(r)
                 report("pandas", ours, base, rss, f"   frame {frame / 1e6:.0f} MB (peak/frame {max(rss) / frame:.2f})")
+                with h5py.File(out, "r") as f:
+                    block = list(f["landscapes"])[0]
+                    grids = [f"landscapes/{block}/{m}" for m in f["landscapes"][block]]
+                drawn = {"plot": [f"landscapes/{block}/{'E' if kind == 'trajectory' else 'converged'}",
+                                  f"landscapes/{block}/status_code"],
+                         "report": [f"runs/{c}" for c in ("block", "status", "done", "run_id", metric)] + grids}
                 for name, command in (("plot", "plot_landscape"), ("report", "report")):
-                    ours, rss = [], []
+                    ours, rss, base, base_rss, old, old_rss = [], [], [], [], [], []
                     page = out + "." + name + (".png" if name == "plot" else ".html")
-                    for _ in range(args.repeat):
+                    for _ in range(args.repeat):  # alternated with the plain read of what it draws
                         t, r = timed([sys.executable, "-m", "kinesweep." + command, out, "-o", page], env=ANALYSIS_ENV)
                         ours.append(t)
                         rss.append(r)
-                    mn, md = stats(ours)
+                        t, r = timed([sys.executable, "-c", READ, out, *drawn[name]])
+                        base.append(t)
+                        base_rss.append(r)
+                        if args.analysis_before:
+                            t, r = timed([sys.executable, "-m", "kinesweep." + command, out, "-o", page],
+                                         env=dict(os.environ, PYTHONPATH=args.analysis_before))
+                            old.append(t)
+                            old_rss.append(r)
+                    (mn, md), (bmn, bmd) = stats(ours), stats(base)
                     print(f"  {name:<8} {mn:8.2f} s (median {md:6.2f})   peak {max(rss) / 1e6:7.0f} MB   "
-                          f"output {os.path.getsize(page) / 1e6:.2f} MB", flush=True)
+                          f"output {os.path.getsize(page) / 1e6:.2f} MB   h5py read of what it draws "
+                          f"({len(drawn[name])} datasets, a fresh interpreter) {bmn:.2f} s (median {bmd:.2f}, "
+                          f"peak {max(base_rss) / 1e6:.0f} MB)   ratio {mn / bmn:.2f} (median {md / bmd:.2f})",
+                          flush=True)
+                    if old:
+                        (omn, omd) = stats(old)
+                        print(f"  {'before':<8} {omn:8.2f} s (median {omd:6.2f})   peak {max(old_rss) / 1e6:7.0f} MB   "
+                              f"ratio {omn / bmn:.2f} (median {omd / bmd:.2f})   ({args.analysis_before})", flush=True)
                     os.remove(page)
                 if args.mpi and kind == "trajectory":
                     mpi_merge(ks, study, out, args)
