@@ -13,25 +13,12 @@
 #include "schema/params.hpp"
 #include "store/store.hpp"
 #include "verify/gci.hpp"
+#include "cli/kind_meaning.hpp"
 
 namespace ks::cli {
 
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-/// The list attribute `name` ("good_statuses", "ranking") of kind `kind` in the file's /kinds; for a
-/// file from before /kinds, this engine's declaration of it (schema/params.hpp); empty when unknown.
-std::vector<std::string> kind_list(const store::StoreMeta& meta, const std::string& kind, const std::string& name) {
-  for (const store::KindMeta& k : meta.kinds)
-    if (k.name == kind)
-      for (const auto& [attr, values] : k.lists)
-        if (attr == name) return values;
-  BlockKind b;
-  if (!meta.kinds.empty() || !parse(kind, b)) return {};
-  if (name == "good_statuses") return {std::string(statuses(b).front())};
-  if (name == "ranking") return {std::string(ranking(b).objective)};
-  return {};
-}
 
 /// The text of row `r` of column `c` (numbers as format_double, missing as "").
 std::string text(const RunsColumn* c, std::int64_t r) {
@@ -105,8 +92,8 @@ int run_compare(const CompareArgs& args) {
       if (c.role == Role::metric && c.type != CellType::str && c.applies_to(kind)) numeric.push_back(c.name);
     std::vector<std::string> wanted = args.metrics;
     if (wanted.empty()) {
-      const auto r = kind_list(t.meta, kind, "ranking");
-      if (!r.empty()) wanted.push_back(r.front());
+      const std::string objective = kind_meaning(t.meta, kind).objective();
+      if (!objective.empty()) wanted.push_back(objective);
     }
     for (const std::string& m : wanted) {
       if (std::find(numeric.begin(), numeric.end(), m) != numeric.end()) metrics[kind].push_back(m);
@@ -145,8 +132,7 @@ int run_compare(const CompareArgs& args) {
       const std::string kind = p.kind(r);
       const auto m = metrics.find(kind);
       if (m == metrics.end()) continue;
-      const auto good = kind_list(p.meta, kind, "good_statuses");
-      if (std::find(good.begin(), good.end(), text(status, r)) == good.end()) continue;
+      if (!kind_meaning(p.meta, kind).is_good(text(status, r))) continue;
       std::string end;
       if (kind == to_string(BlockKind::trajectory))
         end = end_condition(text(method, r), text(spline, r), text(end_state, r), text(local_end, r));

@@ -10,6 +10,7 @@
 #include <map>
 #include <sstream>
 
+#include "cli/kind_meaning.hpp"
 #include "cli/query_util.hpp"
 #include "schema/params.hpp"
 #include "runner/verify_best.hpp"
@@ -141,10 +142,7 @@ void print_optimizations(store::ResultsReader& reader, const RunsTable& t, std::
       // The kind's key metrics (E_M only when the objective names it), a peak torque followed by the
       // joints' own (tau<i>_inf); else every metric of the run.
       std::vector<std::string> parts;
-      BlockKind kind{};
-      if (parse(o.kind, kind))
-        for (std::string_view key : key_metrics(kind)) {
-          const std::string k(key);
+      for (const std::string& k : kind_meaning(t.meta, o.kind).key_metrics) {
           const double* v = metric(k);
           if (!v || (k == "E_M" && o.objective.find(k) == std::string::npos)) continue;
           std::string s = k + " = " + with_unit(k, *v);
@@ -244,8 +242,10 @@ int run_info(const InfoArgs& args) {
   t.load_kind_columns();
   for (RunsColumn& c : t.cols) {
     if (&c == block || &c == status || c.role == Role::parameter) c.loaded = true;
-    for (const BlockKind k : block_kinds())
-      if (c.role == Role::metric && (c.name == ranking(k).objective || c.name == ranking(k).tie)) c.loaded = true;
+    for (const std::string& k : declared_kinds(m)) {
+      const KindMeaning km = kind_meaning(m, k);
+      if (c.role == Role::metric && (c.name == km.objective() || c.name == km.tie())) c.loaded = true;
+    }
   }
   std::vector<bool> loaded;
   for (const RunsColumn& c : t.cols) loaded.push_back(c.loaded);
@@ -290,14 +290,15 @@ int run_info(const InfoArgs& args) {
       for (std::size_t c = 0; c < p.cols.size(); ++c)
         if (!b.varies[c] && p.cols[c].role == Role::parameter && !same_value(p.cols[c], r, b.first.cols[c], 0))
           b.varies[c] = true;
-      // Best rows: the kind's ranking (ranking(kind)) among its good runs.
-      BlockKind kind;
-      if (!b.ranked && !b.kind.empty() && parse(b.kind, kind)) {
-        b.ranked = true;
-        const Ranking rank = ranking(kind);
-        b.good = std::string(statuses(kind).front());
-        b.key = metric_column(p, b.kind, rank.objective);
-        b.tie = rank.tie.empty() ? nullptr : metric_column(p, b.kind, rank.tie);
+      // Best rows: the kind's ranking among its good runs, as the file declares them.
+      if (!b.ranked && !b.kind.empty()) {
+        const KindMeaning km = kind_meaning(m, b.kind);
+        if (km.known && !km.objective().empty()) {
+          b.ranked = true;
+          b.good = km.good();
+          b.key = metric_column(p, b.kind, km.objective());
+          b.tie = km.tie().empty() ? nullptr : metric_column(p, b.kind, km.tie());
+        }
       }
       if (b.ranked && st == b.good) {
         const RunsColumn* key = b.key;
@@ -357,22 +358,22 @@ int run_info(const InfoArgs& args) {
   // Best rows per block: the candidates' rows read back by run id.
   os << "\nbest rows per block (the lowest objective among the runs of the good status, ties by the\n"
         "second metric, then run id:";
-  for (const BlockKind k : block_kinds()) {
-    const Ranking rank = ranking(k);
-    os << (k == block_kinds().front() ? " " : "; ") << to_string(k) << ": " << rank.objective << " among "
-       << statuses(k).front() << " runs" << (rank.tie.empty() ? "" : ", then " + std::string(rank.tie));
+  const std::vector<std::string> kinds = declared_kinds(m);
+  for (const std::string& k : kinds) {
+    const KindMeaning km = kind_meaning(m, k);
+    os << (k == kinds.front() ? " " : "; ") << k << ": " << km.objective() << " among " << km.good() << " runs"
+       << (km.tie().empty() ? "" : ", then " + km.tie());
   }
   os << ")\n";
   for (const auto& b : blocks) {
     if (b.done == 0 || b.name == "(pending)") continue;
-    BlockKind kind;
-    if (!parse(b.kind, kind)) continue;  // no ranking defined for another kind
-    const Ranking rank = ranking(kind);
-    const RunsColumn* key = metric_column(t, b.kind, rank.objective);
-    const RunsColumn* tie = rank.tie.empty() ? nullptr : metric_column(t, b.kind, rank.tie);
+    const KindMeaning km = kind_meaning(m, b.kind);
+    if (!km.known || km.objective().empty()) continue;  // no ranking declared for the kind
+    const RunsColumn* key = metric_column(t, b.kind, km.objective());
+    const RunsColumn* tie = km.tie().empty() ? nullptr : metric_column(t, b.kind, km.tie());
     if (!key || !status) continue;
     if (b.good_runs == 0) {
-      os << "  " << b.name << ": no " << statuses(kind).front() << " run\n";
+      os << "  " << b.name << ": no " << km.good() << " run\n";
       continue;
     }
     std::vector<std::int64_t> ids;

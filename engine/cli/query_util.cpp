@@ -1,4 +1,5 @@
 #include "cli/query_util.hpp"
+#include "cli/kind_meaning.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -58,13 +59,12 @@ void RunsTable::load_kind_columns() {
 }
 
 std::vector<const RunsColumn*> RunsTable::key_metrics(const std::string& kind) const {
-  BlockKind k{};
-  const bool known = parse(kind, k);
+  const KindMeaning km = kind_meaning(meta, kind);
+  const auto& keys = km.key_metrics;
   std::vector<const RunsColumn*> out;
   for (const auto& c : cols) {
     if (c.role != Role::metric || !c.applies_to(kind)) continue;
-    const auto keys = known ? ks::key_metrics(k) : std::span<const std::string_view>{};
-    if (known ? std::count(keys.begin(), keys.end(), c.name) > 0 : out.size() < 3) out.push_back(&c);
+    if (km.known ? std::count(keys.begin(), keys.end(), c.name) > 0 : out.size() < 3) out.push_back(&c);
   }
   return out;
 }

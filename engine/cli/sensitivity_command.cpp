@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "cli/kind_meaning.hpp"
 #include "cli/query_util.hpp"
 #include "schema/params.hpp"
 #include "sensitivity/sobol_indices.hpp"
@@ -34,10 +35,12 @@ std::string cell_text(const Cell& c) {
   return std::get<std::string>(c);
 }
 
-BlockKind kind_of(const std::string& name) {
-  for (BlockKind k : block_kinds())
-    if (to_string(k) == name) return k;
-  throw std::runtime_error("unknown run kind '" + name + "' in /designs");
+/// The meaning of a design's run kind, as the file declares it (cli/kind_meaning.hpp).
+KindMeaning meaning_of(const store::ResultsReader& reader, const std::string& name) {
+  KindMeaning km = kind_meaning(reader.meta(), name);
+  if (!km.known || km.good().empty() || km.objective().empty())
+    throw std::runtime_error("unknown run kind '" + name + "' in /designs");
+  return km;
 }
 
 /// Runs of the design with a status other than the good one.
@@ -63,7 +66,7 @@ void analyse(store::ResultsReader& reader, const store::DesignMeta& d, const std
   for (std::int64_t s : d.sizes) runs *= s;
   const auto done = reader.done_mask(d.first_run, runs);
   const auto status = reader.read_str("status", d.first_run, runs);
-  const std::string good(statuses(kind_of(d.kind)).front());
+  const std::string good = meaning_of(reader, d.kind).good();
   // strides of the mixed-radix local index (last dimension fastest)
   const std::size_t nd = d.sizes.size(), dim = static_cast<std::size_t>(d.dim);
   std::vector<std::int64_t> stride(nd, 1);
@@ -213,7 +216,7 @@ int run_sensitivity(const SensitivityArgs& args) {
   for (const auto& d : designs) {
     if (!args.block.empty() && d.block != args.block) continue;
     std::vector<std::string> metrics = args.metrics;
-    if (metrics.empty()) metrics.emplace_back(ranking(kind_of(d.kind)).objective);
+    if (metrics.empty()) metrics.emplace_back(meaning_of(reader, d.kind).objective());
     std::vector<std::string> numeric;
     for (const ColumnSpec& c : reader.columns())
       if (c.role == Role::metric && c.type != CellType::str && ("," + c.kinds + ",").find("," + d.kind + ",") != std::string::npos)

@@ -117,6 +117,59 @@ class Kinds(TempDirTest):
             self.assertEqual(res.kind_meaning("nonsense"), {})
 
 
+    def copy_with_kinds(self, name, edit):
+        """A copy of the study's file whose /kinds attributes `edit` changes (a file written by an
+        engine that declares its kinds otherwise)."""
+        path = os.path.join(self.dir, name)
+        with open(self.out, "rb") as a, open(path, "wb") as b:
+            b.write(a.read())
+        with h5py.File(path, "r+") as f:
+            edit(f["kinds"])
+        return path
+
+    def test_the_commands_read_a_kinds_meaning_from_the_file(self):
+        def rank_by_peak_torque(kinds):
+            t = kinds["trajectory"]
+            t.attrs.create("ranking", ["tau_inf"], dtype=h5py.string_dtype())
+            t.attrs.create("key_metrics", ["tau_inf", "min_manipulability"], dtype=h5py.string_dtype())
+        other = self.copy_with_kinds("other.h5", rank_by_peak_torque)
+        from kinesweep import read as ksread
+        with ksread.open_results(other) as res:
+            df = res.to_pandas()
+        ok = df[(df.block == "traj") & (df.status == "ok")]
+        tau = dict(zip(ok.run_id, ok.tau_inf))
+        rows = list(tau)
+        self.assertNotEqual(min(rows, key=lambda i: (tau[i], i)), ok.run_id[ok.E.idxmin()])  # the two rankings differ
+        ranked = sorted(rows, key=lambda i: (tau[i], i))
+        self.assertGreater(len(ranked), 1)
+        info = subprocess.run([KS, "info", other, "--best", "1"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(info.returncode, 0, info.stderr)
+        self.assertIn("trajectory: tau_inf among ok runs", info.stdout)
+        self.assertNotIn("trajectory: E among", info.stdout)
+        # the best row of the block is the lowest tau_inf among its ok runs (not the lowest E)
+        best_rows = [l.split() for l in info.stdout.splitlines() if l.strip().startswith("traj ") and " run " in l]
+        self.assertEqual([int(r[2]) for r in best_rows], ranked[:1], info.stdout)
+        self.assertIn("tau_inf =", " ".join(" ".join(r) for r in best_rows))
+        # compare's default metric is the file's ranking objective
+        cmp = subprocess.run([KS, "compare", other, "--format", "csv"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(cmp.returncode, 0, cmp.stderr)
+        self.assertIn("tau_inf", cmp.stdout)
+        self.assertNotIn(",E,", cmp.stdout)
+        # query's compact table shows the file's key metrics of the kind
+        q = subprocess.run([KS, "query", other, "-w", "block=traj"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(q.returncode, 0, q.stderr)
+        header = q.stdout.splitlines()[0]
+        self.assertIn("min_manipulability", header)
+        self.assertNotIn("E [Nm]", header)
+
+        # a status the file declares good is counted so; one it does not is not
+        def nothing_good(kinds):
+            kinds["trajectory"].attrs.create("good_statuses", ["no_such_status"], dtype=h5py.string_dtype())
+        none = self.copy_with_kinds("none.h5", nothing_good)
+        info = subprocess.run([KS, "info", none], capture_output=True, text=True, timeout=60)
+        self.assertEqual(info.returncode, 0, info.stderr)
+        self.assertIn("traj: no no_such_status run", info.stdout)
+
     def test_every_metric_has_one_display_name_that_the_readers_use(self):
         from kinesweep import read as ksread
         from kinesweep import kinds as kstypes
