@@ -31,7 +31,7 @@ std::vector<std::vector<double>> saltelli_draws(std::uint64_t seed, std::uint64_
   const std::uint64_t rows = count * (d + 2);
   std::vector<std::vector<double>> out(d, std::vector<double>(rows));
   for (std::size_t i = 0; i < d; ++i) {
-    const auto [from, to] = ranges[i];
+    const double from = ranges[i].first, to = ranges[i].second;  // named, not bound: clang 14 captures no structured binding
     const auto at = [&](double u) { return from + (to - from) * u; };
     std::vector<double>& v = out[i];
     for (std::uint64_t j = 0; j < count; ++j) {
