@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from kinesweep.kinds import STATUS_COLOURS  # noqa: F401 (used below)
-from kinesweep.report_page import esc, fmt
+from kinesweep.report_page import Rounded, esc, fmt
 
 MAX_FRAMES = 24      # facets / dropdown entries per figure; further dims are held at the best cell
 MAX_FACETS = 4       # up to this many frames side by side, more in a dropdown
@@ -285,8 +285,9 @@ def landscape_figure(ls, cap):
 
 def hover_data(values, cells):
     """Per-cell hover values (a list per row of [v0, v1, ...]) where `cells` is true, null elsewhere
-    (cells without hover text), floats to 5 significant digits as the hover shows them."""
-    out = []
+    (cells without hover text), floats to 5 significant digits as the hover shows them (a Rounded
+    list: the page keeps them as they are, 7 digits of them being the same numbers)."""
+    out = Rounded()
     stacked = np.stack(values, axis=-1) if values else np.zeros(cells.shape + (0,))
     for row, keep in zip(stacked, cells):
         out.append([[float(f"{x:.5g}") if math.isfinite(x) else None for x in cell] if k else None

@@ -162,6 +162,11 @@ def table(columns, rows, css_id=None, text_columns=()):
     return "".join(out)
 
 
+class Rounded(list):
+    """A list that _clean passes as it is: JSON-ready already (floats rounded to at most 7 significant
+    digits, None for NaN, nested plain lists), e.g. a figure's hover values at 5 digits."""
+
+
 def _floats(values):
     """A list of Python floats to 7 significant digits, NaN and infinities as None."""
     isfinite = math.isfinite
@@ -170,6 +175,8 @@ def _floats(values):
 
 def _clean(o):
     t = type(o)
+    if t is Rounded:
+        return o
     if t is float:
         return float(f"{o:.7g}") if math.isfinite(o) else None
     if t is list or t is tuple:
