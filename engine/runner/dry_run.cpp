@@ -25,6 +25,7 @@
 #include "common/human_units.hpp"
 #include "methods/closed_form/lanes.hpp"
 #include "runner/landscape.hpp"
+#include "runner/study_meta.hpp"
 #include "store/store.hpp"
 
 namespace ks {

@@ -23,6 +23,7 @@
 
 #include "common/shell_word.hpp"
 #include "runner/mpi_work.hpp"
+#include "runner/study_meta.hpp"
 #include "runner/sweep_backend.hpp"
 
 namespace ks {

@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "runner/run_identity.hpp"
-#include "runner/run_study.hpp"
+#include "runner/study_meta.hpp"
 
 namespace ks {
 

@@ -8,7 +8,10 @@
 #include <ostream>
 #include <string>
 
-#include "runner/run_study.hpp"
+#include "runner/run_request.hpp"
+#include "schema/history_arrays.hpp"
+#include "store/store.hpp"
+#include "study/study.hpp"
 
 namespace ks {
 
@@ -70,6 +73,13 @@ OpenedResults open_results(const Study& study, const StudySchema& schema, const 
                            bool adopt_recorded);
 
 /// The shards of a distributed run of `output` that exist (`<out>.rank<digits>.h5`), by rank.
+/// The history policy a resume of the file `path`, which records `recorded` ("" in files from
+/// before it was recorded), writes its runs with: the recorded one when `adopt` (no --histories
+/// given) and it parses, else `asked`, which must then equal the recorded one (a file never mixes
+/// two policies). Throws store::StoreError naming both policies and the option that resumes.
+HistoryPolicy resume_histories(const std::string& path, const std::string& recorded, const HistoryPolicy& asked,
+                               bool adopt);
+
 std::vector<std::string> find_shards(const std::string& output);
 
 /// Throws store::StoreError when `files` new results files (a file and its shards) of `runs` rows

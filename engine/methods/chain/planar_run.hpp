@@ -7,7 +7,8 @@
 // joint counts a planar task can use (planar_position needs N > 2).
 #include <optional>
 
-#include "methods/chain/trajectory.hpp"
+#include "methods/chain/start.hpp"
+#include "methods/chain/task.hpp"
 #include "task/quintic_path.hpp"
 
 namespace ks {

@@ -32,20 +32,6 @@ constexpr NameTable<TaskSpace, 4> kTaskSpaces{{{TaskSpace::planar_position, "pla
 std::string_view to_string(TaskSpace s) { return name_of(kTaskSpaces, s); }
 bool parse(std::string_view n, TaskSpace& out) { return value_of(kTaskSpaces, n, out); }
 
-void ChainHistory::prepare(std::size_t samples, int joints, int position_rows) {
-  const Eigen::Index n = static_cast<Eigen::Index>((samples + stride - 1) / stride + 1);
-  if (t.size() < n || q.rows() != joints || x.rows() != position_rows) {
-    t.resize(n);
-    q.resize(joints, n);
-    qd.resize(joints, n);
-    qdd.resize(joints, n);
-    tau.resize(joints, n);
-    x.resize(position_rows, n);
-    alpha.resize(n);
-  }
-  size = 0;
-}
-
 namespace {
 
 enum class Resolution { weighted, unweighted, nonredundant };

@@ -1,6 +1,6 @@
 // The ksjournal redo journal on disk: its records, the check that it belongs to the file, recovery
-// after a crash, and what readers use (how to open the file, the consistency stamp) (see journal_format.hpp, journal_vfd.hpp, FORMAT.md "Crash safety"). The HDF5 driver
-// that writes it is journal_vfd.cpp.
+// after a crash, and what readers use (how to open the file, the consistency stamp) (see format.hpp, vfd.hpp, FORMAT.md "Crash safety"). The HDF5 driver
+// that writes it is vfd.cpp.
 #include "store/journal/format.hpp"
 
 #include <fcntl.h>
@@ -13,7 +13,6 @@
 #include <cerrno>
 #include <cstring>
 
-#include "store/journal/vfd.hpp"
 
 namespace ks::store::detail {
 namespace journal {
