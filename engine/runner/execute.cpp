@@ -23,8 +23,6 @@
 namespace ks {
 
 namespace {
-const double kNaN = std::numeric_limits<double>::quiet_NaN();
-
 
 /// The history arrays `defs` declares, from a run's buffers (TrajectoryHistory or ChainHistory:
 /// column-major cols x N matrices, so their first `size` columns are the row-major array's bytes),

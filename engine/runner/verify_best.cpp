@@ -108,7 +108,8 @@ std::vector<BestRunRef> best_runs_to_verify(const Study& study, const store::Res
       std::vector<std::string> lowest;
       for (std::size_t m = 0; m < slots.size(); ++m) {
         if (!slots[m]) continue;
-        auto it = std::find_if(runs.begin(), runs.end(), [&](const BestRunRef& r) { return r.run == slots[m]->second.run; });
+        const auto run = slots[m]->second.run;  // named: clang 14 cannot capture a structured binding
+        auto it = std::find_if(runs.begin(), runs.end(), [&](const BestRunRef& r) { return r.run == run; });
         if (it == runs.end()) {
           runs.push_back(slots[m]->second);
           lowest.push_back(by_names[m]);

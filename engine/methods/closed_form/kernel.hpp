@@ -242,7 +242,7 @@ void run(const Shared& s, const Runs& in, Sums* out) {
   // a sample's value enters a lane's sums only while the lane runs (one lane: the loop stops instead;
   // while every lane runs, nothing is masked)
   bool all_on = all(active);
-  const auto keep = [&active, &all_on](const T& updated, const T& old) -> T {
+  const auto keep = [&](const T& updated, const T& old) -> T {  // uses active, all_on with lanes
     if constexpr (one) return updated;
     else return all_on ? updated : select(active, updated, old);
   };
