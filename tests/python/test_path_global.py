@@ -50,8 +50,11 @@ knots = [5, 10, 20]
 end_state = ["rest", "free"]
 """
 
-# Long enough (about 3 s on 2 threads) to be killed in the middle.
-KILL = SEED.replace('name = "pg_seed"', 'name = "pg_kill"').replace("knots = [5, 10, 20]", "knots = [5, 10, 20, 40, 80]")
+# Long enough (about 4 s on 2 threads) to be killed in the middle.
+KILL = (SEED.replace('name = "pg_seed"', 'name = "pg_kill"').replace("knots = [5, 10, 20]", "knots = [5, 10, 20, 40, 80]")
+        .replace("vertex_alpha = [13.30, 17.28, -12.44, -16.12]", "vertex_alpha = [13.30, 17.28, -12.44, -16.12]\ndt = 0.00025")
+        .replace('end_state = ["rest", "free"]',
+                 'end_state = ["rest", "free"]\nglobal_objective = ["E", "E_M", "torque_sq_integral", "kinetic_energy"]'))
 
 # A 4R chain: its local runs and global ones (about 3 s).
 CHAIN = """

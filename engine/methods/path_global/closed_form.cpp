@@ -2,12 +2,12 @@
 // chain-rule gradient, and the metrics through the per-sample accumulator.
 #include "methods/path_global/closed_form.hpp"
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <optional>
 
+#include "methods/closed_form/lanes.hpp"
 #include "methods/metrics/sample_sums.hpp"
 
 namespace ks {
@@ -36,14 +36,45 @@ bool self_motion_chart(const Vec2& p, const Vec2& v, const Vec2& acc, double L, 
 PathGlobalProblem::PathGlobalProblem(const PlanarArm3& arm, const SampledPath& path, Elbow elbow,
                                      double singular_tolerance, Extension extension)
     : arm_(arm), dyn_(arm), path_(path), elbow_(elbow), tolerance_(singular_tolerance), extension_(extension) {
-  velocity_.reserve(path.size());
-  for (std::size_t i = 0; i < path.size(); ++i)
-    velocity_.push_back(path.path().sample_on(path.segment(i), path.time(i)).v);
+  const std::size_t n = path.size();
+  for (std::vector<double>* v : {&px_, &py_, &vx_, &vy_, &ax_, &ay_, &weight_, &x_, &xd_, &xdd_, &term_, &partial_[0],
+                                 &partial_[1], &partial_[2]})
+    v->resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 p = path.position(i), v = path.path().sample_on(path.segment(i), path.time(i)).v,
+               a = path.acceleration(i);
+    px_[i] = p.x(), py_[i] = p.y(), vx_[i] = v.x(), vy_[i] = v.y(), ax_[i] = a.x(), ay_[i] = a.y();
+    weight_[i] = (i == 0 || i + 1 == n) ? 0.5 * path.dt() : path.dt();
+  }
   if (extension_ != Extension::self_motion) return;
-  chart_.resize(path.size());
-  for (std::size_t i = 0; i < path.size(); ++i)
-    chart_defined_ = chart_defined_ && self_motion_chart(path.position(i), velocity_[i], path.acceleration(i),
-                                                arm.l[0] + arm.l[1], arm.l[2], chart_[i]);
+  chart_.resize(n);
+  for (int k = 0; k < 3; ++k) phi_[k].resize(n), beta_[k].resize(n);
+  r_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 p(px_[i], py_[i]), v(vx_[i], vy_[i]), a(ax_[i], ay_[i]);
+    ChartSample& c = chart_[i];
+    chart_defined_ = chart_defined_ && self_motion_chart(p, v, a, arm.l[0] + arm.l[1], arm.l[2], c);
+    for (int k = 0; k < 3; ++k) phi_[k][i] = c.phi[k], beta_[k][i] = c.beta[k];
+    r_[i] = p.norm();
+  }
+}
+
+Terms3RInput PathGlobalProblem::input(GlobalObjective objective) const {
+  Terms3RInput in;
+  in.arm = &arm_;
+  in.dyn = &dyn_;
+  in.n = path_.size();
+  in.self_motion = extension_ == Extension::self_motion;
+  in.elbow = static_cast<int>(elbow_);
+  in.clamp = kReachClamp;
+  in.tolerance = tolerance_;
+  in.objective = objective;
+  in.px = px_.data(), in.py = py_.data(), in.vx = vx_.data(), in.vy = vy_.data(), in.ax = ax_.data(), in.ay = ay_.data();
+  in.weight = weight_.data();
+  for (int k = 0; k < 3; ++k) in.phi[k] = phi_[k].data(), in.beta[k] = beta_[k].data();
+  in.r = r_.data();
+  in.x = x_.data(), in.xd = xd_.data(), in.xdd = xdd_.data();
+  return in;
 }
 
 double PathGlobalProblem::coordinate(std::size_t i, double alpha, Elbow elbow) const {
@@ -52,17 +83,6 @@ double PathGlobalProblem::coordinate(std::size_t i, double alpha, Elbow elbow) c
   const double d = std::remainder(alpha - c.phi[0], 2.0 * std::numbers::pi);
   const double s = std::clamp(d / c.beta[0], -1.0, 1.0);
   return std::atan2(s, static_cast<int>(elbow) * std::sqrt(1.0 - s * s));
-}
-
-void PathGlobalProblem::sample(std::size_t i, double x, double xd, double xdd, GlobalSample& s) const {
-  if (extension_ == Extension::alpha) return sample_alpha(i, x, xd, xdd, elbow_, s);
-  const ChartSample& c = chart_[i];
-  const double sp = std::sin(x), cp = std::cos(x);
-  const double a = c.phi[0] + c.beta[0] * sp;
-  const double ad = c.phi[1] + c.beta[1] * sp + c.beta[0] * cp * xd;
-  const double add = c.phi[2] + c.beta[2] * sp + 2.0 * c.beta[1] * cp * xd - c.beta[0] * sp * xd * xd + c.beta[0] * cp * xdd;
-  sample_alpha(i, a, ad, add, cp >= 0.0 ? Elbow::positive : Elbow::negative, s, self_motion_elbow(x, c.beta[0],
-               path_.position(i).norm(), arm_.l[2], arm_.l[0], arm_.l[1]));
 }
 
 double self_motion_elbow(double psi, double beta, double r, double l3, double l1, double l2) {
@@ -74,43 +94,25 @@ double self_motion_elbow(double psi, double beta, double r, double l3, double l1
   return (std::cos(psi) >= 0.0 ? 2.0 : -2.0) * std::asin(std::sqrt(h));
 }
 
-void PathGlobalProblem::sample_alpha(std::size_t i, double a, double ad, double add, Elbow elbow,
-                                     GlobalSample& s, double theta2) const {
-  // inverse_kinematics (model/kinematics.hpp) with cos(theta2) kept within reach, so that the joint
-  // path and the objective continue past the reach boundary (the optimiser's trial points; the reach
-  // constraints bring it back): an unreachable sample is reported, its values are those at the boundary
-  const Vec2 p = path_.position(i);
-  const double ca = std::cos(a), sa = std::sin(a);
-  const double x2 = p.x() - arm_.l[2] * ca, y2 = p.y() - arm_.l[2] * sa;
-  const double d = x2 * x2 + y2 * y2;
-  const double c2_raw = (d - arm_.l[0] * arm_.l[0] - arm_.l[1] * arm_.l[1]) / (2.0 * arm_.l[0] * arm_.l[1]);
-  s.reachable = std::abs(c2_raw) <= 1.0 && d > 0.0;
-  if (!(d > 0.0) || !std::isfinite(c2_raw)) {
-    s.reachable = false;
-    s.det = 0.0;
-    return;
-  }
-  const bool given = std::isfinite(theta2);  // the self-motion chart's, within reach by construction
-  if (given) s.reachable = true;
-  const double c2 = given ? std::cos(theta2) : std::clamp(c2_raw, -kReachClamp, kReachClamp);
-  const double s2 = given ? std::sin(theta2) : static_cast<int>(elbow) * std::sqrt(1.0 - c2 * c2);
-  const double c1 = ((arm_.l[0] + arm_.l[1] * c2) * x2 + arm_.l[1] * s2 * y2) / d;
-  const double s1 = ((arm_.l[0] + arm_.l[1] * c2) * y2 - arm_.l[1] * s2 * x2) / d;
-  const double t1 = std::atan2(s1, c1), t2 = std::atan2(s2, c2);
-  s.q = Vec3(t1, t2, a - t1 - t2);
-  const JointTrig t = joint_trig(s.q);
-  s.J = jacobian(arm_, t);
-  Mat3 J3;
-  J3.topRows<2>() = s.J;
-  J3.row(2).setOnes();
-  const Eigen::PartialPivLU<Mat3> lu(J3);
-  s.det = lu.determinant();
-  s.qd = lu.solve(Vec3(velocity_[i].x(), velocity_[i].y(), ad));
-  const Vec2 jdqd = jacobian_dot_times_qd(arm_, t, s.qd);
-  const Vec2 xdd = path_.acceleration(i);
-  s.qdd = lu.solve(Vec3(xdd.x() - jdqd.x(), xdd.y() - jdqd.y(), add));
-  s.M = mass_matrix_sym(dyn_, t);
-  s.tau = s.M * s.qdd + coriolis(dyn_, t, s.qd) + gravity(dyn_, t);
+void PathGlobalProblem::evaluate(std::size_t i, double x, double xd, double xdd, Sample3ROf<double>& s,
+                                 double& alpha) const {
+  evaluate_3r(input(GlobalObjective::E), i, x, xd, xdd, s, alpha);
+}
+
+void PathGlobalProblem::sample(std::size_t i, double x, double xd, double xdd, GlobalSample& out) const {
+  Sample3ROf<double> s;
+  double alpha = 0.0;
+  evaluate(i, x, xd, xdd, s, alpha);
+  out.reachable = s.reachable;
+  out.det = s.det;
+  if (!(s.det == s.det) || (!s.reachable && s.det == 0.0)) return;
+  const double t1 = std::atan2(s.trig.s1, s.trig.c1), t2 = std::atan2(s.trig.s2, s.trig.c2);
+  out.q = Vec3(t1, t2, alpha - t1 - t2);
+  out.qd = s.qd;
+  out.qdd = s.qdd;
+  out.tau = s.tau;
+  out.M = s.M;
+  out.J = s.J;
 }
 
 void PathGlobalProblem::reach(const AlphaBasis& basis, const double* c, double* con, double* jac) const {
@@ -134,46 +136,32 @@ void PathGlobalProblem::reach(const AlphaBasis& basis, const double* c, double* 
   }
 }
 
-double PathGlobalProblem::cost(std::size_t i, double a, double ad, double add, GlobalObjective objective) const {
-  GlobalSample s;
-  sample(i, a, ad, add, s);
-  if (extension_ == Extension::alpha && !(std::abs(s.det) >= tolerance_)) {  // a barrier the size of a diverged run
-    return 1e6 / static_cast<double>(path_.size());
-  }
-  const std::size_t n = path_.size();
-  const double trapezoid = (i == 0 || i + 1 == n) ? 0.5 * path_.dt() : path_.dt();
-  switch (objective) {
-    case GlobalObjective::E: return std::sqrt(s.tau.squaredNorm()) / static_cast<double>(n);
-    case GlobalObjective::E_M: {
-      const SymInverse3 Mi(s.M);
-      return std::sqrt(Mi.P.quadratic_form(s.tau) / Mi.det) / static_cast<double>(n);
-    }
-    case GlobalObjective::torque_sq_integral: return trapezoid * s.tau.squaredNorm();
-    case GlobalObjective::kinetic_energy: return trapezoid * 0.5 * s.M.quadratic_form(s.qd);
-  }
-  return 0.0;
-}
-
 double PathGlobalProblem::objective(const AlphaBasis& basis, const double* c, GlobalObjective objective,
                                     double* grad) const {
   const int K = basis.coefficients;
-  if (grad) std::fill(grad, grad + K, 0.0);
+  const std::size_t n = path_.size();
+  for (std::size_t i = 0; i < n; ++i) basis.at(i, c, x_[i], xd_[i], xdd_[i]);
+  const Terms3RInput in = input(objective);
+  double* const partial[3] = {partial_[0].data(), partial_[1].data(), partial_[2].data()};
+  // the samples in lanes of the widest vectors the processor has, the rest one by one: the same
+  // values in every lane as one by one
+  std::size_t done = 0;
+  const int lanes = max_lanes();
+#if defined(KS_LANES_X8)
+  if (lanes == 8) terms_3r_x8(in, 0, done = n - n % 8, grad != nullptr, term_.data(), partial);
+#endif
+#if defined(KS_LANES_X4)
+  if (lanes == 4) terms_3r_x4(in, 0, done = n - n % 4, grad != nullptr, term_.data(), partial);
+#endif
+  terms_3r<double>(in, done, n, grad != nullptr, term_.data(), partial);
   double f = 0.0;
-  for (std::size_t i = 0; i < path_.size(); ++i) {
-    double x[3];
-    basis.at(i, c, x[0], x[1], x[2]);
-    f += cost(i, x[0], x[1], x[2], objective);
-    if (!grad) continue;
+  for (std::size_t i = 0; i < n; ++i) f += term_[i];
+  if (!grad) return f;
+  std::fill(grad, grad + K, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
     const BasisRow& r = basis.rows[i];
-    for (int d = 0; d < 3; ++d) {
-      const double h = 1e-6 * std::max(1.0, std::abs(x[d]));
-      double up[3] = {x[0], x[1], x[2]}, down[3] = {x[0], x[1], x[2]};
-      up[d] += h;
-      down[d] -= h;
-      const double partial = (cost(i, up[0], up[1], up[2], objective) - cost(i, down[0], down[1], down[2], objective)) /
-                             (up[d] - down[d]);
-      for (int k = 0; k < kBasisWidth && r.first + k < K; ++k) grad[r.first + k] += partial * r.w[d][k];
-    }
+    for (int d = 0; d < 3; ++d)
+      for (int k = 0; k < kBasisWidth && r.first + k < K; ++k) grad[r.first + k] += partial[d][i] * r.w[d][k];
   }
   return f;
 }
@@ -192,10 +180,10 @@ TrajectoryMetrics PathGlobalProblem::measure(const AlphaBasis& basis, const doub
   const auto keep = [](double updated, double) { return updated; };
   for (std::size_t i = 0; i < n; ++i) {
     const double t = path_.time(i);
-    double a, ad, add;
-    basis.at(i, c, a, ad, add);
-    GlobalSample s;
-    sample(i, a, ad, add, s);
+    double x, xd, xdd, a;
+    basis.at(i, c, x, xd, xdd);
+    Sample3ROf<double> s;
+    evaluate(i, x, xd, xdd, s, a);
     if (!s.reachable || !std::isfinite(s.det)) {
       stop = RunStatus::infeasible;
       break;
@@ -210,12 +198,13 @@ TrajectoryMetrics PathGlobalProblem::measure(const AlphaBasis& basis, const doub
       stop = RunStatus::diverged;
       break;
     }
+    const double t1 = std::atan2(s.trig.s1, s.trig.c1), t2 = std::atan2(s.trig.s2, s.trig.c2);
+    const Vec3 q(t1, t2, a - t1 - t2);
     const SymInverse3 Mi(s.M);
-    const JointTrig trig = joint_trig(s.q);
-    const Vec2 tip = end_effector(arm_, trig), err = tip - path_.position(i);
+    const Vec2 tip = end_effector(arm_, s.trig), err = tip - path_.position(i);
     const double p0 = s.tau[0] * s.qd[0], p1 = s.tau[1] * s.qd[1], p2 = s.tau[2] * s.qd[2];
-    const double alpha = s.q[0] + s.q[1] + s.q[2];
-    const SampleValues<double> v{3, s.q.data(), s.qd.data(), s.tau.data(), tt, 0.0, Mi.P.quadratic_form(s.tau), Mi.det,
+    const double alpha = q[0] + q[1] + q[2];
+    const SampleValues<double> v{3, q.data(), s.qd.data(), s.tau.data(), tt, 0.0, Mi.P.quadratic_form(s.tau), Mi.det,
                                  p0 * p0 + p1 * p1 + p2 * p2, manipulability_squared(s.J), err.squaredNorm(), 0.0, alpha,
                                  0.5 * s.M.quadratic_form(s.qd)};
     const bool off = sums.add(i, t, v, abs_tau, 3, keep);
@@ -223,7 +212,7 @@ TrajectoryMetrics PathGlobalProblem::measure(const AlphaBasis& basis, const doub
     if (history && (i % static_cast<std::size_t>(history->stride) == 0 || i + 1 == n)) {
       const Eigen::Index col = history->size++;
       history->t[col] = t;
-      history->q.col(col) = s.q;
+      history->q.col(col) = q;
       history->qd.col(col) = s.qd;
       history->qdd.col(col) = s.qdd;
       history->tau.col(col) = s.tau;

@@ -1,29 +1,25 @@
 #pragma once
 // The evaluator of the path-global method on the seed's planar 3R arm: given alpha(t) (any
 // AlphaBasis and its coefficients), the joint path is the exact inverse kinematics of (path, alpha)
-// at every sample (methods/path_global/alpha_basis.hpp's families share it), qd and qdd solve the square extended
-// task [tip; alpha] (J3 qd = [xd; alpha_d], J3 qdd = [xdd - Jd qd; alpha_dd]), and tau is the inverse
-// dynamics M qdd + c + g. The objective is a sum of per-sample terms, each a function of (alpha,
-// alpha_d, alpha_dd) at its sample, so its gradient is the chain rule through the basis' weights with
-// the three partials per sample by central differences: seven sample evaluations per sample for the
-// whole gradient, whatever the number of coefficients.
+// at every sample (methods/path_global/alpha_basis.hpp's families share it), qd and qdd solve the
+// square extended task [tip; alpha], and tau is the inverse dynamics M qdd + c + g
+// (methods/path_global/sample_3r.hpp, one template for values and derivatives). The objective is a
+// sum of per-sample terms, each a function of the coordinate x (alpha or psi), its rate and its
+// acceleration at its sample, so its gradient is the chain rule through the basis' weights with the
+// three partials per sample exact: one evaluation in forward-mode derivative numbers (model/dual.hpp)
+// per sample gives the term and its three partials, whatever the number of coefficients.
 #include <cstddef>
 #include <limits>
 #include <vector>
 
-#include "methods/path_global/alpha_basis.hpp"
 #include "methods/base/path_global_options.hpp"
 #include "methods/base/trajectory.hpp"
+#include "methods/path_global/alpha_basis.hpp"
+#include "methods/path_global/objective_3r.hpp"
+#include "methods/path_global/sample_3r.hpp"
 #include "model/dynamics.hpp"
 
 namespace ks {
-
-/// The self-motion chart at one sample (Extension::self_motion): alpha = phi + beta sin psi with phi
-/// the tip's direction from the base and beta half the arc of tip angles the wrist can reach, and
-/// their first two time derivatives [rad, rad/s, rad/s^2].
-struct ChartSample {
-  double phi[3], beta[3];
-};
 
 /// The self-motion chart at a tip position p [m], velocity v [m/s] and acceleration acc [m/s^2] of a
 /// 3R arm whose first two links reach L = l1 + l2 [m] and whose last is l3 [m]: phi = atan2(y, x) and
@@ -35,6 +31,8 @@ bool self_motion_chart(const Vec2& p, const Vec2& v, const Vec2& acc, double L, 
 /// psi [rad] of the self-motion chart with half-arc beta [rad], the tip at distance r [m] from the
 /// base, links l1, l2, l3 [m]: sign(cos psi) times its magnitude from the law of cosines, written so
 /// that it keeps its precision near the stretched arm (theta2 near 0, where the chart changes branch).
+/// (The planar chains' chart; the 3R evaluator takes cos and sin of theta2 from
+/// self_motion_half_versine, the same quantity without an angle on the way.)
 double self_motion_elbow(double psi, double beta, double r, double l3, double l1, double l2);
 
 /// One sample of the joint path for (alpha, alpha_d, alpha_dd).
@@ -68,8 +66,8 @@ class PathGlobalProblem {
   /// Fills `s` (q .. tau only when reachable).
   void sample(std::size_t i, double x, double xd, double xdd, GlobalSample& s) const;
 
-  /// The objective at coefficients c of `basis`; `grad` (size basis.coefficients) its gradient when
-  /// not null. Past the reach boundary the samples are taken at the boundary (cos theta2 = +-kReachClamp),
+  /// The objective at coefficients c of `basis`; `grad` (size basis.coefficients) its exact gradient
+  /// when not null. Past the reach boundary the samples are taken at the boundary (cos theta2 = +-kReachClamp),
   /// so that the objective stays finite and continuous for the optimiser's trial points.
   double objective(const AlphaBasis& basis, const double* c, GlobalObjective objective, double* grad) const;
 
@@ -86,19 +84,24 @@ class PathGlobalProblem {
   static constexpr double kReachClamp = 1.0 - 1e-12;
 
  private:
-  double cost(std::size_t i, double a, double ad, double add, GlobalObjective objective) const;
-  /// theta2: the elbow angle when known (the self-motion chart's), NaN to solve it from the reach
-  void sample_alpha(std::size_t i, double a, double ad, double add, Elbow elbow, GlobalSample& s,
-                    double theta2 = std::numeric_limits<double>::quiet_NaN()) const;
+  /// What the terms read (methods/path_global/objective_3r.hpp); x, xd, xdd are the scratch arrays.
+  Terms3RInput input(GlobalObjective objective) const;
+  /// Sample i at the coordinate x, its rate and acceleration; `alpha` the tip angle there [rad].
+  void evaluate(std::size_t i, double x, double xd, double xdd, Sample3ROf<double>& s, double& alpha) const;
 
   PlanarArm3 arm_;
   DynamicsCoefficients dyn_;
   const SampledPath& path_;
-  std::vector<Vec2> velocity_;  // the path's velocity at each sample [m/s]
   Elbow elbow_;
   double tolerance_;
   Extension extension_;
   std::vector<ChartSample> chart_;  // self_motion
+  // the path and the chart as arrays over the samples: position, velocity, acceleration, the
+  // trapezoid's weights, the chart's phi and beta and |tip|
+  std::vector<double> px_, py_, vx_, vy_, ax_, ay_, weight_, phi_[3], beta_[3], r_;
+  // an evaluation's scratch: the coordinates at each sample, the terms and their partials (a problem
+  // belongs to one run, evaluated by one thread)
+  mutable std::vector<double> x_, xd_, xdd_, term_, partial_[3];
   bool chart_defined_ = true;
 };
 
