@@ -12,7 +12,7 @@ import sys
 def main():
     width, objects = sys.argv[1], sys.argv[2:]
     tags = {"x4": ("F64x4", "M64x4"), "x8": ("F64x8", "M64x8")}[width]
-    entry_names = (f"ks::kernel::run_{width}(", f"ks::terms_3r_{width}(")
+    entry_names = (f"ks::kernel::run_{width}(", f"ks::terms_3r_{width}(", f"ks::samples_3r_{width}(")
     bad, entries = [], {e: 0 for e in entry_names}
     for obj in objects:
         out = subprocess.run(["nm", "-C", "--defined-only", obj], check=True, capture_output=True, text=True).stdout

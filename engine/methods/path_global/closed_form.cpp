@@ -11,6 +11,21 @@
 #include "methods/metrics/sample_sums.hpp"
 
 namespace ks {
+namespace {
+
+/// Calls run(lanes, count) with the widest lane width the processor has (methods/closed_form/lanes.hpp)
+/// and the largest multiple of it not above n, and returns that count (0 with one lane): the caller
+/// evaluates the rest one by one. Every lane computes what one by one computes.
+template <class Run>
+std::size_t in_lanes(std::size_t n, Run&& run) {
+  const int lanes = max_lanes();
+  if (lanes <= 1) return 0;
+  const std::size_t count = n - n % static_cast<std::size_t>(lanes);
+  if (count > 0) run(lanes, count);
+  return count;
+}
+
+}  // namespace
 
 bool self_motion_chart(const Vec2& p, const Vec2& v, const Vec2& acc, double L, double l3, ChartSample& c) {
   const double r2 = p.squaredNorm(), r = std::sqrt(r2);
@@ -143,16 +158,15 @@ double PathGlobalProblem::objective(const AlphaBasis& basis, const double* c, Gl
   for (std::size_t i = 0; i < n; ++i) basis.at(i, c, x_[i], xd_[i], xdd_[i]);
   const Terms3RInput in = input(objective);
   double* const partial[3] = {partial_[0].data(), partial_[1].data(), partial_[2].data()};
-  // the samples in lanes of the widest vectors the processor has, the rest one by one: the same
-  // values in every lane as one by one
-  std::size_t done = 0;
-  const int lanes = max_lanes();
+  const std::size_t done = in_lanes(n, [&](int lanes, std::size_t end) {
+    (void)lanes, (void)end;
 #if defined(KS_LANES_X8)
-  if (lanes == 8) terms_3r_x8(in, 0, done = n - n % 8, grad != nullptr, term_.data(), partial);
+    if (lanes == 8) terms_3r_x8(in, 0, end, grad != nullptr, term_.data(), partial);
 #endif
 #if defined(KS_LANES_X4)
-  if (lanes == 4) terms_3r_x4(in, 0, done = n - n % 4, grad != nullptr, term_.data(), partial);
+    if (lanes == 4) terms_3r_x4(in, 0, end, grad != nullptr, term_.data(), partial);
 #endif
+  });
   terms_3r<double>(in, done, n, grad != nullptr, term_.data(), partial);
   double f = 0.0;
   for (std::size_t i = 0; i < n; ++i) f += term_[i];
@@ -164,6 +178,21 @@ double PathGlobalProblem::objective(const AlphaBasis& basis, const double* c, Gl
       for (int k = 0; k < kBasisWidth && r.first + k < K; ++k) grad[r.first + k] += partial[d][i] * r.w[d][k];
   }
   return f;
+}
+
+void PathGlobalProblem::samples(const AlphaBasis& basis, const double* c, const Terms3RInput& in, std::size_t first,
+                                std::size_t end, Sample3RBlock& block) const {
+  for (std::size_t i = first; i < end; ++i) basis.at(i, c, x_[i], xd_[i], xdd_[i]);
+  const std::size_t done = first + in_lanes(end - first, [&](int lanes, std::size_t count) {
+    (void)lanes, (void)count;
+#if defined(KS_LANES_X8)
+    if (lanes == 8) samples_3r_x8(in, first, first + count, block);
+#endif
+#if defined(KS_LANES_X4)
+    if (lanes == 4) samples_3r_x4(in, first, first + count, block);
+#endif
+  });
+  samples_3r<double>(in, done, end, block);
 }
 
 TrajectoryMetrics PathGlobalProblem::measure(const AlphaBasis& basis, const double* c, const TrajectoryOptions& o,
@@ -178,44 +207,49 @@ TrajectoryMetrics PathGlobalProblem::measure(const AlphaBasis& basis, const doub
   sums.start_alpha(s0.reachable ? s0.q.sum() : x0);
   RunStatus stop = RunStatus::ok;
   const auto keep = [](double updated, double) { return updated; };
+  const Terms3RInput in = input(GlobalObjective::E);
+  Sample3RBlock block;
   for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = i % kSampleBlock;
+    if (j == 0) samples(basis, c, in, i, std::min(n, i + kSampleBlock), block);
     const double t = path_.time(i);
-    double x, xd, xdd, a;
-    basis.at(i, c, x, xd, xdd);
-    Sample3ROf<double> s;
-    evaluate(i, x, xd, xdd, s, a);
-    if (!s.reachable || !std::isfinite(s.det)) {
+    const double det = block.det[j];
+    if (!(block.reach[j] != 0.0) || !std::isfinite(det)) {
       stop = RunStatus::infeasible;
       break;
     }
-    if (extension_ == Extension::alpha && !(std::abs(s.det) >= o.singular_tolerance)) {
+    if (extension_ == Extension::alpha && !(std::abs(det) >= o.singular_tolerance)) {
       stop = RunStatus::singular_extension;
       break;
     }
-    const double abs_tau[3] = {std::abs(s.tau[0]), std::abs(s.tau[1]), std::abs(s.tau[2])};
-    const double tt = s.tau.squaredNorm();
+    const Vec3 tau(block.tau[0][j], block.tau[1][j], block.tau[2][j]), qd(block.qd[0][j], block.qd[1][j], block.qd[2][j]);
+    const double abs_tau[3] = {std::abs(tau[0]), std::abs(tau[1]), std::abs(tau[2])};
+    const double tt = tau.squaredNorm();
     if (!(std::max({abs_tau[0], abs_tau[1], abs_tau[2]}) <= o.torque_bound) || !std::isfinite(tt)) {
       stop = RunStatus::diverged;
       break;
     }
-    const double t1 = std::atan2(s.trig.s1, s.trig.c1), t2 = std::atan2(s.trig.s2, s.trig.c2);
-    const Vec3 q(t1, t2, a - t1 - t2);
-    const SymInverse3 Mi(s.M);
-    const Vec2 tip = end_effector(arm_, s.trig), err = tip - path_.position(i);
-    const double p0 = s.tau[0] * s.qd[0], p1 = s.tau[1] * s.qd[1], p2 = s.tau[2] * s.qd[2];
+    const double t1 = std::atan2(block.s1[j], block.c1[j]), t2 = std::atan2(block.s2[j], block.c2[j]);
+    const Vec3 q(t1, t2, block.alpha[j] - t1 - t2);
+    const Sym3 M{block.M[0][j], block.M[1][j], block.M[2][j], block.M[3][j], block.M[4][j], block.M[5][j]};
+    Mat23 J;
+    J << block.J[0][j], block.J[1][j], block.J[2][j], block.J[3][j], block.J[4][j], block.J[5][j];
+    const SymInverse3 Mi(M);
+    const Vec2 tip(block.tip[0][j], block.tip[1][j]), err = tip - path_.position(i);
+    const double p0 = tau[0] * qd[0], p1 = tau[1] * qd[1], p2 = tau[2] * qd[2];
     const double alpha = q[0] + q[1] + q[2];
-    const SampleValues<double> v{3, q.data(), s.qd.data(), s.tau.data(), tt, 0.0, Mi.P.quadratic_form(s.tau), Mi.det,
-                                 p0 * p0 + p1 * p1 + p2 * p2, manipulability_squared(s.J), err.squaredNorm(), 0.0, alpha,
-                                 0.5 * s.M.quadratic_form(s.qd)};
+    const SampleValues<double> v{3, q.data(), qd.data(), tau.data(), tt, 0.0, Mi.P.quadratic_form(tau), Mi.det,
+                                 p0 * p0 + p1 * p1 + p2 * p2, manipulability_squared(J), err.squaredNorm(), 0.0, alpha,
+                                 0.5 * M.quadratic_form(qd)};
     const bool off = sums.add(i, t, v, abs_tau, 3, keep);
     sums.mark(off);
     if (history && (i % static_cast<std::size_t>(history->stride) == 0 || i + 1 == n)) {
       const Eigen::Index col = history->size++;
       history->t[col] = t;
       history->q.col(col) = q;
-      history->qd.col(col) = s.qd;
-      history->qdd.col(col) = s.qdd;
-      history->tau.col(col) = s.tau;
+      history->qd.col(col) = qd;
+      history->qdd.col(col) = Vec3(block.qdd[0][j], block.qdd[1][j], block.qdd[2][j]);
+      history->tau.col(col) = tau;
       history->x.col(col) = tip;
       history->alpha[col] = alpha;
     }

@@ -86,6 +86,10 @@ class PathGlobalProblem {
  private:
   /// What the terms read (methods/path_global/objective_3r.hpp); x, xd, xdd are the scratch arrays.
   Terms3RInput input(GlobalObjective objective) const;
+  /// Samples [first, end) (at most kSampleBlock) at coefficients c into `block` (in lanes where the
+  /// processor has them).
+  void samples(const AlphaBasis& basis, const double* c, const Terms3RInput& in, std::size_t first, std::size_t end,
+               Sample3RBlock& block) const;
   /// Sample i at the coordinate x, its rate and acceleration; `alpha` the tip angle there [rad].
   void evaluate(std::size_t i, double x, double xd, double xdd, Sample3ROf<double>& s, double& alpha) const;
 

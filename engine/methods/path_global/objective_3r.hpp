@@ -112,10 +112,49 @@ template <class L>
   }
 }
 
-/// terms_3r in 4 lanes (AVX2) and 8 lanes (AVX-512), each compiled for its vectors.
+/// A block of samples as the run's metrics read them (structure of arrays, kSampleBlock samples from
+/// the block's first): reach is 1 where the wrist is within reach, else 0; M's upper triangle by
+/// rows, J by rows, the tip as end_effector (model/kinematics.hpp) computes it.
+inline constexpr std::size_t kSampleBlock = 256;
+struct Sample3RBlock {
+  alignas(64) double reach[kSampleBlock], det[kSampleBlock], alpha[kSampleBlock], c1[kSampleBlock],
+      s1[kSampleBlock], c2[kSampleBlock], s2[kSampleBlock], qd[3][kSampleBlock], qdd[3][kSampleBlock],
+      tau[3][kSampleBlock], M[6][kSampleBlock], J[6][kSampleBlock], tip[2][kSampleBlock];
+};
+
+/// Samples [first, end) (end - first a multiple of the lanes, at most kSampleBlock) into `out`, row
+/// i - first. Everything it calls is inlined into it, as in terms_3r.
+template <class L>
+[[gnu::flatten]] inline void samples_3r(const Terms3RInput& in, std::size_t first, std::size_t end,
+                                        Sample3RBlock& out) {
+  constexpr int W = lanes_of<L>;
+  const auto put = [](const L& v, double* p) {
+    if constexpr (W == 1) *p = v; else v.store(p);
+  };
+  for (std::size_t i = first; i + W <= end; i += W) {
+    const std::size_t j = i % kSampleBlock;
+    Sample3ROf<L> s;
+    L alpha;
+    evaluate_3r(in, i, load_lanes<L>(in.x + i), load_lanes<L>(in.xd + i), load_lanes<L>(in.xdd + i), s, alpha);
+    put(select(s.reachable, L(1.0), L(0.0)), out.reach + j);
+    put(s.det, out.det + j);
+    put(alpha, out.alpha + j);
+    put(s.trig.c1, out.c1 + j), put(s.trig.s1, out.s1 + j), put(s.trig.c2, out.c2 + j), put(s.trig.s2, out.s2 + j);
+    for (int k = 0; k < 3; ++k) put(s.qd[k], out.qd[k] + j), put(s.qdd[k], out.qdd[k] + j), put(s.tau[k], out.tau[k] + j);
+    const L m[6] = {s.M.a00, s.M.a01, s.M.a02, s.M.a11, s.M.a12, s.M.a22};
+    for (int k = 0; k < 6; ++k) put(m[k], out.M[k] + j), put(s.J(k / 3, k % 3), out.J[k] + j);
+    const JointTrigOf<L>& t = s.trig;
+    const double l1 = in.arm->l[0], l2 = in.arm->l[1], l3 = in.arm->l[2];
+    put(l1 * t.c1 + l2 * t.c12 + l3 * t.c123, out.tip[0] + j), put(l1 * t.s1 + l2 * t.s12 + l3 * t.s123, out.tip[1] + j);
+  }
+}
+
+/// terms_3r and samples_3r in 4 lanes (AVX2) and 8 lanes (AVX-512), each compiled for its vectors.
 void terms_3r_x4(const Terms3RInput& in, std::size_t first, std::size_t end, bool partials, double* term,
                  double* const partial[3]);
 void terms_3r_x8(const Terms3RInput& in, std::size_t first, std::size_t end, bool partials, double* term,
                  double* const partial[3]);
+void samples_3r_x4(const Terms3RInput& in, std::size_t first, std::size_t end, Sample3RBlock& out);
+void samples_3r_x8(const Terms3RInput& in, std::size_t first, std::size_t end, Sample3RBlock& out);
 
 }  // namespace ks
