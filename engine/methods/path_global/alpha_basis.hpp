@@ -33,12 +33,46 @@ struct AlphaBasis {
   void at(std::size_t i, const double* c, double& a, double& ad, double& add) const {
     const BasisRow& r = rows[i];
     a = ad = add = 0.0;
+    if (r.first + kBasisWidth <= coefficients) {  // every row but the last few: a fixed-size loop
+      for (int k = 0; k < kBasisWidth; ++k) {
+        const double x = c[r.first + k];
+        a += r.w[0][k] * x;
+        ad += r.w[1][k] * x;
+        add += r.w[2][k] * x;
+      }
+      return;
+    }
     for (int k = 0; k < kBasisWidth && r.first + k < coefficients; ++k) {
       const double x = c[r.first + k];
       a += r.w[0][k] * x;
       ad += r.w[1][k] * x;
       add += r.w[2][k] * x;
     }
+  }
+  /// grad[first_i + k] += partial[d][i] w_i[d][k] over the samples i in order and d = 0, 1, 2 (the
+  /// chain rule of per-sample terms whose partials with respect to alpha, its rate and acceleration
+  /// are partial[d][i]). The running sums of a row's coefficients stay in registers while consecutive
+  /// rows share their first coefficient: the same additions in the same order as through memory.
+  void add_gradients(const double* const partial[3], double* grad) const {
+    int first = -1, width = 0;
+    double g[kBasisWidth] = {};
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const BasisRow& r = rows[i];
+      if (r.first != first) {
+        for (int k = 0; k < width; ++k) grad[first + k] = g[k];
+        first = r.first;
+        width = first + kBasisWidth <= coefficients ? kBasisWidth : coefficients - first;
+        for (int k = 0; k < width; ++k) g[k] = grad[first + k];
+      }
+      if (width == kBasisWidth) {
+        for (int d = 0; d < 3; ++d)
+          for (int k = 0; k < kBasisWidth; ++k) g[k] += partial[d][i] * r.w[d][k];
+      } else {
+        for (int d = 0; d < 3; ++d)
+          for (int k = 0; k < width; ++k) g[k] += partial[d][i] * r.w[d][k];
+      }
+    }
+    for (int k = 0; k < width; ++k) grad[first + k] = g[k];
   }
 };
 

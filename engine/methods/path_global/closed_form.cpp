@@ -172,11 +172,7 @@ double PathGlobalProblem::objective(const AlphaBasis& basis, const double* c, Gl
   for (std::size_t i = 0; i < n; ++i) f += term_[i];
   if (!grad) return f;
   std::fill(grad, grad + K, 0.0);
-  for (std::size_t i = 0; i < n; ++i) {
-    const BasisRow& r = basis.rows[i];
-    for (int d = 0; d < 3; ++d)
-      for (int k = 0; k < kBasisWidth && r.first + k < K; ++k) grad[r.first + k] += partial[d][i] * r.w[d][k];
-  }
+  basis.add_gradients(partial, grad);
   return f;
 }
 
