@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -93,6 +94,31 @@ TEST(FailedRunMetrics, GlobalMeasureEndingAtTheFirstSample) {
   m = alpha.measure(basis, reachable.data(), o, nullptr);
   EXPECT_GT(m.samples, 0u);
   EXPECT_TRUE(std::isfinite(m.E));
+}
+
+// A run that leaves the reach part-way: its metrics stop at the last sample within reach, whose tip
+// angle (the joint angles' sum, as sample() gives them) is the run's final_alpha, wherever that
+// sample falls in the measure's blocks.
+TEST(FailedRunMetrics, GlobalMeasureEndingPartWayKeepsTheLastSamplesAngle) {
+  const PlanarArm3 arm = PlanarArm3::seed();
+  const SampledPath path(seed_square(), 1e-3);
+  const AlphaBasis basis = cubic_spline_basis(path, 10);
+  const TrajectoryOptions o = global_options();
+  const PathGlobalProblem alpha(arm, path, Elbow::positive, o.singular_tolerance, Extension::alpha);
+  std::vector<double> c(basis.coefficients, -23.75 * kDegree);
+  for (int k = 5; k < basis.coefficients; ++k) c[k] = -60.0 * kDegree;  // out of reach from mid-path on
+  const TrajectoryMetrics m = alpha.measure(basis, c.data(), o, nullptr);
+  ASSERT_EQ(m.status, RunStatus::infeasible);
+  ASSERT_GT(m.samples, 1u);
+  ASSERT_LT(m.samples, path.size());
+  const std::size_t last = m.samples - 1;
+  std::printf("the run ends at sample %zu (block row %zu)\n", last, last % kSampleBlock);
+  double a, ad, add;
+  basis.at(last, c.data(), a, ad, add);
+  GlobalSample s;
+  alpha.sample(last, a, ad, add, s);
+  ASSERT_TRUE(s.reachable);
+  EXPECT_EQ(m.final_alpha, s.q[0] + s.q[1] + s.q[2]) << "sample " << last;
 }
 
 TEST(FailedRunMetrics, GlobalSolveRefusals) {

@@ -171,8 +171,10 @@ class SampleSums {
     return r;
   }
 
-  /// Sets the last tip angle before any sample (the start's).
+  /// Sets the last tip angle: before any sample (the start's), or after the last one, for a caller
+  /// that adds its samples with a placeholder angle and computes the last sample's only at the end.
   void start_alpha(const T& alpha) { last_alpha = alpha; }
+  void set_last_alpha(const T& alpha) { last_alpha = alpha; }
 
  private:
   T sumE = 0.0, sumEM = 0.0, sumEF = 0.0, sum_err_ = 0.0;

@@ -205,6 +205,16 @@ TrajectoryMetrics PathGlobalProblem::measure(const AlphaBasis& basis, const doub
   const auto keep = [](double updated, double) { return updated; };
   const Terms3RInput in = input(GlobalObjective::E);
   Sample3RBlock block;
+  // the joint angles (atan2) only where something reads them: a history column, and the last
+  // sample's tip angle (final_alpha; the samples carry no joint limits, which would read q): it is
+  // computed at the end of each block and, for a run ending inside a block, once the loop ends
+  const auto angles = [&block](std::size_t j) {
+    const double t1 = std::atan2(block.s1[j], block.c1[j]), t2 = std::atan2(block.s2[j], block.c2[j]);
+    return Vec3(t1, t2, block.alpha[j] - t1 - t2);
+  };
+  double last_alpha = 0.0;
+  std::ptrdiff_t pending = -1;  // the block row of the last sample added, its angle not yet computed
+  bool added = false;
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t j = i % kSampleBlock;
     if (j == 0) samples(basis, c, in, i, std::min(n, i + kSampleBlock), block);
@@ -225,32 +235,42 @@ TrajectoryMetrics PathGlobalProblem::measure(const AlphaBasis& basis, const doub
       stop = RunStatus::diverged;
       break;
     }
-    const double t1 = std::atan2(block.s1[j], block.c1[j]), t2 = std::atan2(block.s2[j], block.c2[j]);
-    const Vec3 q(t1, t2, block.alpha[j] - t1 - t2);
     const Sym3 M{block.M[0][j], block.M[1][j], block.M[2][j], block.M[3][j], block.M[4][j], block.M[5][j]};
     Mat23 J;
     J << block.J[0][j], block.J[1][j], block.J[2][j], block.J[3][j], block.J[4][j], block.J[5][j];
     const SymInverse3 Mi(M);
     const Vec2 tip(block.tip[0][j], block.tip[1][j]), err = tip - path_.position(i);
     const double p0 = tau[0] * qd[0], p1 = tau[1] * qd[1], p2 = tau[2] * qd[2];
-    const double alpha = q[0] + q[1] + q[2];
-    const SampleValues<double> v{3, q.data(), qd.data(), tau.data(), tt, 0.0, Mi.P.quadratic_form(tau), Mi.det,
-                                 p0 * p0 + p1 * p1 + p2 * p2, manipulability_squared(J), err.squaredNorm(), 0.0, alpha,
+    const SampleValues<double> v{3, nullptr, qd.data(), tau.data(), tt, 0.0, Mi.P.quadratic_form(tau), Mi.det,
+                                 p0 * p0 + p1 * p1 + p2 * p2, manipulability_squared(J), err.squaredNorm(), 0.0, 0.0,
                                  0.5 * M.quadratic_form(qd)};
     const bool off = sums.add(i, t, v, abs_tau, 3, keep);
     sums.mark(off);
+    added = true;
+    pending = static_cast<std::ptrdiff_t>(j);
+    if (j + 1 == kSampleBlock || i + 1 == n) {
+      const Vec3 q = angles(j);
+      last_alpha = q[0] + q[1] + q[2];
+      pending = -1;
+    }
     if (history && (i % static_cast<std::size_t>(history->stride) == 0 || i + 1 == n)) {
       const Eigen::Index col = history->size++;
       history->t[col] = t;
+      const Vec3 q = angles(j);
       history->q.col(col) = q;
       history->qd.col(col) = qd;
       history->qdd.col(col) = Vec3(block.qdd[0][j], block.qdd[1][j], block.qdd[2][j]);
       history->tau.col(col) = tau;
       history->x.col(col) = tip;
-      history->alpha[col] = alpha;
+      history->alpha[col] = q[0] + q[1] + q[2];
     }
     if (off && o.on_violation == OnViolation::stop) break;
   }
+  if (pending >= 0) {
+    const Vec3 q = angles(static_cast<std::size_t>(pending));
+    last_alpha = q[0] + q[1] + q[2];
+  }
+  if (added) sums.set_last_alpha(last_alpha);
   RunShape shape;
   return finish_run(sums.of_lane(0, stop, 3), shape, o);
 }
