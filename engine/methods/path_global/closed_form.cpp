@@ -52,9 +52,7 @@ PathGlobalProblem::PathGlobalProblem(const PlanarArm3& arm, const SampledPath& p
                                      double singular_tolerance, Extension extension)
     : arm_(arm), dyn_(arm), path_(path), elbow_(elbow), tolerance_(singular_tolerance), extension_(extension) {
   const std::size_t n = path.size();
-  for (std::vector<double>* v : {&px_, &py_, &vx_, &vy_, &ax_, &ay_, &weight_, &x_, &xd_, &xdd_, &term_, &partial_[0],
-                                 &partial_[1], &partial_[2]})
-    v->resize(n);
+  for (std::vector<double>* v : {&px_, &py_, &vx_, &vy_, &ax_, &ay_, &weight_, &x_, &xd_, &xdd_}) v->resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2 p = path.position(i), v = path.path().sample_on(path.segment(i), path.time(i)).v,
                a = path.acceleration(i);
@@ -157,6 +155,8 @@ double PathGlobalProblem::objective(const AlphaBasis& basis, const double* c, Gl
   const std::size_t n = path_.size();
   for (std::size_t i = 0; i < n; ++i) basis.at(i, c, x_[i], xd_[i], xdd_[i]);
   const Terms3RInput in = input(objective);
+  if (term_.size() != n)  // allocated by the first evaluation (a problem only measured needs none)
+    for (std::vector<double>* v : {&term_, &partial_[0], &partial_[1], &partial_[2]}) v->resize(n);
   double* const partial[3] = {partial_[0].data(), partial_[1].data(), partial_[2].data()};
   const std::size_t done = in_lanes(n, [&](int lanes, std::size_t end) {
     (void)lanes, (void)end;
