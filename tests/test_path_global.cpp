@@ -210,43 +210,6 @@ TEST(PathGlobal, SelfMotionChartRoundTripsAndCrossesBranchesContinuously) {
   }
 }
 
-TEST(PathGlobal, GradientMatchesFiniteDifferences) {
-  const PlanarArm3 arm = PlanarArm3::seed();
-  const SampledPath path(seed_square(), 1e-3);
-  for (Extension ext : {Extension::self_motion, Extension::alpha}) {
-    const PathGlobalProblem problem(arm, path, Elbow::positive, 1e-9, ext);
-    const AlphaBasis b = cubic_spline_basis(path, 8);
-    // the thesis' case 4 alpha(t) in the extension's coordinate, fitted by the spline: within reach
-    const std::vector<double> thesis4{-18.3 * kDegree, 18.3 * kDegree, 18.9 * kDegree, -10.3 * kDegree, -8.6 * kDegree};
-    const AlphaBasis v = vertex_quintic_basis(path);
-    std::vector<double> x(path.size());
-    for (std::size_t i = 0; i < path.size(); ++i) {
-      double a, ad, add;
-      v.at(i, thesis4.data(), a, ad, add);
-      x[i] = problem.coordinate(i, a, Elbow::positive);
-    }
-    const std::vector<double> c = fit_basis(b, x.data(), x.size());
-    if (ext == Extension::alpha) {  // (the self-motion chart reaches by construction)
-      std::vector<double> reach(path.size());
-      problem.reach(b, c.data(), reach.data(), nullptr);
-      ASSERT_LT(*std::max_element(reach.begin(), reach.end()), 0.0);
-    }
-    for (GlobalObjective obj : {GlobalObjective::E, GlobalObjective::E_M, GlobalObjective::torque_sq_integral,
-                                GlobalObjective::kinetic_energy}) {
-      std::vector<double> g(8);
-      problem.objective(b, c.data(), obj, g.data());
-      for (int k = 0; k < 8; ++k) {
-        const double h = 1e-6;
-        std::vector<double> up = c, down = c;
-        up[k] += h;
-        down[k] -= h;
-        const double fd = (problem.objective(b, up.data(), obj, nullptr) - problem.objective(b, down.data(), obj, nullptr)) / (2 * h);
-        EXPECT_NEAR(g[k], fd, 1e-5 * std::max(1.0, std::abs(fd))) << to_string(ext) << " " << to_string(obj) << " " << k;
-      }
-    }
-  }
-}
-
 // Seed 3R, physical inertia, objective E, 20 knots, from case 4's alpha(t): below the best local run
 // of the shipped landscape_alpha_k (36.74 Nm, 1.3 mm off its path) and below case 4's optimum (45.33),
 // on the path; 1,000 small random perturbations of the optimum's coefficients do not lower E.

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -13,13 +14,13 @@
 #include "methods/path_global/closed_form.hpp"
 #include "methods/path_global/sample_3r.hpp"
 #include "model/dual.hpp"
+#include "path_global_fixtures.hpp"
 #include "task/quintic_path.hpp"
 
 namespace ks {
 namespace {
 
 using D = Dual<2>;
-constexpr double kDegree = 3.14159265358979323846 / 180.0;
 
 // f(x, y) = sqrt(x^2 y + 3) sin(x) / (y - 5) + cos(x y): every operation Dual defines
 template <class T>
@@ -104,21 +105,19 @@ TEST(PathGlobalDerivatives, SampleTorquePartialsMatchCentralDifferences) {
 
 // The objective's exact gradient against central differences of the objective over the coefficients,
 // every extension and objective, at a spline fitted to the thesis' case 4 (within reach everywhere).
+// (The 12-knot spline: rows of full width and the last rows' narrower ones.)
 TEST(PathGlobalDerivatives, ObjectiveGradientMatchesCentralDifferences) {
   const PlanarArm3 arm = PlanarArm3::seed();
   const SampledPath path(seed_square(), 1e-3);
-  const std::vector<double> thesis4{-18.3 * kDegree, 18.3 * kDegree, 18.9 * kDegree, -10.3 * kDegree, -8.6 * kDegree};
   for (Extension ext : {Extension::self_motion, Extension::alpha}) {
     const PathGlobalProblem problem(arm, path, Elbow::positive, 1e-9, ext);
     const AlphaBasis b = cubic_spline_basis(path, 12);
-    const AlphaBasis v = vertex_quintic_basis(path);
-    std::vector<double> x(path.size());
-    for (std::size_t i = 0; i < path.size(); ++i) {
-      double a, ad, add;
-      v.at(i, thesis4.data(), a, ad, add);
-      x[i] = problem.coordinate(i, a, Elbow::positive);
+    const std::vector<double> c = case4_fit(problem, path, b);
+    if (ext == Extension::alpha) {  // within reach (the self-motion chart reaches by construction)
+      std::vector<double> reach(path.size());
+      problem.reach(b, c.data(), reach.data(), nullptr);
+      ASSERT_LT(*std::max_element(reach.begin(), reach.end()), 0.0);
     }
-    const std::vector<double> c = fit_basis(b, x.data(), x.size());
     for (GlobalObjective obj : {GlobalObjective::E, GlobalObjective::E_M, GlobalObjective::torque_sq_integral,
                                 GlobalObjective::kinetic_energy}) {
       std::vector<double> g(b.coefficients);
@@ -145,18 +144,10 @@ TEST(PathGlobalDerivatives, ObjectiveGradientMatchesCentralDifferences) {
 TEST(PathGlobalDerivatives, LaneWidthsGiveTheSameBits) {
   const PlanarArm3 arm = PlanarArm3::seed();
   const SampledPath path(seed_square(), 1e-3);
-  const std::vector<double> thesis4{-18.3 * kDegree, 18.3 * kDegree, 18.9 * kDegree, -10.3 * kDegree, -8.6 * kDegree};
   for (Extension ext : {Extension::self_motion, Extension::alpha}) {
     const PathGlobalProblem problem(arm, path, Elbow::positive, 1e-9, ext);
     const AlphaBasis b = cubic_spline_basis(path, 20);
-    const AlphaBasis v = vertex_quintic_basis(path);
-    std::vector<double> x(path.size());
-    for (std::size_t i = 0; i < path.size(); ++i) {
-      double a, ad, add;
-      v.at(i, thesis4.data(), a, ad, add);
-      x[i] = problem.coordinate(i, a, Elbow::positive);
-    }
-    std::vector<double> c = fit_basis(b, x.data(), x.size());
+    std::vector<double> c = case4_fit(problem, path, b);
     c[3] += 2.0;  // some samples out of reach (alpha: the boundary and the barrier in lanes)
     for (GlobalObjective obj : {GlobalObjective::E, GlobalObjective::E_M, GlobalObjective::torque_sq_integral,
                                 GlobalObjective::kinetic_energy}) {

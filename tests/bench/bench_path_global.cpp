@@ -9,33 +9,18 @@
 #include "methods/path_global/alpha_basis.hpp"
 #include "methods/path_global/closed_form.hpp"
 #include "methods/path_global/solve_closed_form.hpp"
+#include "path_global_fixtures.hpp"
 #include "task/quintic_path.hpp"
 
 using namespace ks;
 
-namespace {
-constexpr double kDegree = 3.14159265358979323846 / 180.0;
-
-// the thesis' case 4 alpha(t) in the extension's coordinate, fitted by the 20-knot spline
-std::vector<double> case4(const PathGlobalProblem& problem, const SampledPath& path, const AlphaBasis& b) {
-  const std::vector<double> thesis4{-18.3 * kDegree, 18.3 * kDegree, 18.9 * kDegree, -10.3 * kDegree, -8.6 * kDegree};
-  const AlphaBasis v = vertex_quintic_basis(path);
-  std::vector<double> x(path.size());
-  for (std::size_t i = 0; i < path.size(); ++i) {
-    double a, ad, add;
-    v.at(i, thesis4.data(), a, ad, add);
-    x[i] = problem.coordinate(i, a, Elbow::positive);
-  }
-  return fit_basis(b, x.data(), x.size());
-}
-}  // namespace
 
 static void evaluation(benchmark::State& st, Extension ext, bool gradient) {
   const PlanarArm3 arm = PlanarArm3::seed();
   const SampledPath path(seed_square(), 1e-3);
   const PathGlobalProblem problem(arm, path, Elbow::positive, 1e-9, ext);
   const AlphaBasis b = cubic_spline_basis(path, 20);
-  const std::vector<double> c = case4(problem, path, b);
+  const std::vector<double> c = case4_fit(problem, path, b);
   std::vector<double> g(b.coefficients);
   for (auto _ : st) benchmark::DoNotOptimize(problem.objective(b, c.data(), GlobalObjective::E, gradient ? g.data() : nullptr));
   st.counters["per_sample"] = benchmark::Counter(static_cast<double>(path.size()) * st.iterations(),
