@@ -1,0 +1,11 @@
+// The lane probe (lane_probe.hpp) in 4 lanes; compiled with -mavx2 added (tests/bench/CMakeLists.txt).
+#define KS_LANE_PROBE_IMPL
+#include "lane_probe.hpp"
+
+namespace ks_probe {
+
+void run_x4(const ProbePath& path, const double* alpha1A, const double* k, double* E) {
+  simulate<4>(path, alpha1A, k, E);
+}
+
+}  // namespace ks_probe
