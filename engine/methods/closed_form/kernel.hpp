@@ -112,6 +112,18 @@ struct Task {
   T alpha_d, alpha_v, alpha;
   bool rest = false;  // end = rest: in the terminal feedback's window (local methods)
   double rest_weight = 0;  // and its weight there (rest_weight)
+
+  /// Sets every field (the path's acceleration a, its position p, the rest zero: alpha_dd, v,
+  /// alpha_d, alpha_v; rest from rest_from). Field by field: an aggregate initialiser of this
+  /// 64-byte-aligned struct zero-fills all of it first (GCC: a rep stos per sample and stage).
+  void set(double a0, double a1, double p0, double p1, const T& alpha_now, double t, const Shared& s) {
+    a[0] = a0, a[1] = a1;
+    alpha_dd = T(0.0);
+    p[0] = p0, p[1] = p1, v[0] = 0.0, v[1] = 0.0;
+    alpha_d = T(0.0), alpha_v = T(0.0), alpha = alpha_now;
+    rest = t >= s.rest_from;
+    rest_weight = rest ? ks::kernel::rest_weight(s, t) : 0.0;  // rest_weight is 0 outside the window
+  }
 };
 
 template <class T>
@@ -277,10 +289,9 @@ void run(const Shared& s, const Runs& in, Sums* out) {
   for (std::size_t i = 0; i < n; ++i) {
     const double t = static_cast<double>(i) * dt;  // SampledPath::time(i)
     const double* xa = s.samples + 4 * i;
-    Task<T> x{{xa[2], xa[3]}, T(0.0), {xa[0], xa[1]}, {0.0, 0.0}, T(0.0), T(0.0), q[0] + q[1] + q[2]};
+    Task<T> x;
+    x.set(xa[2], xa[3], xa[0], xa[1], q[0] + q[1] + q[2], t, s);
     if (vertex) x.alpha_dd = unit_alpha_acceleration(*s.alpha_unit, s.segment[i], t) * rise(s.segment[i]);
-    x.rest = t >= s.rest_from;
-    x.rest_weight = rest_weight(s, t);
     if (s.closed_loop || vertex || x.rest) feed(s.segment[i], t, x);
     if (stop(resolver.evaluate(x, trig.trig(), qd, e), singular)) break;
     const V3 Mqdd = e.M * e.qdd;
@@ -299,9 +310,10 @@ void run(const Shared& s, const Runs& in, Sums* out) {
     const T taus[3] = {tau0, tau1, tau2};
     const V3 Mqd = e.M * qd;
     const T ke = 0.5 * (qd[0] * Mqd[0] + qd[1] * Mqd[1] + qd[2] * Mqd[2]);
-    const SampleValues<T> v{3, &q[0], &qd[0], taus, tt, T(0.0), e.Mi.P.quadratic_form(tau), e.Mi.det,
-                            p0 * p0 + p1 * p1 + p2 * p2, e.w2, ex * ex + ey * ey,
-                            vertex ? vabs(alpha - x.alpha_d) : T(0.0), alpha, ke};
+    SampleValues<T> v;  // field by field: see Task::set
+    v.n = 3, v.q = &q[0], v.qd = &qd[0], v.tau = taus, v.tt = tt, v.ff = T(0.0);
+    v.qf = e.Mi.P.quadratic_form(tau), v.det = e.Mi.det, v.p6 = p0 * p0 + p1 * p1 + p2 * p2, v.w2 = e.w2;
+    v.err2 = ex * ex + ey * ey, v.orient = vertex ? vabs(alpha - x.alpha_d) : T(0.0), v.alpha = alpha, v.ke = ke;
     const M off = sums.add(i, t, v, a, 3, keep) & active;
     sums.mark(off);
     if (in.any_history) {
@@ -322,16 +334,13 @@ void run(const Shared& s, const Runs& in, Sums* out) {
     } else {
       StageTasks stt;
       stage_tasks(*s.path, s.alpha_unit, t, dt, stt);
-      Task<T> xh{{stt.a_h[0], stt.a_h[1]}, T(0.0), {0.0, 0.0}, {0.0, 0.0}, T(0.0), T(0.0), T(0.0)};
-      Task<T> x1{{stt.a_1[0], stt.a_1[1]}, T(0.0), {0.0, 0.0}, {0.0, 0.0}, T(0.0), T(0.0), T(0.0)};
+      Task<T> xh, x1;
+      xh.set(stt.a_h[0], stt.a_h[1], 0.0, 0.0, T(0.0), t + hdt, s);
+      x1.set(stt.a_1[0], stt.a_1[1], 0.0, 0.0, T(0.0), t + dt, s);
       if (vertex) {
         xh.alpha_dd = stt.unit_h * rise(stt.seg_h);
         x1.alpha_dd = stt.unit_1 * rise(stt.seg_1);
       }
-      xh.rest = t + hdt >= s.rest_from;
-      x1.rest = t + dt >= s.rest_from;
-      xh.rest_weight = rest_weight(s, t + hdt);
-      x1.rest_weight = rest_weight(s, t + dt);
       if (s.closed_loop || xh.rest) feed(stt.seg_h, t + hdt, xh);
       if (s.closed_loop || x1.rest) feed(stt.seg_1, t + dt, x1);
       const V3 k1q = qd, k1v = e.qdd;
