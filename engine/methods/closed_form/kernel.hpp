@@ -236,8 +236,11 @@ inline int lane_bits(MaskOf<T> m) {
 }
 
 /// The loop of simulate() over lanes: out[l] for lane l (the lanes of `in` that are active).
+/// Flattened: the resolver, the resolution, the trig tracker and the sums are inlined into the loop,
+/// so that a step's intermediates (Evaluation, Task) stay in registers rather than passing through
+/// memory to out-of-line calls; the operations and their order are the same, so are the results.
 template <class T>
-void run(const Shared& s, const Runs& in, Sums* out) {
+[[gnu::flatten]] void run(const Shared& s, const Runs& in, Sums* out) {
   using V3 = Vec3Of<T>;
   using M = MaskOf<T>;
   constexpr bool one = std::is_same_v<T, double>;
@@ -248,6 +251,9 @@ void run(const Shared& s, const Runs& in, Sums* out) {
   M active = load_lanes<T>(in.active) != 0.0;
   M singular = T(0.0) != T(0.0), diverged = singular, bounded = singular;
   Evaluation<T> e, st;  // e: at the sample; st: RK4 stages
+  // qdd is read only after an evaluation that set it (an evaluation that stops every lane returns
+  // before it and the loop breaks); set once here so that GCC, with the whole loop inlined, does not warn
+  e.qdd = st.qdd = V3{T(0.0), T(0.0), T(0.0)};
   TrigTrackerOf<T> trig(q);  // the sample's trig, carried from step to step (semi-implicit Euler)
   SampleSums<T, 3> sums(load_lanes<T>(in.tracking_bound), load_lanes<T>(in.orientation_bound));
   sums.start_alpha(q[0] + q[1] + q[2]);
