@@ -12,24 +12,13 @@ import os
 
 import numpy as np
 
-from study_runs import run_study
+from study_runs import ARM7_SQUARE, run_study
 
 STUDY = """
 [study]
 name = "arm7_durations"
 histories = "none"
-
-[robot]
-urdf = "{urdf}"
-base = "base_link"
-tip = "tool"
-gravity = [0, 0, -9.81]
-
-[task]
-vertices = [[0.5, -0.1, 0.4], [0.5, 0.1, 0.4], [0.5, 0.1, 0.6], [0.5, -0.1, 0.6], [0.5, -0.1, 0.4]]
-durations = [{d}, {d}, {d}, {d}]
-integrator = "rk4"
-dt = 0.004
+""" + ARM7_SQUARE + """
 
 [[block]]
 name = "k_sweep"

@@ -17,6 +17,7 @@ import tempfile
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
 from kinesweep import read as ksread  # noqa: E402
+from study_runs import ARM7_SQUARE  # noqa: E402
 
 SEED = """
 [study]
@@ -38,18 +39,7 @@ ARM7 = """
 [study]
 name = "path_global_speed_arm7"
 histories = "none"
-
-[robot]
-urdf = "{urdf}"
-base = "base_link"
-tip = "tool"
-gravity = [0, 0, -9.81]
-
-[task]
-vertices = [[0.5, -0.1, 0.4], [0.5, 0.1, 0.4], [0.5, 0.1, 0.6], [0.5, -0.1, 0.6], [0.5, -0.1, 0.4]]
-durations = [2, 2, 2, 2]
-integrator = "rk4"
-dt = 0.004
+""" + ARM7_SQUARE.replace("{d}", "2") + """
 
 [[block]]
 name = "global"

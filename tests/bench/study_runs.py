@@ -9,6 +9,24 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from kinesweep import read as ksread  # noqa: E402
 
 
+# The 7-DOF arm (studies/robots/arm7.urdf) on its square in space, each side `d` seconds, sampled every
+# 4 ms and integrated by RK4: the [robot] and [task] tables of the path_global_arm7 benchmarks
+# (format with urdf= and d=).
+ARM7_SQUARE = """
+[robot]
+urdf = "{urdf}"
+base = "base_link"
+tip = "tool"
+gravity = [0, 0, -9.81]
+
+[task]
+vertices = [[0.5, -0.1, 0.4], [0.5, 0.1, 0.4], [0.5, 0.1, 0.6], [0.5, -0.1, 0.6], [0.5, -0.1, 0.4]]
+durations = [{d}, {d}, {d}, {d}]
+integrator = "rk4"
+dt = 0.004
+"""
+
+
 def run_study(kinesweep, text, threads="2", degrees=False):
     """The done rows of /runs (ksread's Table) of the study `text` run by `kinesweep`."""
     with tempfile.TemporaryDirectory() as tmp:
