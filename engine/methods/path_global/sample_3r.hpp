@@ -1,7 +1,8 @@
 #pragma once
-// One sample of the seed 3R arm's path-global joint path, over a scalar type T: double for the value,
-// or Dual<3> (model/dual.hpp) seeded with the chart coordinate, its rate and its acceleration, for
-// the value and its exact partials in one pass. The joint path is the exact inverse kinematics of
+// One sample of the seed 3R arm's path-global joint path, over a scalar type T: a lane type L (double,
+// or several samples in SIMD lanes: model/lanes.hpp) for the value, or DualOf<L, 3> (model/dual.hpp)
+// seeded with the chart coordinate, its rate and its acceleration, for the value and its exact
+// partials in one pass. Branches are per-lane selects, so every lane computes what a double would. The joint path is the exact inverse kinematics of
 // (tip, alpha) at the sample; qd and qdd solve the extended task [tip; alpha] with J3 = [J; 1 1 1]
 // (J3 qd = [xd; alpha_d], J3 qdd = [xdd - Jd qd; alpha_dd]) by its closed-form adjugate, whose
 // determinant is l1 l2 sin(theta2); tau = M qdd + c + g. Every sine and cosine of the joint angles
