@@ -43,10 +43,13 @@ void closed_form_3r(benchmark::State& st) {
   for (auto _ : st) benchmark::DoNotOptimize(simulate(arm, path, o));
 }
 
+/// A chain's run to its last sample: the robots' joint limits are marked, not stopped at (a run of the
+/// shipped URDFs along these squares crosses some), so every run measures the whole path.
 void run_chain(benchmark::State& st, const Chain& chain, const ChainTask& task, const VecN& q0,
-               const TrajectoryOptions& o) {
+               TrajectoryOptions o) {
+  o.on_violation = OnViolation::mark;
   const TrajectoryMetrics check = simulate(chain, task, q0, o);
-  if (check.status != RunStatus::ok) {
+  if (check.samples != task.path.size()) {
     st.SkipWithError(("run status " + std::string(to_string(check.status))).c_str());
     return;
   }

@@ -1,8 +1,8 @@
 #pragma once
 // The definition of planar_chain_run_n<N> (methods/chain/planar_run.hpp), included by the files that
-// instantiate it. The loop is methods/chain/trajectory.cpp's, step for step (same samples, statuses,
-// metrics and history), with the chain's dynamics from model/planar_chain_dynamics.hpp and the
-// resolutions written out on fixed-size arrays: an LDL^T factor of M (N x N) and one of
+// instantiate it: the planar chain as a model of the one trajectory loop
+// (methods/loop/trajectory_loop.hpp), with the chain's dynamics from model/planar_chain_dynamics.hpp
+// and the resolutions written out on fixed-size arrays: an LDL^T factor of M (N x N) and one of
 // A = J W^-1 J^T (m x m), N + m divisions per evaluation.
 #include <Eigen/LU>
 #include <algorithm>
@@ -15,6 +15,7 @@
 #include "methods/metrics/run_sums.hpp"
 #include "methods/metrics/sample_sums.hpp"
 #include "methods/chain/planar_run.hpp"
+#include "methods/loop/trajectory_loop.hpp"
 #include "model/planar_chain_dynamics.hpp"
 
 namespace ks {
@@ -180,171 +181,149 @@ class Stepper {
   double centre_[N] = {};
 };
 
-/// The loop of one run from q_start at rest.
+/// The fixed-size planar chain as methods/loop/trajectory_loop.hpp's model. The loop's state is in
+/// the kernel's coordinates u = sigma q (model/planar_chain_dynamics.hpp); values() and record()
+/// report the chain's.
 template <int N, TaskSpace S, Resolution R>
-TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_start, const TrajectoryOptions& o,
-                      const std::optional<Profile1>& alpha_profile, ChainHistory* history) {
-  constexpr int m = task_dimension(S), P = position_rows(S);
-  static_assert(P == 2);
-  const SampledPath3& sampled = task.path;
-  const QuinticPath<3>& path = sampled.path();
-  const std::size_t n = sampled.size();
-  const PlanarChainConstants<N> k(chain);
-  const double alpha_offset = PlanarAngle(chain).offset;
-  const LimitTable limits = LimitTable::of(chain);
-  const Stepper<N, S, R> stepper(k, path, o, alpha_profile, limits);
-  const auto alpha_of = [&](const double* u) {  // the tip angle at u [rad]
+class PlanarModel {
+ public:
+  static constexpr int max_joints = N;
+  static constexpr int m = task_dimension(S);
+  static_assert(position_rows(S) == 2);
+  static constexpr bool oriented = m == 3;
+  using Evaluation = planar_run::Evaluation<N, m>;
+
+  PlanarModel(const Chain& chain, const ChainTask& task, const VecN& q_start, const TrajectoryOptions& o,
+              const std::optional<Profile1>& alpha, ChainHistory* history)
+      : k_(chain), sampled_(task.path), o_(o), q_start_(q_start), history_(history), limits_(LimitTable::of(chain)),
+        stepper_(k_, task.path.path(), o, alpha, limits_), alpha_offset_(PlanarAngle(chain).offset),
+        closed_(o.closed_loop()) {}
+
+  int joints() const { return N; }
+  LoopShape shape() const { return {sampled_.size(), o_.dt, o_.integrator, o_.on_violation == OnViolation::stop}; }
+  RunShape run_shape() const { return RunShape{N, oriented, false, limits_.any() ? &limits_ : nullptr}; }
+  SampleSums<double, N> sums() const {
+    return SampleSums<double, N>(o_.tracking_bound, o_.orientation_bound, limits_.any() ? &limits_ : nullptr);
+  }
+  static constexpr bool prismatic_joints = false;
+  bool start(double* u) {
+    for (int j = 0; j < N; ++j) u[j] = k_.sigma[j] * q_start_[j];
+    trig_.reset(k_, u);
+    return true;
+  }
+  double torque_bound() const { return o_.torque_bound; }
+  /// The tip angle at u [rad].
+  double alpha(const double* u) const {
     double a = 0;
     for (int j = 0; j < N; ++j) a += u[j];
-    return alpha_offset + a;
-  };
-  const bool closed = o.closed_loop();
-  constexpr bool oriented = m == 3;
-  const RunShape shape{N, oriented, false, limits.any() ? &limits : nullptr};
+    return alpha_offset_ + a;
+  }
 
-  RunStatus status = RunStatus::ok;
-  Evaluation<N, m> e, s;  // e: at the sample; s: RK4 stages
-  // q, qd, qdd, tau: in the coordinates u = sigma q of the kernel (model/planar_chain_dynamics.hpp)
-  double q[N], qd[N], tau[N], abs_tau[N];
-  for (int j = 0; j < N; ++j) q[j] = k.sigma[j] * q_start[j], qd[j] = 0.0;
-  PlanarChainTrig<N> trig, stage;  // trig: the sample's, carried from step to step (semi-implicit Euler)
-  trig.reset(k, q);
-  SampleSums<double, N> sums(o.tracking_bound, o.orientation_bound, shape.limits);
-  const auto keep = [](double updated, double) { return updated; };
-  const double dt = o.dt;
-  double xdd[m];
-  double fb[7] = {}, fh[7] = {}, f1[7] = {};  // closed loop: path position (3), velocity (3), arm angle
-  sums.start_alpha(alpha_of(q));
-
-  for (std::size_t i = 0; i < n; ++i) {
-    const double t = sampled.time(i);
-    stepper.task(sampled, i, xdd);
-    if (closed || oriented) stepper.desired(t, sampled.segment(i), fb, fb + 3);
-    const double alpha = alpha_of(q);
-    fb[6] = alpha;
-    if (!stepper.evaluate(xdd, q, trig.s, trig.c, qd, e, closed ? fb : nullptr)) {
-      status = RunStatus::singular;
-      break;
-    }
-    double tt = 0, p6 = 0;
-    bool bounded = true;
+  bool at_sample(std::size_t i, double t, const double* u, const double* ud, Evaluation& e) {
+    stepper_.task(sampled_, i, xdd_);
+    if (closed_ || oriented) stepper_.desired(t, sampled_.segment(i), fb_, fb_ + 3);
+    fb_[6] = alpha(u);
+    return stepper_.evaluate(xdd_, u, trig_.s, trig_.c, ud, e, closed_ ? fb_ : nullptr);
+  }
+  void torques(const Evaluation& e, const double*, double* tau) const {
     for (int j = 0; j < N; ++j) {
       double Mqdd = 0;
       for (int l = 0; l < N; ++l) Mqdd += e.st.M[j][l] * e.qdd[l];
-      const double tj = Mqdd + e.st.c[j] + e.st.g[j];
-      tau[j] = tj;
-      tt += tj * tj;
-      const double pj = tj * qd[j];
-      p6 += pj * pj;
-      abs_tau[j] = std::abs(tj);
-      bounded = bounded && abs_tau[j] <= o.torque_bound;  // NaN fails the comparison
+      tau[j] = Mqdd + e.st.c[j] + e.st.g[j];
     }
-    // one test catches non-finite values and the bound
-    if (!(bounded && std::isfinite(tt))) {
-      status = RunStatus::diverged;
-      break;
-    }
-    // metrics of this sample
-    double qa[N], qda[N], taua[N];  // in the chain's coordinates q = sigma u
-    for (int j = 0; j < N; ++j) qa[j] = k.sigma[j] * q[j], qda[j] = k.sigma[j] * qd[j], taua[j] = k.sigma[j] * tau[j];
-    SampleValues<double> v;
-    v.n = N, v.q = qa, v.qd = qda, v.tau = taua;
-    v.tt = tt, v.ff = 0.0, v.p6 = p6;
+  }
+
+  void values(const Evaluation& e, std::size_t i, const double* u, const double* ud, const double* tau,
+              SampleValues<double>& v) {
+    for (int j = 0; j < N; ++j) qa_[j] = k_.sigma[j] * u[j], qda_[j] = k_.sigma[j] * ud[j], taua_[j] = k_.sigma[j] * tau[j];
+    v.q = qa_, v.qd = qda_, v.tau = taua_;
     double z[N];
     for (int j = 0; j < N; ++j) z[j] = tau[j];
     v.qf = e.Mf.inverse_quadratic_form(z), v.det = 1.0;  // tau^T M^-1 tau
-    if constexpr (P == m && R != Resolution::nonredundant)
+    if constexpr (m == 2 && R != Resolution::nonredundant)
       v.w2 = e.w2;
     else
-      v.w2 = gram_det<P>(e.st.J);
-    const Eigen::Vector3d ref = sampled.position(i);
+      v.w2 = gram_det<2>(e.st.J);
+    const Eigen::Vector3d ref = sampled_.position(i);
     const double ex = e.st.px - ref[0], ey = e.st.py - ref[1];
     v.err2 = ex * ex + ey * ey;
-    v.orient = oriented ? std::abs(alpha - fb[2]) : 0.0;
-    v.alpha = alpha;
+    v.orient = oriented ? std::abs(fb_[6] - fb_[2]) : 0.0;
+    v.alpha = fb_[6];
     double ke = 0;  // qd^T M qd / 2: the same in the kernel's coordinates u = sigma q
     for (int j = 0; j < N; ++j) {
       double Mqd = 0;
-      for (int l = 0; l < N; ++l) Mqd += e.st.M[j][l] * qd[l];
-      ke += qd[j] * Mqd;
+      for (int l = 0; l < N; ++l) Mqd += e.st.M[j][l] * ud[l];
+      ke += ud[j] * Mqd;
     }
     v.ke = 0.5 * ke;
-    const bool off = sums.add(i, t, v, abs_tau, N, keep);
-    bool beyond = false;
-    if (shape.limits) beyond = sums.limits(qa, qda, tau, N);
-    sums.mark(off, beyond);
-    if (history && (i % history->stride == 0 || i + 1 == n)) {
-      const Eigen::Index col = history->size++;
-      history->t[col] = t;
-      for (int j = 0; j < N; ++j) {
-        history->q(j, col) = k.sigma[j] * q[j];
-        history->qd(j, col) = k.sigma[j] * qd[j];
-        history->qdd(j, col) = k.sigma[j] * e.qdd[j];
-        history->tau(j, col) = k.sigma[j] * tau[j];
-      }
-      history->x(0, col) = e.st.px;
-      history->x(1, col) = e.st.py;
-      history->alpha[col] = alpha;
+  }
+
+  void record(std::size_t i, double t, const Evaluation& e, const double* u, const double* ud, const double* tau,
+              bool) {
+    if (!history_ || !(i % history_->stride == 0 || i + 1 == sampled_.size())) return;
+    ChainHistory& h = *history_;
+    const Eigen::Index col = h.size++;
+    h.t[col] = t;
+    for (int j = 0; j < N; ++j) {
+      h.q(j, col) = k_.sigma[j] * u[j];
+      h.qd(j, col) = k_.sigma[j] * ud[j];
+      h.qdd(j, col) = k_.sigma[j] * e.qdd[j];
+      h.tau(j, col) = k_.sigma[j] * tau[j];
     }
-    if (o.on_violation == OnViolation::stop && (off || beyond)) break;
-    if (i + 1 == n) break;  // the last sample is measured, not integrated past
-    // integrate to the next sample
-    if (o.integrator == Integrator::semi_implicit_euler) {
-      double dq[N];
-      for (int j = 0; j < N; ++j) {
-        qd[j] += dt * e.qdd[j];
-        dq[j] = dt * qd[j];
-        q[j] += dq[j];
-      }
-      trig.advance(k, q, dq);
-    } else {
-      const double h = 0.5 * dt, th = t + h, t1 = t + dt;
-      const std::size_t sh = path.segment_at(th), s1 = path.segment_at(t1);
-      double xh[m], x1[m], k2q[N], k3q[N], k4q[N], k2v[N], k3v[N], yq[N], yv[N];
-      stepper.task(th, sh, xh);
-      stepper.task(t1, s1, x1);
-      if (closed) {
-        stepper.desired(th, sh, fh, fh + 3);
-        stepper.desired(t1, s1, f1, f1 + 3);
-      }
-      // stage 2 at (q + h k1q, qd + h k1v) with k1q = qd, k1v = qdd
-      for (int j = 0; j < N; ++j) {
-        yq[j] = q[j] + h * qd[j];
-        k2q[j] = yv[j] = qd[j] + h * e.qdd[j];
-      }
-      stage.reset(k, yq);
-      fh[6] = alpha_of(yq);
-      bool good = stepper.evaluate(xh, yq, stage.s, stage.c, yv, s, closed ? fh : nullptr);
-      for (int j = 0; j < N; ++j) {
-        k2v[j] = s.qdd[j];
-        yq[j] = q[j] + h * k2q[j];
-        k3q[j] = yv[j] = qd[j] + h * k2v[j];
-      }
-      stage.reset(k, yq);
-      fh[6] = alpha_of(yq);
-      good = good && stepper.evaluate(xh, yq, stage.s, stage.c, yv, s, closed ? fh : nullptr);
-      for (int j = 0; j < N; ++j) {
-        k3v[j] = s.qdd[j];
-        yq[j] = q[j] + dt * k3q[j];
-        k4q[j] = yv[j] = qd[j] + dt * k3v[j];
-      }
-      stage.reset(k, yq);
-      f1[6] = alpha_of(yq);
-      good = good && stepper.evaluate(x1, yq, stage.s, stage.c, yv, s, closed ? f1 : nullptr);
-      if (!good) {
-        status = RunStatus::singular;
-        break;
-      }
-      const double w = dt / 6.0;
-      for (int j = 0; j < N; ++j) {
-        const double k4v = s.qdd[j];
-        q[j] += w * (qd[j] + 2.0 * k2q[j] + 2.0 * k3q[j] + k4q[j]);
-        qd[j] += w * (e.qdd[j] + 2.0 * k2v[j] + 2.0 * k3v[j] + k4v);
-      }
-      trig.reset(k, q);
+    h.x(0, col) = e.st.px;
+    h.x(1, col) = e.st.py;
+    h.alpha[col] = fb_[6];
+  }
+
+  void stages(double t, double dt) {
+    const QuinticPath<3>& path = sampled_.path();
+    const double th = t + 0.5 * dt, t1 = t + dt;
+    const std::size_t sh = path.segment_at(th), s1 = path.segment_at(t1);
+    stepper_.task(th, sh, xh_);
+    stepper_.task(t1, s1, x1_);
+    if (closed_) {
+      stepper_.desired(th, sh, fh_, fh_ + 3);
+      stepper_.desired(t1, s1, f1_, f1_ + 3);
     }
   }
-  return finish_run(sums.of_lane(0, status, N), shape, o);
+  bool stage(bool end, const double* yq, const double* yv, Evaluation& s) {
+    stage_.reset(k_, yq);
+    double* f = end ? f1_ : fh_;
+    f[6] = alpha(yq);
+    return stepper_.evaluate(end ? x1_ : xh_, yq, stage_.s, stage_.c, yv, s, closed_ ? f : nullptr);
+  }
+  /// The sample's trig carried along (semi-implicit Euler's step dq) or recomputed at u (RK4).
+  void moved(const double* u, const double* dq) {
+    if (dq)
+      trig_.advance(k_, u, dq);
+    else
+      trig_.reset(k_, u);
+  }
+
+ private:
+  const PlanarChainConstants<N> k_;
+  const SampledPath3& sampled_;
+  const TrajectoryOptions& o_;
+  const VecN& q_start_;
+  ChainHistory* history_;
+  const LimitTable limits_;
+  const Stepper<N, S, R> stepper_;
+  const double alpha_offset_;
+  const bool closed_;
+  PlanarChainTrig<N> trig_, stage_;  // trig_: the sample's, carried from step to step (semi-implicit Euler)
+  double xdd_[m], xh_[m], x1_[m];
+  double fb_[7] = {}, fh_[7] = {}, f1_[7] = {};  // path position (3), velocity (3), the arm's tip angle
+  double qa_[N], qda_[N], taua_[N];               // in the chain's coordinates q = sigma u
+};
+
+/// One run from q_start at rest: the one trajectory loop over the planar chain.
+template <int N, TaskSpace S, Resolution R>
+TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_start, const TrajectoryOptions& o,
+                      const std::optional<Profile1>& alpha_profile, ChainHistory* h) {
+  PlanarModel<N, S, R> model(chain, task, q_start, o, alpha_profile, h);
+  RunSums sums;
+  trajectory_loop<double>(model, &sums);
+  return finish_run(sums, model.run_shape(), o);
 }
 
 }  // namespace planar_run

@@ -1,9 +1,11 @@
-// simulate_local() for a chain: the closed form's loop (methods/closed_form/run.cpp) over the chain's dynamics
-// (model/chain_dynamics.hpp) and the resolutions of methods/chain/resolution.hpp. The task space and
-// the method are template parameters of the loop, chosen once per run: the step branches on neither.
-// Fixed-maximum-size types throughout: nothing is allocated per step. Planar tasks on planar chains of
-// revolute joints take the fixed-size run of methods/chain/planar_run.hpp instead.
+// simulate_local() for a chain: the chain as a model of the one trajectory loop
+// (methods/loop/trajectory_loop.hpp) over the chain's dynamics (model/chain_dynamics.hpp) and the
+// resolutions of methods/chain/resolution.hpp. The task space and the method are template parameters
+// of the model, chosen once per run: the step branches on neither. Fixed-maximum-size types
+// throughout: nothing is allocated per step. Planar tasks on planar chains of revolute joints take the
+// fixed-size model of methods/chain/planar_run.hpp instead.
 #include "methods/chain/trajectory.hpp"
+#include "methods/loop/trajectory_loop.hpp"
 #include "methods/metrics/run_sums.hpp"
 #include "methods/metrics/sample_sums.hpp"
 #include "methods/base/singular_scale.hpp"
@@ -38,7 +40,7 @@ enum class Resolution { weighted, unweighted, nonredundant };
 
 /// Everything one evaluation of the method at (t, q, qd) produces.
 template <int m>
-struct Evaluation {
+struct SampleEvaluation {
   ChainState st;           // M, c, g, J (6 x n), bias, tip
   InertiaFactor Mf;        // M = L D L^T
   TaskJacobian<m> Jt;      // task rows of J
@@ -104,7 +106,7 @@ class ChainResolver {
   /// Joint accelerations for task acceleration xdd at (q, qd); fills every intermediate in `e`. With
   /// `fb` (closed loop), xdd + K_D (path velocity - J qd) + K_P (path - tip) is commanded instead.
   /// Returns false when the task Jacobian is singular.
-  bool evaluate(const TaskVec<m>& xdd, const VecN& q, const VecN& qd, Evaluation<m>& e, const Desired* fb = nullptr) {
+  bool evaluate(const TaskVec<m>& xdd, const VecN& q, const VecN& qd, SampleEvaluation<m>& e, const Desired* fb = nullptr) {
     evaluate_dynamics(chain_, data_, q, qd, e.st);
     select_task_rows<S>(e.st.J, e.Jt);
     TaskVec<m> b = xdd - select_task_rows<S>(e.st.bias);
@@ -168,145 +170,147 @@ class ChainResolver {
   double centre_[kMaxJoints] = {}, spring_term_[kMaxJoints] = {};
 };
 
-/// The loop of one run from the start q_start at rest.
+/// The chain as methods/loop/trajectory_loop.hpp's model: the loop's state copied into the
+/// resolver's vectors, the per-sample values on the chain's Eigen types.
 template <TaskSpace S, Resolution R>
-TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_start, const TrajectoryOptions& o,
-                      const std::optional<Profile1>& alpha_profile, ChainHistory* history) {
-  constexpr int m = task_dimension(S), P = position_rows(S);
-  const SampledPath3& sampled = task.path;
-  const QuinticPath<3>& path = sampled.path();
-  const std::size_t n = sampled.size();
-  const int dof = chain.dof();
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  const std::optional<PlanarAngle> angle = is_planar(S) ? std::optional<PlanarAngle>(PlanarAngle(chain)) : std::nullopt;
-  const bool closed = o.closed_loop();
-  constexpr bool oriented = S == TaskSpace::planar_pose || S == TaskSpace::spatial_pose;
-  const LimitTable limits = LimitTable::of(chain);
-  RunShape shape{dof, oriented, false, limits.any() ? &limits : nullptr};
-  bool prismatic[kMaxJoints];
-  for (int j = 0; j < dof; ++j) shape.prismatic |= prismatic[j] = chain.joints[j].type == JointType::prismatic;
+class ChainModel {
+ public:
+  static constexpr int max_joints = kMaxJoints;
+  static constexpr bool prismatic_joints = true;
+  static constexpr int m = task_dimension(S), P = position_rows(S);
+  static constexpr bool oriented = S == TaskSpace::planar_pose || S == TaskSpace::spatial_pose;
+  using Evaluation = SampleEvaluation<m>;
 
-  RunStatus status = RunStatus::ok;
-  ChainResolver<S, R> resolver(chain, path, o, alpha_profile);
-  Evaluation<m> e, s;  // e: at the sample; s: RK4 stages
-  VecN q = q_start, qd = VecN::Zero(dof), tau(dof), z(dof);
-  VecN k1q, k1v, k2q, k2v, k3q, k3v, k4q, k4v, yq;
-  SampleSums<double, kMaxJoints> sums(o.tracking_bound, o.orientation_bound, shape.limits);
-  const auto keep = [](double updated, double) { return updated; };
-  const double dt = o.dt;
-  Desired d, dh, d1;  // at the sample, at RK4's stage times
-  Eigen::Matrix3d held = Eigen::Matrix3d::Identity();  // spatial_pose: the start's orientation
-  d.R = dh.R = d1.R = &held;
-  sums.start_alpha(angle ? (*angle)(q) : nan);
+  ChainModel(const Chain& chain, const ChainTask& task, const VecN& q_start, const TrajectoryOptions& o,
+             const std::optional<Profile1>& alpha, ChainHistory* history)
+      : chain_(chain), sampled_(task.path), o_(o), q_start_(q_start), history_(history),
+        resolver_(chain, task.path.path(), o, alpha), limits_(LimitTable::of(chain)), closed_(o.closed_loop()),
+        n_(chain.dof()) {
+    if constexpr (is_planar(S)) angle_.emplace(chain);
+    for (int j = 0; j < n_; ++j) prismatic_[j] = chain.joints[j].type == JointType::prismatic;
+    q_.resize(n_), qd_.resize(n_), yq_.resize(n_), yv_.resize(n_), z_.resize(n_);
+    d_.R = dh_.R = d1_.R = &held_;
+  }
 
-  for (std::size_t i = 0; i < n; ++i) {
-    const double t = sampled.time(i);
-    if (closed || oriented) resolver.desired(t, sampled.segment(i), d);
-    if (angle) d.alpha_now = (*angle)(q);
+  int joints() const { return n_; }
+  LoopShape shape() const { return {sampled_.size(), o_.dt, o_.integrator, o_.on_violation == OnViolation::stop}; }
+  RunShape run_shape() const {
+    RunShape shape{n_, oriented, false, limits_.any() ? &limits_ : nullptr};
+    for (int j = 0; j < n_; ++j) shape.prismatic |= prismatic_[j];
+    return shape;
+  }
+  SampleSums<double, kMaxJoints> sums() const {
+    return SampleSums<double, kMaxJoints>(o_.tracking_bound, o_.orientation_bound, limits_.any() ? &limits_ : nullptr);
+  }
+  bool start(double* q) {
+    for (int j = 0; j < n_; ++j) q[j] = q_[j] = q_start_[j];
+    return true;
+  }
+  double alpha(const double*) const { return angle_ ? (*angle_)(q_) : std::numeric_limits<double>::quiet_NaN(); }
+  double torque_bound() const { return o_.torque_bound; }
+  bool prismatic(int j) const { return prismatic_[j]; }
+
+  bool at_sample(std::size_t i, double t, const double* q, const double* qd, Evaluation& e) {
+    for (int j = 0; j < n_; ++j) q_[j] = q[j], qd_[j] = qd[j];
+    if (closed_ || oriented) resolver_.desired(t, sampled_.segment(i), d_);
+    if (angle_) d_.alpha_now = (*angle_)(q_);
     if (i == 0 && S == TaskSpace::spatial_pose) {  // the orientation held: the start's, before any feedback
       ChainState st0;
       ChainData data0;
-      evaluate_dynamics(chain, data0, q, qd, st0);
-      held = st0.tip.R;
+      evaluate_dynamics(chain_, data0, q_, qd_, st0);
+      held_ = st0.tip.R;
     }
-    if (!resolver.evaluate(resolver.task(sampled, i), q, qd, e, closed ? &d : nullptr)) {
-      status = RunStatus::singular;
-      break;
-    }
-    double tt = 0, ff = 0, p6 = 0, abs_tau[kMaxJoints];
-    bool bounded = true;
-    for (int j = 0; j < dof; ++j) {
+    return resolver_.evaluate(resolver_.task(sampled_, i), q_, qd_, e, closed_ ? &d_ : nullptr);
+  }
+  void torques(const Evaluation& e, const double*, double* tau) const {
+    for (int j = 0; j < n_; ++j) {
       double Mqdd = 0;
-      for (int k = 0; k < dof; ++k) Mqdd += e.st.M(j, k) * e.qdd[k];
-      const double tj = Mqdd + e.st.c[j] + e.st.g[j];
-      tau[j] = z[j] = tj;
-      (prismatic[j] ? ff : tt) += tj * tj;
-      const double pj = tj * qd[j];
-      p6 += pj * pj;
-      abs_tau[j] = std::abs(tj);
-      bounded = bounded && abs_tau[j] <= o.torque_bound;  // NaN fails the comparison
+      for (int k = 0; k < n_; ++k) Mqdd += e.st.M(j, k) * e.qdd[k];
+      tau[j] = Mqdd + e.st.c[j] + e.st.g[j];
     }
-    // one test catches non-finite values and the bound
-    if (!(bounded && std::isfinite(tt) && std::isfinite(ff))) {
-      status = RunStatus::diverged;
-      break;
-    }
-    // metrics of this sample
-    SampleValues<double> v;
-    v.n = dof, v.q = q.data(), v.qd = qd.data(), v.tau = tau.data();
-    v.tt = tt, v.ff = ff, v.p6 = p6;
-    v.qf = e.Mf.inverse_quadratic_form(z.data()), v.det = 1.0;  // tau^T M^-1 tau
+  }
+
+  void values(const Evaluation& e, std::size_t i, const double* q, const double* qd, const double* tau,
+              SampleValues<double>& v) {
+    v.q = q, v.qd = qd, v.tau = tau;
+    for (int j = 0; j < n_; ++j) z_[j] = tau[j];
+    v.qf = e.Mf.inverse_quadratic_form(z_.data()), v.det = 1.0;  // tau^T M^-1 tau
     if constexpr (P == m && R != Resolution::nonredundant)
       v.w2 = e.w2;
     else
       v.w2 = gram_determinant<P, m>(e.Jt);
-    const Eigen::Matrix<double, P, 1> err = e.st.tip.p.template head<P>() - sampled.position(i).template head<P>();
+    const Eigen::Matrix<double, P, 1> err = e.st.tip.p.template head<P>() - sampled_.position(i).template head<P>();
     v.err2 = err.squaredNorm();
     v.orient = 0.0;
-    if constexpr (S == TaskSpace::planar_pose) v.orient = std::abs(d.alpha_now - d.alpha);
-    if constexpr (S == TaskSpace::spatial_pose) v.orient = orientation_angle(e.st.tip.R, held);
-    v.alpha = angle ? d.alpha_now : nan;
+    if constexpr (S == TaskSpace::planar_pose) v.orient = std::abs(d_.alpha_now - d_.alpha);
+    if constexpr (S == TaskSpace::spatial_pose) v.orient = orientation_angle(e.st.tip.R, held_);
+    v.alpha = angle_ ? d_.alpha_now : std::numeric_limits<double>::quiet_NaN();
     double ke = 0;  // qd^T M qd (no temporary per sample)
-    for (int j = 0; j < dof; ++j) ke += qd[j] * e.st.M.row(j).head(dof).dot(qd.head(dof));
+    for (int j = 0; j < n_; ++j) ke += qd_[j] * e.st.M.row(j).head(n_).dot(qd_.head(n_));
     v.ke = 0.5 * ke;
-    const bool off = sums.add(i, t, v, abs_tau, dof, keep);
-    const bool beyond = sums.limits(q.data(), qd.data(), tau.data(), dof);
-    sums.mark(off, beyond);
-    if (history && (i % history->stride == 0 || i + 1 == n)) {
-      const Eigen::Index c = history->size++;
-      history->t[c] = t;
-      history->q.col(c) = q;
-      history->qd.col(c) = qd;
-      history->qdd.col(c) = e.qdd;
-      history->tau.col(c) = tau;
-      history->x.col(c) = e.st.tip.p.template head<P>();
-      history->alpha[c] = v.alpha;
-    }
-    if (o.on_violation == OnViolation::stop && (off || beyond)) break;
-    if (i + 1 == n) break;  // the last sample is measured, not integrated past
-    // integrate to the next sample
-    if (o.integrator == Integrator::semi_implicit_euler) {
-      for (int j = 0; j < dof; ++j) {
-        qd[j] += dt * e.qdd[j];
-        q[j] += dt * qd[j];
-      }
-    } else {
-      const double th = t + 0.5 * dt, t1 = t + dt;
-      const std::size_t sh = path.segment_at(th), s1 = path.segment_at(t1);
-      k1q = qd;
-      k1v = e.qdd;
-      const TaskVec<m> xh = resolver.task(th, sh), x1 = resolver.task(t1, s1);
-      if (closed) {
-        resolver.desired(th, sh, dh);
-        resolver.desired(t1, s1, d1);
-      }
-      // stage state's tip angle for planar_pose feedback
-      const auto at = [&](const VecN& y, Desired& dd) -> const Desired* {
-        if (!closed) return nullptr;
-        if (angle) dd.alpha_now = (*angle)(y);
-        return &dd;
-      };
-      yq = q + 0.5 * dt * k1q;
-      bool good = resolver.evaluate(xh, yq, qd + 0.5 * dt * k1v, s, at(yq, dh));
-      k2q = qd + 0.5 * dt * k1v;
-      k2v = s.qdd;
-      yq = q + 0.5 * dt * k2q;
-      good = good && resolver.evaluate(xh, yq, qd + 0.5 * dt * k2v, s, at(yq, dh));
-      k3q = qd + 0.5 * dt * k2v;
-      k3v = s.qdd;
-      yq = q + dt * k3q;
-      good = good && resolver.evaluate(x1, yq, qd + dt * k3v, s, at(yq, d1));
-      if (!good) {
-        status = RunStatus::singular;
-        break;
-      }
-      k4q = qd + dt * k3v;
-      k4v = s.qdd;
-      q += dt / 6.0 * (k1q + 2.0 * k2q + 2.0 * k3q + k4q);
-      qd += dt / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+  }
+
+  void record(std::size_t i, double t, const Evaluation& e, const double*, const double*, const double* tau, bool) {
+    if (!history_ || !(i % history_->stride == 0 || i + 1 == sampled_.size())) return;
+    ChainHistory& h = *history_;
+    const Eigen::Index c = h.size++;
+    h.t[c] = t;
+    h.q.col(c) = q_;
+    h.qd.col(c) = qd_;
+    h.qdd.col(c) = e.qdd;
+    for (int j = 0; j < n_; ++j) h.tau(j, c) = tau[j];
+    h.x.col(c) = e.st.tip.p.template head<P>();
+    h.alpha[c] = angle_ ? d_.alpha_now : std::numeric_limits<double>::quiet_NaN();
+  }
+
+  void stages(double t, double dt) {
+    const QuinticPath<3>& path = sampled_.path();
+    const double th = t + 0.5 * dt, t1 = t + dt;
+    const std::size_t sh = path.segment_at(th), s1 = path.segment_at(t1);
+    xh_ = resolver_.task(th, sh), x1_ = resolver_.task(t1, s1);
+    if (closed_) {
+      resolver_.desired(th, sh, dh_);
+      resolver_.desired(t1, s1, d1_);
     }
   }
-  return finish_run(sums.of_lane(0, status, dof), shape, o);
+  bool stage(bool end, const double* yq, const double* yv, Evaluation& s) {
+    for (int j = 0; j < n_; ++j) yq_[j] = yq[j], yv_[j] = yv[j];
+    Desired& dd = end ? d1_ : dh_;
+    const Desired* fb = nullptr;
+    if (closed_) {  // the stage state's tip angle for planar_pose feedback
+      if (angle_) dd.alpha_now = (*angle_)(yq_);
+      fb = &dd;
+    }
+    return resolver_.evaluate(end ? x1_ : xh_, yq_, yv_, s, fb);
+  }
+  void moved(const double*, const double*) {}
+
+ private:
+  const Chain& chain_;
+  const SampledPath3& sampled_;
+  const TrajectoryOptions& o_;
+  const VecN& q_start_;
+  ChainHistory* history_;
+  ChainResolver<S, R> resolver_;
+  const LimitTable limits_;
+  const bool closed_;
+  const int n_;
+  std::optional<PlanarAngle> angle_;
+  bool prismatic_[kMaxJoints] = {};
+  VecN q_, qd_, yq_, yv_, z_;  // the sample's state, a stage's, tau (for M^-1 tau)
+  TaskVec<m> xh_, x1_;         // RK4: the task at the half step and the step's end
+  Desired d_, dh_, d1_;        // at the sample, at RK4's stage times
+  Eigen::Matrix3d held_ = Eigen::Matrix3d::Identity();  // spatial_pose: the start's orientation
+};
+
+/// One run from the start q_start at rest: the one trajectory loop over the chain.
+template <TaskSpace S, Resolution R>
+TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_start, const TrajectoryOptions& o,
+                      const std::optional<Profile1>& alpha_profile, ChainHistory* history) {
+  ChainModel<S, R> model(chain, task, q_start, o, alpha_profile, history);
+  RunSums sums;
+  trajectory_loop<double>(model, &sums);
+  return finish_run(sums, model.run_shape(), o);
 }
 
 template <TaskSpace S>

@@ -1,10 +1,9 @@
 #pragma once
-// The simulation loop of simulate() as a template over the lane type T (model/lanes.hpp). T = double
-// is simulate() itself; F64x4 and F64x8 run 4 or 8 runs side by side (simulate_lanes), every lane with
-// the operations of the run alone in the same order, so with its bits. Per-lane decisions: the trig
-// tracker's direct evaluations, the statuses (a lane that stops is masked: its sums stop where the run
-// alone breaks, its state is parked at its start with zero velocity so that it computes harmless
-// values), the histories.
+// The seed's closed-form 3R run as a model of the one trajectory loop (methods/loop/trajectory_loop.hpp)
+// over the lane type T (model/lanes.hpp). T = double is simulate() itself; F64x4 and F64x8 run 4 or 8
+// runs side by side (simulate_lanes), every lane with the operations of the run alone in the same
+// order, so with its bits. Per-lane decisions here: the trig tracker's direct evaluations and the
+// histories (the loop masks the statuses and parks a stopped lane's state).
 // The kernel reads plain arrays and calls only templates over T and out-of-line functions, so that a
 // translation unit compiled for wider vectors (methods/closed_form/lanes_x8.cpp) emits no inline
 // function that the rest of the program could end up calling (tests/CMakeLists.txt checks its symbols).
@@ -16,6 +15,7 @@
 #include "methods/metrics/run_sums.hpp"
 #include "methods/metrics/sample_sums.hpp"
 #include "methods/base/trajectory.hpp"
+#include "methods/loop/trajectory_loop.hpp"
 #include "model/dynamics.hpp"
 
 namespace ks::kernel {
@@ -235,150 +235,129 @@ inline int lane_bits(MaskOf<T> m) {
   else return bits(m);
 }
 
-/// The loop of simulate() over lanes: out[l] for lane l (the lanes of `in` that are active).
-/// Flattened: the resolver, the resolution, the trig tracker and the sums are inlined into the loop,
-/// so that a step's intermediates (Evaluation, Task) stay in registers rather than passing through
-/// memory to out-of-line calls; the operations and their order are the same, so are the results.
+/// The closed-form 3R as methods/loop/trajectory_loop.hpp's model over the lanes of T: the path's
+/// task at each sample and stage (shared by the lanes), the resolver, the trig carried from step to
+/// step (semi-implicit Euler), the per-sample values and the lanes' histories.
 template <class T>
-[[gnu::flatten]] void run(const Shared& s, const Runs& in, Sums* out) {
+class Model {
+ public:
   using V3 = Vec3Of<T>;
   using M = MaskOf<T>;
-  constexpr bool one = std::is_same_v<T, double>;
-  constexpr int N = lanes_of<T>;
-  const Resolver<T> resolver(s, in);
-  const V3 q_start{load_lanes<T>(in.q0[0]), load_lanes<T>(in.q0[1]), load_lanes<T>(in.q0[2])};
-  V3 q = q_start, qd{T(0.0), T(0.0), T(0.0)};
-  M active = load_lanes<T>(in.active) != 0.0;
-  M singular = T(0.0) != T(0.0), diverged = singular, bounded = singular;
-  Evaluation<T> e, st;  // e: at the sample; st: RK4 stages
-  // qdd is read only after an evaluation that set it (an evaluation that stops every lane returns
-  // before it and the loop breaks); set once here so that GCC, with the whole loop inlined, does not warn
-  e.qdd = st.qdd = V3{T(0.0), T(0.0), T(0.0)};
-  TrigTrackerOf<T> trig(q);  // the sample's trig, carried from step to step (semi-implicit Euler)
-  SampleSums<T, 3> sums(load_lanes<T>(in.tracking_bound), load_lanes<T>(in.orientation_bound));
-  sums.start_alpha(q[0] + q[1] + q[2]);
-  // a sample's value enters a lane's sums only while the lane runs (one lane: the loop stops instead;
-  // while every lane runs, nothing is masked)
-  bool all_on = all(active);
-  const auto keep = [&](const T& updated, const T& old) -> T {  // uses active, all_on with lanes
-    if constexpr (one) return updated;
-    else return all_on ? updated : select(active, updated, old);
-  };
-  const double dt = s.dt, hdt = 0.5 * dt, dt6 = dt / 6.0;
-  const std::size_t n = s.n;
-  const bool vertex = s.method == TrajectoryMethod::vertex_alpha;
-  const auto lanes_at = [](const double* a, std::size_t segment) -> T { return load_lanes<T>(a + segment * kMaxLanes); };
-  const auto rise = [&](std::size_t segment) -> T { return lanes_at(in.alpha_rise, segment); };
-  // the closed loop's path state at (segment, t) into task x (vertex_alpha: also the desired orientation)
-  const auto feed = [&](std::size_t segment, double t, Task<T>& x) {
+  using Evaluation = kernel::Evaluation<T>;
+  static constexpr int max_joints = 3;
+
+  /// resolver and trig: the run's (trig: at the start q0), kept apart from the model so that the
+  /// compiler keeps each in registers.
+  Model(const Shared& s, const Runs& in, const Resolver<T>& resolver, TrigTrackerOf<T>& trig)
+      : s_(s), in_(in), resolver_(resolver), vertex_(s.method == TrajectoryMethod::vertex_alpha), trig_(trig) {}
+
+  int joints() const { return 3; }
+  LoopShape shape() const { return {s_.n, s_.dt, s_.integrator, s_.stop_on_bound}; }
+  SampleSums<T, 3> sums() const {
+    return SampleSums<T, 3>(load_lanes<T>(in_.tracking_bound), load_lanes<T>(in_.orientation_bound));
+  }
+  M start(T* q) const {
+    for (int j = 0; j < 3; ++j) q[j] = load_lanes<T>(in_.q0[j]);
+    return load_lanes<T>(in_.active) != 0.0;
+  }
+  static T alpha(const T* q) { return q[0] + q[1] + q[2]; }
+  T torque_bound() const { return load_lanes<T>(in_.torque_bound); }
+  static constexpr bool prismatic_joints = false;
+
+  M at_sample(std::size_t i, double t, const T* q, const T* qd, Evaluation& e) {
+    const double* xa = s_.samples + 4 * i;
+    Task<T> x;
+    x.set(xa[2], xa[3], xa[0], xa[1], alpha(q), t, s_);
+    if (vertex_) x.alpha_dd = unit_alpha_acceleration(*s_.alpha_unit, s_.segment[i], t) * rise(s_.segment[i]);
+    if (s_.closed_loop || vertex_ || x.rest) feed(s_.segment[i], t, x);
+    alpha_d_ = x.alpha_d;
+    return resolver_.evaluate(x, trig_.trig(), V3{qd[0], qd[1], qd[2]}, e);
+  }
+  static void torques(const Evaluation& e, const T*, T* tau) {
+    const V3 Mqdd = e.M * e.qdd;
+    for (int j = 0; j < 3; ++j) tau[j] = Mqdd[j] + e.c[j] + e.g[j];
+  }
+  void values(const Evaluation& e, std::size_t i, const T* q, const T* qd, const T* tau, SampleValues<T>& v) const {
+    const double* xa = s_.samples + 4 * i;
+    const T ex = e.J(1, 0) - xa[0], ey = -e.J(0, 0) - xa[1];  // tip = (x1, y1) = (J10, -J00)
+    const T a = alpha(q);
+    const V3 qdv{qd[0], qd[1], qd[2]};
+    const V3 Mqd = e.M * qdv;
+    v.q = q, v.qd = qd, v.tau = tau;
+    v.qf = e.Mi.P.quadratic_form(V3{tau[0], tau[1], tau[2]}), v.det = e.Mi.det, v.w2 = e.w2;
+    v.err2 = ex * ex + ey * ey, v.orient = vertex_ ? vabs(a - alpha_d_) : T(0.0), v.alpha = a;
+    v.ke = 0.5 * (qd[0] * Mqd[0] + qd[1] * Mqd[1] + qd[2] * Mqd[2]);
+  }
+  void record(std::size_t i, double t, const Evaluation& e, const T* q, const T* qd, const T* tau, M active) const {
+    if (!in_.any_history) return;
+    int write = 0;
+    for (int l = 0; l < lanes_of<T>; ++l)
+      if (in_.history[l] && (i % in_.history[l]->stride == 0 || i + 1 == s_.n)) write |= 1 << l;
+    write &= lane_bits<T>(active);
+    if (write)
+      write_histories<T>(in_, write, t, V3{q[0], q[1], q[2]}, V3{qd[0], qd[1], qd[2]}, e, {tau[0], tau[1], tau[2]},
+                         alpha(q));
+  }
+  void stages(double t, double dt) {
+    StageTasks stt;
+    stage_tasks(*s_.path, s_.alpha_unit, t, dt, stt);
+    const double hdt = 0.5 * dt;
+    xh_.set(stt.a_h[0], stt.a_h[1], 0.0, 0.0, T(0.0), t + hdt, s_);
+    x1_.set(stt.a_1[0], stt.a_1[1], 0.0, 0.0, T(0.0), t + dt, s_);
+    if (vertex_) {
+      xh_.alpha_dd = stt.unit_h * rise(stt.seg_h);
+      x1_.alpha_dd = stt.unit_1 * rise(stt.seg_1);
+    }
+    if (s_.closed_loop || xh_.rest) feed(stt.seg_h, t + hdt, xh_);
+    if (s_.closed_loop || x1_.rest) feed(stt.seg_1, t + dt, x1_);
+  }
+  M stage(bool end, const T* yq, const T* yv, Evaluation& st) {
+    Task<T>& x = end ? x1_ : xh_;
+    const V3 q{yq[0], yq[1], yq[2]};
+    x.alpha = q[0] + q[1] + q[2];
+    return resolver_.evaluate(x, joint_trig(q), V3{yv[0], yv[1], yv[2]}, st);
+  }
+  void moved(const T* q, const T* dq) {
+    if (dq)
+      trig_.advance(V3{q[0], q[1], q[2]}, V3{dq[0], dq[1], dq[2]});
+    else
+      trig_.reset(V3{q[0], q[1], q[2]});
+  }
+
+ private:
+  T lanes_at(const double* a, std::size_t segment) const { return load_lanes<T>(a + segment * kMaxLanes); }
+  T rise(std::size_t segment) const { return lanes_at(in_.alpha_rise, segment); }
+  /// The closed loop's path state at (segment, t) into task x (vertex_alpha: also the desired orientation).
+  void feed(std::size_t segment, double t, Task<T>& x) const {
     PathState ps;
-    path_state(*s.path, s.alpha_unit, segment, t, ps);
+    path_state(*s_.path, s_.alpha_unit, segment, t, ps);
     x.p[0] = ps.p[0], x.p[1] = ps.p[1], x.v[0] = ps.v[0], x.v[1] = ps.v[1];
-    if (vertex) {
+    if (vertex_) {
       const T r = rise(segment);
-      x.alpha_d = lanes_at(in.alpha_from, segment) + ps.rise_p * r;
+      x.alpha_d = lanes_at(in_.alpha_from, segment) + ps.rise_p * r;
       x.alpha_v = ps.rise_v * r;
     }
-  };
-  const auto stop = [&](M ok, M& status) {  // lanes failing ok stop with `status`; true when none runs on
-    if constexpr (one) {
-      if (!ok) status = true;
-      return !ok;
-    } else {
-      status = status | (active & !ok);
-      active = active & ok;
-      all_on = all(active);
-      return !any(active);
-    }
-  };
-
-  for (std::size_t i = 0; i < n; ++i) {
-    const double t = static_cast<double>(i) * dt;  // SampledPath::time(i)
-    const double* xa = s.samples + 4 * i;
-    Task<T> x;
-    x.set(xa[2], xa[3], xa[0], xa[1], q[0] + q[1] + q[2], t, s);
-    if (vertex) x.alpha_dd = unit_alpha_acceleration(*s.alpha_unit, s.segment[i], t) * rise(s.segment[i]);
-    if (s.closed_loop || vertex || x.rest) feed(s.segment[i], t, x);
-    if (stop(resolver.evaluate(x, trig.trig(), qd, e), singular)) break;
-    const V3 Mqdd = e.M * e.qdd;
-    const T tau0 = Mqdd[0] + e.c[0] + e.g[0], tau1 = Mqdd[1] + e.c[1] + e.g[1], tau2 = Mqdd[2] + e.c[2] + e.g[2];
-    const T a[3] = {vabs(tau0), vabs(tau1), vabs(tau2)};
-    const T tt = tau0 * tau0 + tau1 * tau1 + tau2 * tau2;
-    // NaN fails every comparison: one test catches non-finite values and the bound
-    const T bound = load_lanes<T>(in.torque_bound);
-    const M good = (a[0] <= bound) & (a[1] <= bound) & (a[2] <= bound) & (vabs(tt) < std::numeric_limits<double>::infinity());
-    if (stop(good, diverged)) break;
-    // metrics of this sample
-    const V3 tau{tau0, tau1, tau2};
-    const T ex = e.J(1, 0) - xa[0], ey = -e.J(0, 0) - xa[1];  // tip = (x1, y1) = (J10, -J00)
-    const T p0 = tau0 * qd[0], p1 = tau1 * qd[1], p2 = tau2 * qd[2];
-    const T alpha = q[0] + q[1] + q[2];
-    const T taus[3] = {tau0, tau1, tau2};
-    const V3 Mqd = e.M * qd;
-    const T ke = 0.5 * (qd[0] * Mqd[0] + qd[1] * Mqd[1] + qd[2] * Mqd[2]);
-    SampleValues<T> v;  // field by field: see Task::set
-    v.n = 3, v.q = &q[0], v.qd = &qd[0], v.tau = taus, v.tt = tt, v.ff = T(0.0);
-    v.qf = e.Mi.P.quadratic_form(tau), v.det = e.Mi.det, v.p6 = p0 * p0 + p1 * p1 + p2 * p2, v.w2 = e.w2;
-    v.err2 = ex * ex + ey * ey, v.orient = vertex ? vabs(alpha - x.alpha_d) : T(0.0), v.alpha = alpha, v.ke = ke;
-    const M off = sums.add(i, t, v, a, 3, keep) & active;
-    sums.mark(off);
-    if (in.any_history) {
-      int write = 0;
-      for (int l = 0; l < N; ++l)
-        if (in.history[l] && (i % in.history[l]->stride == 0 || i + 1 == n)) write |= 1 << l;
-      write &= lane_bits<T>(active);
-      if (write) write_histories<T>(in, write, t, q, qd, e, {tau0, tau1, tau2}, alpha);
-    }
-    if (s.stop_on_bound && any(off) && stop(!off, bounded)) break;
-    if (i + 1 == n) break;  // the last sample is measured, not integrated past
-    // integrate to the next sample
-    if (s.integrator == Integrator::semi_implicit_euler) {
-      for (int j = 0; j < 3; ++j) qd[j] = keep(qd[j] + dt * e.qdd[j], T(0.0));
-      const V3 dq{dt * qd[0], dt * qd[1], dt * qd[2]};
-      for (int j = 0; j < 3; ++j) q[j] = keep(q[j] + dq[j], q_start[j]);
-      trig.advance(q, dq);
-    } else {
-      StageTasks stt;
-      stage_tasks(*s.path, s.alpha_unit, t, dt, stt);
-      Task<T> xh, x1;
-      xh.set(stt.a_h[0], stt.a_h[1], 0.0, 0.0, T(0.0), t + hdt, s);
-      x1.set(stt.a_1[0], stt.a_1[1], 0.0, 0.0, T(0.0), t + dt, s);
-      if (vertex) {
-        xh.alpha_dd = stt.unit_h * rise(stt.seg_h);
-        x1.alpha_dd = stt.unit_1 * rise(stt.seg_1);
-      }
-      if (s.closed_loop || xh.rest) feed(stt.seg_h, t + hdt, xh);
-      if (s.closed_loop || x1.rest) feed(stt.seg_1, t + dt, x1);
-      const V3 k1q = qd, k1v = e.qdd;
-      const V3 q2{q[0] + hdt * k1q[0], q[1] + hdt * k1q[1], q[2] + hdt * k1q[2]};
-      const V3 k2q{qd[0] + hdt * k1v[0], qd[1] + hdt * k1v[1], qd[2] + hdt * k1v[2]};
-      xh.alpha = q2[0] + q2[1] + q2[2];
-      M good_stages = resolver.evaluate(xh, joint_trig(q2), k2q, st);
-      const V3 k2v = st.qdd;
-      const V3 q3{q[0] + hdt * k2q[0], q[1] + hdt * k2q[1], q[2] + hdt * k2q[2]};
-      const V3 k3q{qd[0] + hdt * k2v[0], qd[1] + hdt * k2v[1], qd[2] + hdt * k2v[2]};
-      xh.alpha = q3[0] + q3[1] + q3[2];
-      good_stages = good_stages & resolver.evaluate(xh, joint_trig(q3), k3q, st);
-      const V3 k3v = st.qdd;
-      const V3 q4{q[0] + dt * k3q[0], q[1] + dt * k3q[1], q[2] + dt * k3q[2]};
-      const V3 k4q{qd[0] + dt * k3v[0], qd[1] + dt * k3v[1], qd[2] + dt * k3v[2]};
-      x1.alpha = q4[0] + q4[1] + q4[2];
-      good_stages = good_stages & resolver.evaluate(x1, joint_trig(q4), k4q, st);
-      if (stop(good_stages, singular)) break;
-      const V3 k4v = st.qdd;
-      for (int j = 0; j < 3; ++j) {
-        q[j] = keep(q[j] + dt6 * (k1q[j] + 2.0 * k2q[j] + 2.0 * k3q[j] + k4q[j]), q_start[j]);
-        qd[j] = keep(qd[j] + dt6 * (k1v[j] + 2.0 * k2v[j] + 2.0 * k3v[j] + k4v[j]), T(0.0));
-      }
-      trig.reset(q);
-    }
   }
 
-  const int sing = lane_bits<T>(singular), div = lane_bits<T>(diverged);
-  for (int l = 0; l < N; ++l) {
-    const RunStatus st = (sing >> l & 1) ? RunStatus::singular : (div >> l & 1) ? RunStatus::diverged : RunStatus::ok;
-    out[l] = sums.of_lane(l, st, 3);
-  }
+  const Shared& s_;
+  const Runs& in_;
+  const Resolver<T>& resolver_;
+  const bool vertex_;
+  TrigTrackerOf<T>& trig_;  // the sample's trig, carried from step to step (semi-implicit Euler)
+  T alpha_d_;              // vertex_alpha: the sample's desired orientation
+  Task<T> xh_, x1_;        // RK4: the tasks at the half step and the step's end
+};
+
+/// The runs of the lanes of `in` (those active): out[l] for lane l. Flattened: the model, the
+/// resolution, the trig tracker and the sums are inlined into the one loop, so that a step's
+/// intermediates (Evaluation, Task) stay in registers rather than passing through memory to
+/// out-of-line calls; the operations and their order are the loop's, so are the results.
+template <class T>
+[[gnu::flatten]] void run(const Shared& s, const Runs& in, Sums* out) {
+  const Resolver<T> resolver(s, in);
+  TrigTrackerOf<T> trig(Vec3Of<T>{load_lanes<T>(in.q0[0]), load_lanes<T>(in.q0[1]), load_lanes<T>(in.q0[2])});
+  Model<T> model(s, in, resolver, trig);
+  trajectory_loop<T>(model, out);
 }
 
 }  // namespace ks::kernel
