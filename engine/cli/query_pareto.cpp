@@ -161,7 +161,7 @@ int pareto_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
     for (const Objective& o : objectives) {
       const RunsColumn& c = t.cols[o.col];
       const std::string u = c.angle() && !a.radians ? "deg" : c.unit.empty() ? "1" : c.unit;
-      unit += (unit.empty() ? "" : "*") + u;
+      unit += (unit.empty() ? "" : "*") + (u.find(' ') == std::string::npos ? u : "(" + u + ")");
     }
     out.names = {"hypervolume", "front_runs", "front_runs_inside", "good_runs"};
     out.units = {unit, "", "", ""};
