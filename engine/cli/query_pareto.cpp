@@ -96,13 +96,27 @@ int pareto_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
   for (std::size_t c = 0; c < t.cols.size(); ++c) loaded[c] = t.cols[c].loaded;
   const Selector sel{t, a.radians};
   std::map<std::string, KindMeaning> meanings;
+  // The candidates: the front so far and the good rows with values read since it was last reduced to
+  // its front (a point off the front of some rows is off the front of any superset of them), so that
+  // memory is bounded by the front and a few pieces, whatever the file's size.
   std::vector<std::int64_t> ids;
   std::vector<double> values;
-  std::vector<std::uint8_t> good;
+  auto reduce = [&] {
+    std::vector<std::int64_t> kept_ids;
+    std::vector<double> kept_values;
+    for (std::size_t i : pareto::front(values, dims, senses)) {
+      kept_ids.push_back(ids[i]);
+      kept_values.insert(kept_values.end(), values.begin() + static_cast<std::ptrdiff_t>(i * dims),
+                         values.begin() + static_cast<std::ptrdiff_t>((i + 1) * dims));
+    }
+    ids = std::move(kept_ids), values = std::move(kept_values);
+  };
+  std::size_t reduced_size = 0;
   std::int64_t matching = 0, bad_status = 0, no_value = 0;
   HeldValues held;
   bool consistent = true;
   const std::int64_t total = reader.n_runs();
+  std::vector<double> point(dims);
   for (std::int64_t first = 0; first < total; first += kPieceRows) {
     for (std::size_t c = 0; c < t.cols.size(); ++c) t.cols[c].loaded = loaded[c];
     load_piece(reader, t, first, kPieceRows);
@@ -115,25 +129,35 @@ int pareto_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
       const std::string kind = t.kind(r);
       auto it = meanings.find(kind);
       if (it == meanings.end()) it = meanings.emplace(kind, kind_meaning(t.meta, kind)).first;
-      const bool is_good = it->second.is_good(status->s[static_cast<std::size_t>(r)]);
-      bad_status += !is_good;
-      bool nan = false;
-      for (const Objective& o : objectives) {
-        const RunsColumn& c = t.cols[o.col];
-        const double v = c.missing(r) ? std::nan("") : sel.value(c, r);  // an integer column's -1: no value
-        nan = nan || std::isnan(v);
-        values.push_back(v);
+      if (!it->second.is_good(status->s[static_cast<std::size_t>(r)])) {
+        ++bad_status;
+        continue;
       }
-      no_value += is_good && nan;
+      bool nan = false;
+      for (std::size_t k = 0; k < dims; ++k) {
+        const RunsColumn& c = t.cols[objectives[k].col];
+        point[k] = c.missing(r) ? std::nan("") : sel.value(c, r);  // an integer column's -1: no value
+        nan = nan || std::isnan(point[k]);
+      }
+      if (nan) {
+        ++no_value;
+        continue;
+      }
+      values.insert(values.end(), point.begin(), point.end());
       ids.push_back(t.row_id(r));
-      good.push_back(is_good);
+    }
+    if (ids.size() > reduced_size + static_cast<std::size_t>(4 * kPieceRows)) {
+      reduce();
+      reduced_size = ids.size();
     }
   }
   if (!consistent)
     std::cerr << "kinesweep query: note: the file kept changing while it was read (a sweep is writing it)\n";
   for (const std::string& note : unheld_value_notes(conds, held)) std::cerr << "kinesweep query: note: " << note << '\n';
+  reduce();  // rows in run-id order: the front's ids ascend
+  std::vector<std::size_t> on_front(ids.size());
+  for (std::size_t i = 0; i < on_front.size(); ++i) on_front[i] = i;
 
-  const std::vector<std::size_t> on_front = pareto::front(values, dims, senses, good);
   std::vector<std::string> names, described;
   for (const Objective& o : objectives) {
     names.push_back(t.cols[o.col].name);
