@@ -214,6 +214,45 @@ class Front(StudyFileTest):
             self.assertEqual(pareto_section(res, "E,nosuch"), "")
 
 
+
+class ManyPieces(StudyFileTest):
+    """A file of more good runs than query holds before it reduces them to their front (4 pieces of
+    16384 rows): the front read piece by piece is the front of all runs."""
+    NAME = "pareto_pieces"
+    STUDY = """
+[study]
+name = "pareto_pieces"
+histories = "none"
+
+[[block]]
+name = "basin"
+kind = "ik"
+problem = "scara"
+method = "lm"
+[block.axes]
+q0_1 = { from = -180, to = 180, count = 220 }
+q0_2 = { from = -180, to = 180, count = 220 }
+lambda = [0.01, 0.1]
+"""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.KS = KS
+        super().setUpClass()
+
+    def test_front_over_pieces(self):
+        from kinesweep import pareto
+        self.assertGreater(int((self.runs["status"] == "converged").sum()), 4 * 16384)
+        for spec in ("iterations,error", "iterations,error,min_rcond:max", "error:max,min_rcond"):
+            with self.subTest(spec):
+                r = ks("query", self.h5, "--pareto", spec, "-f", "csv", "-c", "run_id")
+                self.assertEqual(r.returncode, 0, r.stderr)
+                front = pareto.pareto_front(self.h5, spec)
+                self.assertEqual(csv_ids(r.stdout), front["run_id"].tolist())
+                self.assertGreater(len(front), 0)
+
+
+
 if __name__ == "__main__":
     KS = sys.argv.pop(1)
     sys.argv.pop(1)  # the repository root (the package is found through e2e_common)
