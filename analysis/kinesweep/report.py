@@ -14,8 +14,11 @@ that the page stays small (the captions say where).
 
     python3 -m kinesweep.report results/examples_landscape.h5 -o report.html
 
+With --pareto M1,M2[:max][,M3], a section on the Pareto front of those metrics (kinesweep.pareto;
+only when 2 or 3 are asked for and the file has them).
+
 Open a single section with report.html#only=SECTION (study, status, best, verdicts, landscapes, basins,
-samples, sensitivity, importance, histories, optimizations).
+samples, sensitivity, importance, pareto, histories, optimizations).
 """
 import argparse
 import datetime
@@ -27,6 +30,7 @@ from kinesweep import read as ksread  # noqa: E402
 from kinesweep.report_basins import basins_figure  # noqa: E402
 from kinesweep.report_grids import landscape_figure  # noqa: E402
 from kinesweep.report_page import esc, figure, page  # noqa: E402
+from kinesweep.report_pareto import pareto_section  # noqa: E402
 from kinesweep.report_samples import sampled_section  # noqa: E402
 from kinesweep.report_tables import (RunsView, best_section, metadata_section, status_section,  # noqa: E402
                                      verdicts_section)
@@ -48,6 +52,9 @@ def parse_args(argv=None):
                    help="heatmap cells drawn over all grid figures (default %(default)s; bigger grids are "
                         "subsampled and the caption says so)")
     p.add_argument("--title", help="page title (default: the study's name)")
+    p.add_argument("--pareto", metavar="M1,M2[,M3]",
+                   help="add a section on the Pareto front of these 2 or 3 metrics, each COL, COL:min (default) "
+                   "or COL:max (e.g. torque_sq_integral,min_manipulability:max)")
     return p.parse_args(argv)
 
 
@@ -321,8 +328,8 @@ def importance_section(res, limit=MAX_IMPORTANCE_FIGURES):
     return "".join(parts) + "".join(f'<p class="caption">{x}</p>' for x in notes)
 
 
-def build(path, best=5, max_cells=CELL_BUDGET, title=None):
-    """The page's html for one results file."""
+def build(path, best=5, max_cells=CELL_BUDGET, title=None, pareto=None):
+    """The page's html for one results file (`pareto`: the metrics of a Pareto section, or None)."""
     with ksread.open_results(path) as res:
         view = RunsView(res)
         sections = [("study", "Study and file", metadata_section(res, view)),
@@ -347,6 +354,9 @@ def build(path, best=5, max_cells=CELL_BUDGET, title=None):
         imp = importance_section(res)
         if imp:
             sections.append(("importance", "Which parameter matters: permutation importance", imp))
+        front = pareto_section(res, pareto) if pareto and len([m for m in pareto.split(",") if m.strip()]) >= 2 else ""
+        if front:
+            sections.append(("pareto", "Pareto front", front))
         hist = histories_section(view)
         if hist:
             sections.append(("histories", "Histories of the best runs", hist))
@@ -367,7 +377,7 @@ def main(argv=None):
     args = parse_args(argv)
     out = args.output or os.path.splitext(args.file)[0] + "_report.html"
     try:
-        text = build(args.file, best=args.best, max_cells=args.max_cells, title=args.title)
+        text = build(args.file, best=args.best, max_cells=args.max_cells, title=args.title, pareto=args.pareto)
     except (FileNotFoundError, ksread.FormatVersionError, ValueError) as e:
         raise SystemExit(f"report: {e}")
     d = os.path.dirname(out)

@@ -1,5 +1,6 @@
-// `kinesweep query`: the three modes (rows of /runs, one run's history, one optimisation's
-// evaluations). Argument and --where parsing: query_where.cpp; output formatting: query_util.cpp.
+// `kinesweep query`: the modes (rows of /runs, one run's history, one optimisation's evaluations,
+// the runs on a Pareto front: query_pareto.cpp). Argument and --where parsing: query_where.cpp;
+// output formatting: query_util.cpp.
 #include "cli/query_command.hpp"
 
 #include <CLI/CLI.hpp>
@@ -12,6 +13,7 @@
 #include <set>
 
 #include "cli/query_groups.hpp"
+#include "cli/query_pareto.hpp"
 #include "cli/query_table.hpp"
 #include "cli/query_util.hpp"
 #include "cli/query_where.hpp"
@@ -291,7 +293,8 @@ int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
 
 QueryArgs& add_query_command(CLI::App& app) {
   static QueryArgs a;
-  auto* q = app.add_subcommand("query", "Print rows of a results file's /runs (filtered, sorted), one run's history, or one optimisation's evaluations");
+  auto* q = app.add_subcommand("query", "Print rows of a results file's /runs (filtered, sorted), one run's history, one "
+                               "optimisation's evaluations, or the runs on a Pareto front (and its hypervolume)");
   q->add_option("file", a.file, "results file (.h5); may be one a sweep is still writing")->required();
   q->add_option("-w,--where", a.where,
                 "filter, repeatable (ANDed): COL OP VALUE with OP = != < <= > >=, COL=A,B,C (any of), "
@@ -308,6 +311,13 @@ QueryArgs& add_query_command(CLI::App& app) {
   q->add_option("-g,--group-by", a.group_by, "one row per group of rows with equal COL (comma list: equal in each)");
   q->add_option("--agg", a.agg, "with --group-by, the group's columns: count, FN:COL with FN min, max, mean, median, "
                 "sum, argmin, argmax (run_id of the min/max); comma list (default count)");
+  q->add_option("--pareto", a.pareto,
+                "the runs on the Pareto front of 2 or 3 metrics, comma list of COL, COL:min (default) or COL:max "
+                "(e.g. E,min_manipulability:max): the done runs passing --where whose status is good for their kind "
+                "(ok, converged) and that no other such run dominates; a run without a value (NaN) is never on it");
+  q->add_option("--hypervolume", a.hypervolume,
+                "with --pareto: print the front's hypervolume indicator against this reference point (one value "
+                "per metric, as shown: angles in degrees unless --radians) instead of its runs");
   q->add_option("--run", a.run, "history mode: the run id");
   q->add_option("--history", a.history, "history mode: array name(s), comma list, or 'all' (default all)");
   q->add_option("--optimization", a.optimization,
@@ -329,9 +339,15 @@ int query_command(const QueryArgs& a) {
     if (optimization && (history || a.include_pending))
       throw ArgError("--optimization prints one optimisation's evaluations; --run, --history and --include-pending "
                      "do not apply to it");
+    const bool front = !a.pareto.empty();
+    if (!a.hypervolume.empty() && !front) throw ArgError("--hypervolume needs --pareto M1,M2[,M3] (its metrics)");
+    if (front && (history || optimization || !a.group_by.empty() || !a.agg.empty()))
+      throw ArgError("--pareto prints the runs on a front of /runs; --run, --history, --optimization, --group-by and "
+                     "--agg do not apply to it");
     const Format fmt = *parse_format(a.format.empty() ? (history ? "csv" : "table") : a.format);
     store::ResultsReader reader(a.file, v1_column_roles);
     if (optimization) return optimization_mode(a, reader, fmt);
+    if (front) return pareto_mode(a, reader, fmt);
     return history ? history_mode(a, reader, fmt) : rows_mode(a, reader, fmt);
   } catch (const ArgError& e) {
     std::cerr << "kinesweep query: error: " << e.what() << '\n';

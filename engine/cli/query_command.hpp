@@ -4,6 +4,7 @@
 // `kinesweep query FILE --run ID --history NAME[,NAME...]|all [--format table|csv|json] [--limit N]`
 // `kinesweep query FILE --optimization NAME [--where ...] [--sort ...] [--format ...] [--limit N] [--radians]
 // `kinesweep query FILE --group-by COL[,COL] [--agg min:E,count,...] [--where ...]`
+// `kinesweep query FILE --pareto M1[:min|max],M2[,M3] [--where ...] [--hypervolume R1,R2[,R3]] [--format ...]`
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -28,6 +29,8 @@ struct QueryArgs {
   std::string optimization;        ///< optimisation mode: the /optimizations group whose evaluations to print
   std::string group_by;            ///< comma list of columns: one output row per group of equal values
   std::string agg;                 ///< with group_by: count, FN:COL (min, max, mean, median, sum, argmin, argmax)
+  std::string pareto;              ///< 2 or 3 metrics, each COL, COL:min or COL:max: the runs on their Pareto front
+  std::string hypervolume;         ///< with pareto: the reference point (one value per metric); print the indicator
 };
 
 /// Register the subcommand; returns the argument struct it fills.

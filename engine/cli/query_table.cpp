@@ -74,7 +74,8 @@ OutCell cell(const RunsColumn& c, std::int64_t r, const Selector& sel) {
 }
 
 /// The default columns of table output: run id, block (when several), the parameters that vary, the
-/// key metrics of the kinds of the rows shown, status, and every column a filter or sort mentions.
+/// key metrics of the kinds of the rows shown, status, every column a filter or sort mentions, and
+/// the columns the wording names (`shown`).
 std::vector<const RunsColumn*> compact_columns(const RunsTable& t, const std::vector<std::int64_t>& selected,
                                                const std::set<const RunsColumn*>& mentioned,
                                                const TableWording& more) {
@@ -98,6 +99,7 @@ std::vector<const RunsColumn*> compact_columns(const RunsTable& t, const std::ve
   for (auto& c : t.cols) {
     bool take = mentioned.count(&c) > 0 || key_metrics.count(&c) > 0;
     if (c.name == "run_id" || c.name == "status") take = true;  // bookkeeping shown always
+    if (std::find(more.shown.begin(), more.shown.end(), c.name) != more.shown.end()) take = true;
     if ((c.name == "block" || c.role == Role::parameter) && varies(c)) take = true;
     if (take) cols.push_back(&c);
   }

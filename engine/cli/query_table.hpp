@@ -3,6 +3,7 @@
 // --where filter, --sort, --columns, --limit, and --group-by with --agg.
 #include <set>
 #include <string>
+#include <vector>
 
 #include "cli/query_command.hpp"
 #include "cli/query_util.hpp"
@@ -14,6 +15,7 @@ struct TableWording {
   std::string rows = "matching rows";  ///< "(3 of 10 matching rows; ...)"
   std::string summary;                 ///< the trailer's second part, e.g. "8 of 10 runs done"
   bool compact_default = true;         ///< table format without --columns: run_id, varying parameters, key metrics
+  std::vector<std::string> shown;      ///< columns the compact default shows too (--pareto's metrics)
   bool notes_said = false;             ///< the caller printed the --where value notes (over rows `t` lacks)
   /// Matching rows the caller left out of `t` (it holds the first --limit of them, unsorted): their
   /// number, the kinds they hold and the columns in which they differ from t's first row.

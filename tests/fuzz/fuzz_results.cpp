@@ -2,7 +2,7 @@
 // journal magic "KSJRNL", everything from its first occurrence on as the file's journal), opened through
 // every C++ reader of results files: ResultsReader's whole read API (metadata, every /runs column,
 // histories, landscapes, designs, optimisations), the commands behind `kinesweep info`, `query` (rows,
-// --group-by, --run/--history, --optimization) and `sensitivity`, and ResultsWriter::open_for_resume
+// --group-by, --pareto, --run/--history, --optimization) and `sensitivity`, and ResultsWriter::open_for_resume
 // (resume's open). Any exception is an answer (a damaged file refused); a crash, a hang, unbounded
 // memory or undefined behaviour is a defect. Built with libFuzzer under clang (-DKINESWEEP_FUZZ=ON);
 // results_corpus_check drives the same entry point with any compiler.
@@ -173,6 +173,14 @@ void run_commands(const std::string& path) {
     a.sort = {"E"};
     a.format = "json";
     a.limit = 8;
+    (void)ks::cli::query_command(a);
+  }
+  for (const char* reference : {"", "100,0"}) {
+    ks::cli::QueryArgs a;
+    a.file = path;
+    a.pareto = "E,min_manipulability:max";
+    a.hypervolume = reference;
+    a.limit = 16;
     (void)ks::cli::query_command(a);
   }
   {
