@@ -17,7 +17,9 @@
 //                                                   lanes that run
 //   T alpha(const T* q) const;                      the tip angle at q [rad] (NaN: spatial tasks)
 //   T torque_bound() const;                         [Nm]
-//   MaskOf<T> at_sample(i, t, q, qd, Evaluation& e);  the method at sample i (false: singular)
+//   MaskOf<T> at_sample(i, t, q, qd, Evaluation& e);  the method at sample i (false: singular); a
+//                                                   prescribed model (LoopShape) sets q and qd there and
+//                                                   may return a RunStatus instead (not ok: it stops)
 //   void torques(e, qd, T* tau);                    tau = M qdd + c + g (the model's order)
 //   static constexpr bool prismatic_joints;        some joint may be prismatic: then bool prismatic(int j)
 //   void values(e, i, q, qd, tau, SampleValues<T>& v);  every field but n, tt, ff and p6 (the loop's
@@ -26,6 +28,9 @@
 //   void stages(double t, double dt);               RK4: the task at t + dt/2 and t + dt
 //   MaskOf<T> stage(bool end, yq, yv, Evaluation& s);  RK4: the method at a stage's state
 //   void moved(const T* q, const T* dq);            the state moved by dq (Euler) or to q (dq null)
+// and optionally:
+//   T squared_torque(const T* tau);                 tau^T tau in the model's own order
+//   void finish(SampleSums<T, max_joints>& sums);   after the last sample
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -41,6 +46,8 @@ struct LoopShape {
   double dt = 0;  ///< [s]
   Integrator integrator = Integrator::semi_implicit_euler;
   bool stop_on_violation = false;  ///< on_violation = stop: the tracking bound or a limit crossed stops
+  /// the model sets the state at each sample (a path-global run's spline): nothing is integrated
+  bool prescribed = false;
 };
 
 /// Lane l of mask m.
@@ -51,7 +58,7 @@ inline bool bit(M m, int l) {
 }
 
 /// The runs of `model` along its samples from its start at rest: out[l] the sums of lane l (one for
-/// T = double), with its loop status (singular, diverged, else ok; finish_run turns the sums into the
+/// T = double), with its loop status (singular, diverged, a prescribed model's, else ok; finish_run turns the sums into the
 /// run's metrics and status).
 template <class T, class Model>
 void trajectory_loop(Model& model, RunSums* out) {
@@ -66,6 +73,7 @@ void trajectory_loop(Model& model, RunSums* out) {
   // that set it, which GCC cannot see through the whole inlined loop)
   typename Model::Evaluation e{}, s{};
   T q[N], qd[N], q_start[N], tau[N], abs_tau[N];
+  RunStatus stopped = RunStatus::ok;  // one lane: a prescribed model's stop status
   M active = model.start(q);
   for (int j = 0; j < n; ++j) q_start[j] = q[j], qd[j] = T(0.0);
   M singular = T(0.0) != T(0.0), diverged = singular, bounded = singular;
@@ -94,7 +102,15 @@ void trajectory_loop(Model& model, RunSums* out) {
 
   for (std::size_t i = 0; i < samples; ++i) {
     const double t = static_cast<double>(i) * dt;  // SampledPath::time(i)
-    if (stop(model.at_sample(i, t, q, qd, e), singular)) break;
+    const auto state = model.at_sample(i, t, q, qd, e);
+    if constexpr (std::is_same_v<std::remove_const_t<decltype(state)>, RunStatus>) {
+      if (state != RunStatus::ok) {
+        stopped = state;
+        break;
+      }
+    } else if (stop(state, singular)) {
+      break;
+    }
     model.torques(e, qd, tau);
     // the sums start at joint 0's terms (a sum from 0 would add 0.0, which IEEE does not drop)
     T tt(0.0), ff(0.0);
@@ -115,6 +131,7 @@ void trajectory_loop(Model& model, RunSums* out) {
       abs_tau[j] = vabs(tau[j]);
       good = good & (abs_tau[j] <= bound);
     }
+    if constexpr (requires { model.squared_torque(tau); }) tt = model.squared_torque(tau);
     // one test catches non-finite values and the bound
     good = good & (vabs(tt) < infinity);
     if constexpr (Model::prismatic_joints) good = good & (vabs(ff) < infinity);
@@ -130,6 +147,7 @@ void trajectory_loop(Model& model, RunSums* out) {
     if constexpr (one) crossed = crossed || beyond;
     if (shape.stop_on_violation && any(crossed) && stop(!crossed, bounded)) break;
     if (i + 1 == samples) break;  // the last sample is measured, not integrated past
+    if (shape.prescribed) continue;
     // integrate to the next sample
     if (shape.integrator == Integrator::semi_implicit_euler) {
       T dq[N];
@@ -167,10 +185,11 @@ void trajectory_loop(Model& model, RunSums* out) {
       model.moved(q, nullptr);
     }
   }
+  if constexpr (requires { model.finish(sums); }) model.finish(sums);
   constexpr int lanes = lanes_of<T>;
   for (int l = 0; l < lanes; ++l) {
     const bool sing = bit(singular, l), div = bit(diverged, l);
-    out[l] = sums.of_lane(l, sing ? RunStatus::singular : div ? RunStatus::diverged : RunStatus::ok, n);
+    out[l] = sums.of_lane(l, sing ? RunStatus::singular : div ? RunStatus::diverged : stopped, n);
   }
 }
 

@@ -1,6 +1,7 @@
 // ChainGlobalProblem (methods/path_global/chain.hpp): the objective with its chain-rule gradient, the
 // limit constraints with theirs, and the run's metrics, for any extension.
 #include "methods/path_global/chain.hpp"
+#include "methods/loop/trajectory_loop.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
@@ -157,71 +158,120 @@ double ChainGlobalProblem::worst_violation(const AlphaBasis& basis, const double
   return worst;
 }
 
+/// The run of a spline as a prescribed model of the one trajectory loop (methods/loop/trajectory_loop.hpp):
+/// each sample's state, torques and dynamics from the spline's coordinates (`sample`, continued
+/// from the previous sample's solution), nothing integrated.
+class ChainGlobalProblem::MeasureModel {
+ public:
+  static constexpr int max_joints = kMaxJoints;
+  static constexpr bool prismatic_joints = false;
+  using Evaluation = ChainGlobalSample;
+
+  MeasureModel(const ChainGlobalProblem& p, const AlphaBasis& basis, const double* c, const VecN& q_start,
+               const TrajectoryOptions& o, ChainHistory* history)
+      : p_(p), basis_(basis), c_(c), o_(o), history_(history), limits_(LimitTable::of(p.chain_)), q_prev_(q_start) {}
+
+  int joints() const { return p_.n_; }
+  LoopShape shape() const {
+    return {p_.samples(), p_.task_.path.dt(), o_.integrator, o_.on_violation == OnViolation::stop, true};
+  }
+  RunShape run_shape() const {
+    RunShape shape;
+    shape.joints = p_.n_;
+    shape.limits = &limits_;
+    return shape;
+  }
+  SampleSums<double, kMaxJoints> sums() const {
+    return SampleSums<double, kMaxJoints>(o_.tracking_bound, o_.orientation_bound, &limits_);
+  }
+  /// The pass begins; the tip angle at the start is sample 0's (alpha()).
+  bool start(double*) {
+    p_.begin_pass();
+    Evaluation s0;
+    at(0, s0);
+    alpha0_ = s0.alpha;
+    return true;
+  }
+  double alpha(const double*) const { return alpha0_; }
+  double torque_bound() const { return o_.torque_bound; }
+
+  RunStatus at_sample(std::size_t i, double, double* q, double* qd, Evaluation& s) {
+    at(i, s);
+    last_ = &s;
+    p_.accept(i, z_, s);
+    if (s.violation > 0.0) return RunStatus::infeasible;
+    if (!s.tau.allFinite()) return RunStatus::diverged;
+    if (p_.singular(s, o_.singular_tolerance)) return RunStatus::singular_extension;
+    for (int j = 0; j < p_.n_; ++j) s.q[j] = q_prev_[j] + wrap(s.q[j] - q_prev_[j]);  // continuous joint angles
+    q_prev_ = s.q;
+    for (int j = 0; j < p_.n_; ++j) q[j] = s.q[j], qd[j] = s.qd[j];
+    return RunStatus::ok;
+  }
+  void torques(const Evaluation& s, const double*, double* tau) const {
+    for (int j = 0; j < p_.n_; ++j) tau[j] = s.tau[j];
+  }
+  /// tau^T tau as Eigen sums the sample's tau.
+  double squared_torque(const double*) const { return last_->tau.squaredNorm(); }
+
+  void values(const Evaluation& s, std::size_t i, const double*, const double*, const double*, SampleValues<double>& v) {
+    const int n = p_.n_;
+    const ChainState& st = p_.state_;
+    v.q = s.q.data(), v.qd = s.qd.data(), v.tau = s.tau.data();
+    v.qf = s.tau.dot(st.M.ldlt().solve(s.tau)), v.det = 1.0;
+    v.w2 = std::max(0.0, p_.rows_ == 2 ? (st.J.topRows<2>() * st.J.topRows<2>().transpose()).determinant()
+                                      : (st.J.topRows<3>() * st.J.topRows<3>().transpose()).determinant());
+    forward_kinematics(p_.chain_, p_.data_, s.q);
+    tip_ = p_.data_.tip.p;
+    const Eigen::Vector3d miss = tip_ - p_.task_.path.position(i);
+    v.err2 = p_.rows_ == 2 ? miss.head<2>().squaredNorm() : miss.squaredNorm();
+    v.orient = 0.0, v.alpha = s.alpha, v.ke = 0.0;
+    for (int j = 0; j < n; ++j) v.ke += 0.5 * s.qd[j] * st.M.row(j).head(n).dot(s.qd.head(n));
+  }
+  void record(std::size_t i, double t, const Evaluation& s, const double*, const double*, const double*, bool) const {
+    const std::size_t n = p_.samples();
+    if (!history_ || !(i % static_cast<std::size_t>(history_->stride) == 0 || i + 1 == n)) return;
+    ChainHistory& h = *history_;
+    const Eigen::Index col = h.size++;
+    h.t[col] = t;
+    h.q.col(col) = s.q;
+    h.qd.col(col) = s.qd;
+    h.qdd.col(col) = s.qdd;
+    h.tau.col(col) = s.tau;
+    for (int a = 0; a < p_.rows_; ++a) h.x(a, col) = tip_[a];
+    h.alpha[col] = s.alpha;
+  }
+  void stages(double, double) {}
+  bool stage(bool, const double*, const double*, Evaluation&) { return true; }
+  void moved(const double*, const double*) {}
+
+ private:
+  /// Sample i of the spline into s (its coordinates in z_).
+  void at(std::size_t i, Evaluation& s) {
+    const int K = basis_.coefficients;
+    for (int k = 0; k < p_.coordinates(); ++k) basis_.at(i, c_ + k * K, z_[k][0], z_[k][1], z_[k][2]);
+    p_.sample(i, z_, s);
+  }
+
+  const ChainGlobalProblem& p_;
+  const AlphaBasis& basis_;
+  const double* c_;
+  const TrajectoryOptions& o_;
+  ChainHistory* history_;
+  const LimitTable limits_;
+  VecN q_prev_;
+  double z_[kMaxJoints][3] = {};
+  double alpha0_ = 0.0;
+  const Evaluation* last_ = nullptr;  // the sample at_sample() filled
+  Eigen::Vector3d tip_ = Eigen::Vector3d::Zero();
+};
+
 TrajectoryMetrics ChainGlobalProblem::measure(const AlphaBasis& basis, const double* c, const VecN& q_start,
                                               const TrajectoryOptions& o, ChainHistory* history) const {
-  const std::size_t n = samples();
-  const int K = basis.coefficients, r = coordinates();
-  if (history) history->prepare(n, n_, rows_);
-  const LimitTable limits = LimitTable::of(chain_);
-  SampleSums<double, kMaxJoints> sums(o.tracking_bound, o.orientation_bound, &limits);
-  VecN q_prev = q_start;
-  RunStatus stop = RunStatus::ok;
-  double z[kMaxJoints][3];
-  const auto keep = [](double updated, double) { return updated; };
-  ChainGlobalSample s;
-  begin_pass();
-  for (std::size_t i = 0; i < n; ++i) {
-    for (int k = 0; k < r; ++k) basis.at(i, c + k * K, z[k][0], z[k][1], z[k][2]);
-    sample(i, z, s);
-    accept(i, z, s);
-    if (i == 0) sums.start_alpha(s.alpha);
-    if (s.violation > 0.0 || !s.tau.allFinite()) {
-      stop = s.violation > 0.0 ? RunStatus::infeasible : RunStatus::diverged;
-      break;
-    }
-    if (singular(s, o.singular_tolerance)) {
-      stop = RunStatus::singular_extension;
-      break;
-    }
-    for (int j = 0; j < n_; ++j) s.q[j] = q_prev[j] + wrap(s.q[j] - q_prev[j]);  // continuous joint angles
-    q_prev = s.q;
-    double abs_tau[kMaxJoints];
-    for (int j = 0; j < n_; ++j) abs_tau[j] = std::abs(s.tau[j]);
-    if (!(s.tau.cwiseAbs().maxCoeff() <= o.torque_bound)) {
-      stop = RunStatus::diverged;
-      break;
-    }
-    const double w2 = std::max(0.0, rows_ == 2 ? (state_.J.topRows<2>() * state_.J.topRows<2>().transpose()).determinant()
-                                               : (state_.J.topRows<3>() * state_.J.topRows<3>().transpose()).determinant());
-    forward_kinematics(chain_, data_, s.q);
-    const Eigen::Vector3d tip = data_.tip.p;
-    const Eigen::Vector3d miss = tip - task_.path.position(i);
-    const double err2 = rows_ == 2 ? miss.head<2>().squaredNorm() : miss.squaredNorm();
-    double p6 = 0;
-    for (int j = 0; j < n_; ++j) p6 += (s.tau[j] * s.qd[j]) * (s.tau[j] * s.qd[j]);
-    const double qf = s.tau.dot(state_.M.ldlt().solve(s.tau));
-    SampleValues<double> v{n_, s.q.data(), s.qd.data(), s.tau.data(), s.tau.squaredNorm(), 0.0, qf, 1.0, p6, w2,
-                                 err2, 0.0, s.alpha, 0.0};
-    for (int j = 0; j < n_; ++j) v.ke += 0.5 * s.qd[j] * state_.M.row(j).head(n_).dot(s.qd.head(n_));
-    const bool off = sums.add(i, task_.path.time(i), v, abs_tau, n_, keep);
-    const bool beyond = sums.limits(s.q.data(), s.qd.data(), s.tau.data(), n_);
-    sums.mark(off, beyond);
-    if (history && (i % static_cast<std::size_t>(history->stride) == 0 || i + 1 == n)) {
-      const Eigen::Index col = history->size++;
-      history->t[col] = task_.path.time(i);
-      history->q.col(col) = s.q;
-      history->qd.col(col) = s.qd;
-      history->qdd.col(col) = s.qdd;
-      history->tau.col(col) = s.tau;
-      for (int a = 0; a < rows_; ++a) history->x(a, col) = tip[a];
-      history->alpha[col] = s.alpha;
-    }
-    if ((off || beyond) && o.on_violation == OnViolation::stop) break;
-  }
-  RunShape shape;
-  shape.joints = n_;
-  shape.limits = &limits;
-  return finish_run(sums.of_lane(0, stop, n_), shape, o);
+  if (history) history->prepare(samples(), n_, rows_);
+  MeasureModel model(*this, basis, c, q_start, o, history);
+  RunSums sums;
+  trajectory_loop<double>(model, &sums);
+  return finish_run(sums, model.run_shape(), o);
 }
 
 }  // namespace ks

@@ -98,6 +98,7 @@ class ChainGlobalProblem {
   const ChainTask& task_;
   int n_;
   int rows_;  // the task's position rows: 2 (planar) or 3 (spatial)
+  class MeasureModel;  // measure()
   mutable ChainData data_;
   mutable ChainState state_;
 };

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "methods/closed_form/lanes.hpp"
+#include "methods/loop/trajectory_loop.hpp"
 #include "methods/metrics/sample_sums.hpp"
 
 namespace ks {
@@ -191,88 +192,128 @@ void PathGlobalProblem::samples(const AlphaBasis& basis, const double* c, const 
   samples_3r<double>(in, done, end, block);
 }
 
+/// The run of a spline as a prescribed model of the one trajectory loop (methods/loop/trajectory_loop.hpp):
+/// the samples computed a block at a time (in lanes where the processor has them), nothing
+/// integrated. The joint angles (atan2) only where something reads them: a history column, and the
+/// last sample's tip angle (final_alpha; the samples carry no joint limits, which would read q): it
+/// is computed at the end of each block and, for a run ending inside a block, once the loop ends.
+class PathGlobalProblem::MeasureModel {
+ public:
+  static constexpr int max_joints = 3;
+  static constexpr bool prismatic_joints = false;
+  struct Evaluation {
+    double qdd[3];  // (read by the loop's integrator only, which a prescribed model skips)
+  };
+
+  MeasureModel(const PathGlobalProblem& p, const AlphaBasis& basis, const double* c, const TrajectoryOptions& o,
+               TrajectoryHistory* history)
+      : p_(p), basis_(basis), c_(c), o_(o), history_(history), in_(p.input(GlobalObjective::E)) {}
+
+  int joints() const { return 3; }
+  LoopShape shape() const {
+    return {p_.samples(), p_.path_.dt(), o_.integrator, o_.on_violation == OnViolation::stop, true};
+  }
+  SampleSums<double, 3> sums() const { return SampleSums<double, 3>(o_.tracking_bound, o_.orientation_bound); }
+  /// The tip angle at the start: sample 0's, or its coordinate where it is out of reach.
+  bool start(double*) {
+    double x0, xd0, xdd0;
+    basis_.at(0, c_, x0, xd0, xdd0);
+    GlobalSample s0;
+    p_.sample(0, x0, xd0, xdd0, s0);
+    alpha0_ = s0.reachable ? s0.q.sum() : x0;
+    return true;
+  }
+  double alpha(const double*) const { return alpha0_; }
+  double torque_bound() const { return o_.torque_bound; }
+
+  RunStatus at_sample(std::size_t i, double, double*, double* qd, Evaluation&) {
+    j_ = i % kSampleBlock;
+    if (j_ == 0) p_.samples(basis_, c_, in_, i, std::min(p_.samples(), i + kSampleBlock), block_);
+    const double det = block_.det[j_];
+    if (!(block_.reach[j_] != 0.0) || !std::isfinite(det)) return RunStatus::infeasible;
+    if (p_.extension_ == Extension::alpha && !(std::abs(det) >= o_.singular_tolerance))
+      return RunStatus::singular_extension;
+    for (int k = 0; k < 3; ++k) qd[k] = block_.qd[k][j_];
+    return RunStatus::ok;
+  }
+  void torques(const Evaluation&, const double*, double* tau) const {
+    for (int k = 0; k < 3; ++k) tau[k] = block_.tau[k][j_];
+  }
+  static double squared_torque(const double* tau) { return Vec3(tau[0], tau[1], tau[2]).squaredNorm(); }
+
+  void values(const Evaluation&, std::size_t i, const double*, const double* qd, const double* tau,
+              SampleValues<double>& v) {
+    const std::size_t j = j_;
+    const Sym3 M{block_.M[0][j], block_.M[1][j], block_.M[2][j], block_.M[3][j], block_.M[4][j], block_.M[5][j]};
+    Mat23 J;
+    J << block_.J[0][j], block_.J[1][j], block_.J[2][j], block_.J[3][j], block_.J[4][j], block_.J[5][j];
+    const SymInverse3 Mi(M);
+    tip_ = Vec2(block_.tip[0][j], block_.tip[1][j]);
+    const Vec2 err = tip_ - p_.path_.position(i);
+    const Vec3 t3(tau[0], tau[1], tau[2]), qd3(qd[0], qd[1], qd[2]);
+    v.q = nullptr, v.qd = qd, v.tau = tau;
+    v.qf = Mi.P.quadratic_form(t3), v.det = Mi.det, v.w2 = manipulability_squared(J), v.err2 = err.squaredNorm();
+    v.orient = 0.0, v.alpha = 0.0, v.ke = 0.5 * M.quadratic_form(qd3);
+    added_ = true;
+    pending_ = static_cast<std::ptrdiff_t>(j);
+    if (j + 1 == kSampleBlock || i + 1 == p_.samples()) {
+      const Vec3 q = angles(j);
+      last_alpha_ = q[0] + q[1] + q[2];
+      pending_ = -1;
+    }
+  }
+  void record(std::size_t i, double t, const Evaluation&, const double*, const double* qd, const double* tau, bool) const {
+    const std::size_t n = p_.samples();
+    if (!history_ || !(i % static_cast<std::size_t>(history_->stride) == 0 || i + 1 == n)) return;
+    TrajectoryHistory& h = *history_;
+    const Eigen::Index col = h.size++;
+    h.t[col] = t;
+    const Vec3 q = angles(j_);
+    h.q.col(col) = q;
+    h.qd.col(col) = Vec3(qd[0], qd[1], qd[2]);
+    h.qdd.col(col) = Vec3(block_.qdd[0][j_], block_.qdd[1][j_], block_.qdd[2][j_]);
+    h.tau.col(col) = Vec3(tau[0], tau[1], tau[2]);
+    h.x.col(col) = tip_;
+    h.alpha[col] = q[0] + q[1] + q[2];
+  }
+  void finish(SampleSums<double, 3>& sums) {
+    if (pending_ >= 0) {
+      const Vec3 q = angles(static_cast<std::size_t>(pending_));
+      last_alpha_ = q[0] + q[1] + q[2];
+    }
+    if (added_) sums.set_last_alpha(last_alpha_);
+  }
+  void stages(double, double) {}
+  bool stage(bool, const double*, const double*, Evaluation&) { return true; }
+  void moved(const double*, const double*) {}
+
+ private:
+  Vec3 angles(std::size_t j) const {
+    const double t1 = std::atan2(block_.s1[j], block_.c1[j]), t2 = std::atan2(block_.s2[j], block_.c2[j]);
+    return Vec3(t1, t2, block_.alpha[j] - t1 - t2);
+  }
+
+  const PathGlobalProblem& p_;
+  const AlphaBasis& basis_;
+  const double* c_;
+  const TrajectoryOptions& o_;
+  TrajectoryHistory* history_;
+  const Terms3RInput in_;
+  Sample3RBlock block_;
+  std::size_t j_ = 0;               // the sample's row in block_
+  double alpha0_ = 0.0, last_alpha_ = 0.0;
+  std::ptrdiff_t pending_ = -1;     // the block row of the last sample added, its angle not yet computed
+  bool added_ = false;
+  Vec2 tip_ = Vec2::Zero();
+};
+
 TrajectoryMetrics PathGlobalProblem::measure(const AlphaBasis& basis, const double* c, const TrajectoryOptions& o,
                                              TrajectoryHistory* history) const {
-  const std::size_t n = path_.size();
-  if (history) history->prepare(n);
-  SampleSums<double, 3> sums(o.tracking_bound, o.orientation_bound);
-  double x0, xd0, xdd0;
-  basis.at(0, c, x0, xd0, xdd0);
-  GlobalSample s0;
-  sample(0, x0, xd0, xdd0, s0);
-  sums.start_alpha(s0.reachable ? s0.q.sum() : x0);
-  RunStatus stop = RunStatus::ok;
-  const auto keep = [](double updated, double) { return updated; };
-  const Terms3RInput in = input(GlobalObjective::E);
-  Sample3RBlock block;
-  // the joint angles (atan2) only where something reads them: a history column, and the last
-  // sample's tip angle (final_alpha; the samples carry no joint limits, which would read q): it is
-  // computed at the end of each block and, for a run ending inside a block, once the loop ends
-  const auto angles = [&block](std::size_t j) {
-    const double t1 = std::atan2(block.s1[j], block.c1[j]), t2 = std::atan2(block.s2[j], block.c2[j]);
-    return Vec3(t1, t2, block.alpha[j] - t1 - t2);
-  };
-  double last_alpha = 0.0;
-  std::ptrdiff_t pending = -1;  // the block row of the last sample added, its angle not yet computed
-  bool added = false;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t j = i % kSampleBlock;
-    if (j == 0) samples(basis, c, in, i, std::min(n, i + kSampleBlock), block);
-    const double t = path_.time(i);
-    const double det = block.det[j];
-    if (!(block.reach[j] != 0.0) || !std::isfinite(det)) {
-      stop = RunStatus::infeasible;
-      break;
-    }
-    if (extension_ == Extension::alpha && !(std::abs(det) >= o.singular_tolerance)) {
-      stop = RunStatus::singular_extension;
-      break;
-    }
-    const Vec3 tau(block.tau[0][j], block.tau[1][j], block.tau[2][j]), qd(block.qd[0][j], block.qd[1][j], block.qd[2][j]);
-    const double abs_tau[3] = {std::abs(tau[0]), std::abs(tau[1]), std::abs(tau[2])};
-    const double tt = tau.squaredNorm();
-    if (!(std::max({abs_tau[0], abs_tau[1], abs_tau[2]}) <= o.torque_bound) || !std::isfinite(tt)) {
-      stop = RunStatus::diverged;
-      break;
-    }
-    const Sym3 M{block.M[0][j], block.M[1][j], block.M[2][j], block.M[3][j], block.M[4][j], block.M[5][j]};
-    Mat23 J;
-    J << block.J[0][j], block.J[1][j], block.J[2][j], block.J[3][j], block.J[4][j], block.J[5][j];
-    const SymInverse3 Mi(M);
-    const Vec2 tip(block.tip[0][j], block.tip[1][j]), err = tip - path_.position(i);
-    const double p0 = tau[0] * qd[0], p1 = tau[1] * qd[1], p2 = tau[2] * qd[2];
-    const SampleValues<double> v{3, nullptr, qd.data(), tau.data(), tt, 0.0, Mi.P.quadratic_form(tau), Mi.det,
-                                 p0 * p0 + p1 * p1 + p2 * p2, manipulability_squared(J), err.squaredNorm(), 0.0, 0.0,
-                                 0.5 * M.quadratic_form(qd)};
-    const bool off = sums.add(i, t, v, abs_tau, 3, keep);
-    sums.mark(off);
-    added = true;
-    pending = static_cast<std::ptrdiff_t>(j);
-    if (j + 1 == kSampleBlock || i + 1 == n) {
-      const Vec3 q = angles(j);
-      last_alpha = q[0] + q[1] + q[2];
-      pending = -1;
-    }
-    if (history && (i % static_cast<std::size_t>(history->stride) == 0 || i + 1 == n)) {
-      const Eigen::Index col = history->size++;
-      history->t[col] = t;
-      const Vec3 q = angles(j);
-      history->q.col(col) = q;
-      history->qd.col(col) = qd;
-      history->qdd.col(col) = Vec3(block.qdd[0][j], block.qdd[1][j], block.qdd[2][j]);
-      history->tau.col(col) = tau;
-      history->x.col(col) = tip;
-      history->alpha[col] = q[0] + q[1] + q[2];
-    }
-    if (off && o.on_violation == OnViolation::stop) break;
-  }
-  if (pending >= 0) {
-    const Vec3 q = angles(static_cast<std::size_t>(pending));
-    last_alpha = q[0] + q[1] + q[2];
-  }
-  if (added) sums.set_last_alpha(last_alpha);
-  RunShape shape;
-  return finish_run(sums.of_lane(0, stop, 3), shape, o);
+  if (history) history->prepare(samples());
+  MeasureModel model(*this, basis, c, o, history);
+  RunSums sums;
+  trajectory_loop<double>(model, &sums);
+  return finish_run(sums, RunShape{}, o);
 }
 
 }  // namespace ks

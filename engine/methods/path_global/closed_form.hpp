@@ -93,6 +93,8 @@ class PathGlobalProblem {
   /// Sample i at the coordinate x, its rate and acceleration; `alpha` the tip angle there [rad].
   void evaluate(std::size_t i, double x, double xd, double xdd, Sample3ROf<double>& s, double& alpha) const;
 
+  class MeasureModel;  // measure()
+
   PlanarArm3 arm_;
   DynamicsCoefficients dyn_;
   const SampledPath& path_;
