@@ -10,6 +10,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "common/angles.hpp"
+
 namespace ks {
 namespace {
 
@@ -17,7 +19,6 @@ constexpr double kViolationWeight = 1e6;
 constexpr double kInfeasibleFloor = 1e4;  // per unit of 1 / samples, in the objective's units
 constexpr double kSingularDet = 1e-12;    // an extension this close to singular costs the floor too
 
-double wrap(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
 
 }  // namespace
 
@@ -48,7 +49,7 @@ double ChainGlobalProblem::ratio(const LimitConstraints& limits, const std::arra
   switch (row[0]) {
     case 0: {
       const double off = s.q[j] - L.mid[j];
-      return std::abs(wraps_angles() ? wrap(off) : off) * L.inv_half[j];
+      return std::abs(wraps_angles() ? remainder_2pi(off) : off) * L.inv_half[j];
     }
     case 1: return std::abs(s.qd[j]) * L.inv_velocity[j];
     default: return std::abs(s.tau[j]) * L.inv_effort[j];
@@ -183,7 +184,7 @@ TrajectoryMetrics ChainGlobalProblem::measure(const AlphaBasis& basis, const dou
       stop = RunStatus::singular_extension;
       break;
     }
-    for (int j = 0; j < n_; ++j) s.q[j] = q_prev[j] + wrap(s.q[j] - q_prev[j]);  // continuous joint angles
+    for (int j = 0; j < n_; ++j) s.q[j] = q_prev[j] + remainder_2pi(s.q[j] - q_prev[j]);  // continuous joint angles
     q_prev = s.q;
     double abs_tau[kMaxJoints];
     for (int j = 0; j < n_; ++j) abs_tau[j] = std::abs(s.tau[j]);
