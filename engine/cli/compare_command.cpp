@@ -1,6 +1,5 @@
 #include "cli/compare_command.hpp"
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -202,21 +201,6 @@ std::string end_condition(const std::string& method, const std::string& spline, 
   if (method == "vertex_alpha") return "rest";
   if (!end_state.empty() && rule.applies(method)) return spline == "vertex_quintic" ? "rest" : end_state;
   return local_end == "rest" ? "rest" : "free";
-}
-
-CompareArgs& add_compare_command(CLI::App& app) {
-  static CompareArgs a;
-  auto* c = app.add_subcommand("compare", "Verdict table: the best good run per group (method or any column), "
-                                          "per end condition and metric, with its GCI and its margin to the next group");
-  c->add_option("file", a.file, "results file (.h5)")->required();
-  c->add_option("--by", a.by, "the /runs column whose values are the groups (default: method)");
-  c->add_option("--metric", a.metrics, "metrics to compare (default: the run kind's ranking objective, E)");
-  c->add_option("--end", a.end, "rest | free: only runs ending so; any: mix them (default: each on its own)")
-      ->check(CLI::IsMember({"rest", "free", "any"}));
-  c->add_option("-w,--where", a.where, "only the rows where EXPR holds (kinesweep query's syntax, angles in degrees; "
-                                      "repeatable: all hold), e.g. inertia=physical");
-  c->add_option("--format", a.format, "table (default), json or csv")->check(CLI::IsMember({"table", "json", "csv"}));
-  return a;
 }
 
 int compare_command(const CompareArgs& args) {

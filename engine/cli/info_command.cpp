@@ -1,6 +1,5 @@
 #include "cli/info_command.hpp"
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -438,15 +437,6 @@ int run_info(const InfoArgs& args) {
 }
 
 }  // namespace
-
-InfoArgs& add_info_command(CLI::App& app) {
-  static InfoArgs a;
-  auto* s = app.add_subcommand("info", "Summarise a results file: study, runs by block and status, best rows, "
-                                       "histories, landscapes, optimisations");
-  s->add_option("file", a.file, "results file (.h5); may be one a sweep is still writing")->required();
-  s->add_option("--best", a.best, "best rows shown per block (default 3; N >= 0)")->check(CLI::Validator(check_count, "N>=0"));
-  return a;
-}
 
 int info_command(const InfoArgs& args) {
   try {

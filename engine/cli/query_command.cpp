@@ -3,7 +3,6 @@
 // output formatting: query_util.cpp.
 #include "cli/query_command.hpp"
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -290,42 +289,6 @@ int rows_mode(const QueryArgs& a, store::ResultsReader& reader, Format fmt) {
 }
 
 }  // namespace
-
-QueryArgs& add_query_command(CLI::App& app) {
-  static QueryArgs a;
-  auto* q = app.add_subcommand("query", "Print rows of a results file's /runs (filtered, sorted), one run's history, one "
-                               "optimisation's evaluations, or the runs on a Pareto front (and its hypervolume)");
-  q->add_option("file", a.file, "results file (.h5); may be one a sweep is still writing")->required();
-  q->add_option("-w,--where", a.where,
-                "filter, repeatable (ANDed): COL OP VALUE with OP = != < <= > >=, COL=A,B,C (any of), "
-                "COL=LO..HI or LO<=COL<=HI (range), 'A | B' (either); angles in degrees unless --radians; "
-                "also on --optimization evaluations")
-      ->allow_extra_args(false);
-  q->add_option("-c,--columns", a.columns, "comma-separated columns, or 'all' (default: table: a compact set; csv/json: all)");
-  q->add_option("-s,--sort", a.sort, "sort by COL or COL:desc (repeatable or comma list; NaN last)")->allow_extra_args(false);
-  q->add_option("-n,--limit", a.limit, "print at most N rows (N >= 0)")->check(CLI::Validator(check_count, "N>=0"));
-  q->add_option("-f,--format", a.format, "table | csv | json (default: table; csv for --history)")
-      ->check(CLI::IsMember({"table", "csv", "json"}));
-  q->add_flag("--radians", a.radians, "show and filter angles in radians (as stored) instead of degrees");
-  q->add_flag("--include-pending", a.include_pending, "also rows not done yet (missing values)");
-  q->add_option("-g,--group-by", a.group_by, "one row per group of rows with equal COL (comma list: equal in each)");
-  q->add_option("--agg", a.agg, "with --group-by, the group's columns: count, FN:COL with FN min, max, mean, median, "
-                "sum, argmin, argmax (run_id of the min/max); comma list (default count)");
-  q->add_option("--pareto", a.pareto,
-                "the runs on the Pareto front of 2 or 3 metrics, comma list of COL, COL:min (default) or COL:max "
-                "(e.g. E,min_manipulability:max): the done runs passing --where whose status is good for their kind "
-                "(ok, converged) and that no other such run dominates; a run without a value (NaN) is never on it");
-  q->add_option("--hypervolume", a.hypervolume,
-                "with --pareto: print the front's hypervolume indicator against this reference point (one value "
-                "per metric, as shown: angles in degrees unless --radians) instead of its runs");
-  q->add_option("--run", a.run, "history mode: the run id");
-  q->add_option("--history", a.history, "history mode: array name(s), comma list, or 'all' (default all)");
-  q->add_option("--optimization", a.optimization,
-                "optimisation mode: print every evaluation of /optimizations/NAME (index, stage, start, the "
-                "variables, objective, constraint, status)");
-  a.format.clear();
-  return a;
-}
 
 int query_command(const QueryArgs& a) {
   try {

@@ -1,6 +1,5 @@
 #include "cli/robot_command.hpp"
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -260,19 +259,6 @@ bool is_urdf(const std::string& file) {
 }
 
 }  // namespace
-
-RobotArgs& add_robot_command(CLI::App& app) {
-  static RobotArgs a;
-  auto* c = app.add_subcommand("robot", "Show the chain a study's robot (or a URDF file) gives: joints, masses, "
-                                        "inertias, gravity, its plane or spatial, the task's redundancy");
-  c->add_option("file", a.file, "study file (TOML) or URDF file (.urdf, .xml)")->required();
-  c->add_option("--base", a.base, "URDF: the chain's base link");
-  c->add_option("--tip", a.tip, "URDF: the chain's tip link");
-  c->add_option("--gravity", a.gravity, "URDF: gx,gy,gz in m/s^2, base frame (default 0,0,-9.81: URDF's z up; "
-                                        "--gravity=gx,... when gx is negative)");
-  c->add_option("--format", a.format, "table | json")->check(CLI::IsMember({"table", "json"}));
-  return a;
-}
 
 int robot_command(const RobotArgs& a, std::ostream& out, std::ostream& err) {
   RobotView v;

@@ -2,7 +2,6 @@
 
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -98,30 +97,6 @@ class ProgressDisplay {
   double last_ = -1e9;
 };
 }  // namespace
-
-RunArgs& add_run_command(CLI::App& app) {
-  static RunArgs a;
-  auto* c = app.add_subcommand("run", "Run a study file into an HDF5 results file");
-  c->add_option("study", a.study, "study file (TOML)")->required();
-  c->add_option("-o,--output", a.output, "results file (default: the study's output, results/<name>.h5)");
-  c->add_option("--threads", a.threads, "worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
-  c->add_option("--lanes", a.lanes, "trajectory runs computed side by side in SIMD lanes: 1, 4 (AVX2) or 8 (AVX-512) "
-                "(default: the widest this processor runs; the results are the same bit for bit)")
-      ->check(CLI::IsMember({1, 4, 8}));
-  c->add_flag("--resume", a.resume, "complete only the runs missing from an existing results file");
-  c->add_flag("--overwrite", a.overwrite, "replace an existing results file");
-  c->add_flag("--dry-run", a.dry_run, "print the output path, runs per block, estimated size and time (from sample runs); write nothing");
-  c->add_option("--histories", a.histories, "full | every=N | none (default: the study's)");
-  c->add_option("--compression", a.compression, "history compression, read by HDF5's shuffle and deflate filters (default 1: runs of the top byte plane coded, the rest stored; 2-9: libdeflate on the two high planes at that level; 0: raw chunks, no filter)")
-      ->check(CLI::Range(0, 9));
-  c->add_option("--max-runs", a.max_runs, "the most runs a study may ask for (default 50000000; a study's max_runs may only lower it)")
-      ->check(CLI::PositiveNumber);
-  c->add_flag("-q,--quiet", a.quiet, "no progress display");
-  c->add_flag("--no-verify-best", a.no_verify_best,
-              "do not verify the best runs against the grid (dt/2, dt/4; 2K, 4K knots) at the end");
-  c->add_flag("--verbose", a.verbose, "with a results-file error, HDF5's own error stack too");
-  return a;
-}
 
 int run_command(const RunArgs& a) {
   const StopOnSignals signals;  // before anything is read or created

@@ -1,6 +1,5 @@
 #include "cli/schema_command.hpp"
 
-#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
 #include <set>
@@ -198,13 +197,6 @@ void print_schema_json(std::ostream& os) {
     first = false;
   }
   os << "]}\n";
-}
-
-SchemaArgs& add_schema_command(CLI::App& app) {
-  static SchemaArgs a;
-  auto* c = app.add_subcommand("schema", "List every run parameter and metric (name, type, units, domain, default)");
-  c->add_option("--format", a.format, "markdown | json")->check(CLI::IsMember({"markdown", "json"}));
-  return a;
 }
 
 int schema_command(const SchemaArgs& a) {

@@ -1,6 +1,5 @@
 #include "cli/sensitivity_command.hpp"
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -235,20 +234,6 @@ int run_sensitivity(const SensitivityArgs& args) {
 }
 
 }  // namespace
-
-SensitivityArgs& add_sensitivity_command(CLI::App& app) {
-  static SensitivityArgs a;
-  auto* s = app.add_subcommand("sensitivity", "First-order and total Sobol' indices (bootstrap intervals) of the "
-                                              "blocks run as a Saltelli design");
-  s->add_option("file", a.file, "results file (.h5)")->required();
-  s->add_option("--block", a.block, "only this block (default: every block with a design)");
-  s->add_option("--metric", a.metrics, "metrics to analyse (default: the run kind's ranking objective, E or iterations)");
-  s->add_option("--format", a.format, "table (default) or json")->check(CLI::IsMember({"table", "json"}));
-  s->add_option("--bootstrap", a.bootstrap, "bootstrap resamples for the intervals (default 1000; 0: none)");
-  s->add_option("--confidence", a.confidence, "the intervals' level (default 0.95)");
-  s->add_option("--seed", a.seed, "seed of the resampling (default 1)")->check(CLI::NonNegativeNumber);
-  return a;
-}
 
 int sensitivity_command(const SensitivityArgs& args) {
   try {

@@ -14,4 +14,7 @@ inline double wrap_angle(double x) {
   const double r = std::remainder(x, 2.0 * kPi);  // exact, in [-pi, pi]
   return r == -kPi ? kPi : r;
 }
+
+/// std::remainder(x, 2 pi): x wrapped to [-pi, pi] (either end possible, unlike wrap_angle).
+inline double remainder_2pi(double x) { return std::remainder(x, 2.0 * std::numbers::pi); }
 }  // namespace ks

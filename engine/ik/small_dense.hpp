@@ -3,7 +3,9 @@
 // PartialPivLU and LLT behind functions compiled once per size, in ik/small_dense.cpp, instead of in
 // every file that instantiates a solver (each instance of Eigen's decompositions and their condition
 // estimate costs seconds of compile time; the chain solvers need them for every joint count). The
-// operations are Eigen's, unchanged, so the results are the same bits as calling Eigen directly.
+// operations are Eigen's, unchanged, so the results are the same bits as calling Eigen directly:
+// small_dense.cpp calls the unblocked factorisations that Eigen's PartialPivLU and LLT run for
+// these sizes, without instantiating their blocked (dynamic-size) paths, which never run here.
 //
 //   SmallLu<N> lu(A);          // A = P^-1 L U, partial pivoting
 //   Vec<N> x = lu.solve(b);    // A x = b
@@ -33,7 +35,8 @@ class SmallLu {
   Mat<N, N> solve(const Mat<N, N>& B) const;
 
  private:
-  Eigen::PartialPivLU<Mat<N, N>> lu_;
+  Mat<N, N> lu_;                         // L (unit lower, below the diagonal) and U, as PartialPivLU's
+  Eigen::PermutationMatrix<N, N> p_;     // P, as PartialPivLU's permutationP()
 };
 
 /// Cholesky factorisation A = L L^T of a symmetric N x N matrix (Eigen::LLT<Mat<N, N>>, lower).
@@ -48,7 +51,8 @@ class SmallLlt {
   Vec<N> solve(const Vec<N>& b) const;
 
  private:
-  Eigen::LLT<Mat<N, N>> llt_;
+  Mat<N, N> l_;  // L in the lower triangle, as LLT's matrixLLT()
+  bool ok_;
 };
 
 /// Reciprocal condition estimate of A (N x N) in the 1-norm by its LU (Eigen's PartialPivLU::rcond, 0 when singular).

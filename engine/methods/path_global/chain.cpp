@@ -11,6 +11,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "common/angles.hpp"
+
 namespace ks {
 namespace {
 
@@ -18,7 +20,6 @@ constexpr double kViolationWeight = 1e6;
 constexpr double kInfeasibleFloor = 1e4;  // per unit of 1 / samples, in the objective's units
 constexpr double kSingularDet = 1e-12;    // an extension this close to singular costs the floor too
 
-double wrap(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
 
 }  // namespace
 
@@ -49,7 +50,7 @@ double ChainGlobalProblem::ratio(const LimitConstraints& limits, const std::arra
   switch (row[0]) {
     case 0: {
       const double off = s.q[j] - L.mid[j];
-      return std::abs(wraps_angles() ? wrap(off) : off) * L.inv_half[j];
+      return std::abs(wraps_angles() ? remainder_2pi(off) : off) * L.inv_half[j];
     }
     case 1: return std::abs(s.qd[j]) * L.inv_velocity[j];
     default: return std::abs(s.tau[j]) * L.inv_effort[j];
@@ -202,7 +203,7 @@ class ChainGlobalProblem::MeasureModel {
     if (s.violation > 0.0) return RunStatus::infeasible;
     if (!s.tau.allFinite()) return RunStatus::diverged;
     if (p_.singular(s, o_.singular_tolerance)) return RunStatus::singular_extension;
-    for (int j = 0; j < p_.n_; ++j) s.q[j] = q_prev_[j] + wrap(s.q[j] - q_prev_[j]);  // continuous joint angles
+    for (int j = 0; j < p_.n_; ++j) s.q[j] = q_prev_[j] + remainder_2pi(s.q[j] - q_prev_[j]);  // continuous joint angles
     q_prev_ = s.q;
     for (int j = 0; j < p_.n_; ++j) q[j] = s.q[j], qd[j] = s.qd[j];
     return RunStatus::ok;

@@ -8,6 +8,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "common/angles.hpp"
 #include "methods/path_global/closed_form.hpp"
 #include "model/planar_chain_dynamics.hpp"
 
@@ -19,7 +20,6 @@ constexpr double kClamp = 1.0 - 1e-12;
 
 V2 dir(double a) { return {std::cos(a), std::sin(a)}; }
 V2 perp(const V2& v) { return {-v.y(), v.x()}; }  // turned by +90 degrees
-double wrap(double a) { return std::remainder(a, 2.0 * std::numbers::pi); }
 V2 turned(const V2& v, double a) {  // v rotated by a
   const double c = std::cos(a), s = std::sin(a);
   return {c * v.x() - s * v.y(), s * v.x() + c * v.y()};
@@ -108,9 +108,9 @@ void PlanarChartProblem::sample(std::size_t i, const double (*z)[3], ChainGlobal
   const V2 tdd = lu.solve(wdd + L1_ * td[0] * td[0] * dir(t1) + L2_ * td[1] * td[1] * dir(t2));
   // back to the joints: phi_a = theta1 - delta1, phi_a+1 = theta2 - delta2, phi_a+2 = A - delta3
   const int a = a_;
-  s.q[a] = wrap(sigma_[a] * (t1 - d1_ - phi - beta_[a]));
-  s.q[a + 1] = wrap(sigma_[a + 1] * (t2 - d2_ - (t1 - d1_) - beta_[a + 1]));
-  s.q[a + 2] = wrap(sigma_[a + 2] * (A - d3_ - (t2 - d2_) - beta_[a + 2]));
+  s.q[a] = remainder_2pi(sigma_[a] * (t1 - d1_ - phi - beta_[a]));
+  s.q[a + 1] = remainder_2pi(sigma_[a + 1] * (t2 - d2_ - (t1 - d1_) - beta_[a + 1]));
+  s.q[a + 2] = remainder_2pi(sigma_[a + 2] * (A - d3_ - (t2 - d2_) - beta_[a + 2]));
   s.qd[a] = sigma_[a] * (td[0] - phid), s.qd[a + 1] = sigma_[a + 1] * (td[1] - td[0]), s.qd[a + 2] = sigma_[a + 2] * (Ad - td[1]);
   s.qdd[a] = sigma_[a] * (tdd[0] - phidd), s.qdd[a + 1] = sigma_[a + 1] * (tdd[1] - tdd[0]);
   s.qdd[a + 2] = sigma_[a + 2] * (Add - tdd[1]);
@@ -137,7 +137,7 @@ void PlanarChartProblem::coordinates_of(std::size_t i, const VecN& q, double* z,
   const V2 d = task_.path.position(i).head<2>() - P;
   const double r = d.norm(), L = L1_ + L2_;
   const double gamma = std::clamp((r * r + L3_ * L3_ - L * L) / (2.0 * L3_ * r), -kClamp, kClamp);
-  const double s = std::clamp(wrap(A - std::atan2(d.y(), d.x())) / std::acos(gamma), -1.0, 1.0);
+  const double s = std::clamp(remainder_2pi(A - std::atan2(d.y(), d.x())) / std::acos(gamma), -1.0, 1.0);
   z[n_ - 3] = std::atan2(s, static_cast<int>(elbow) * std::sqrt(1.0 - s * s));
 }
 
