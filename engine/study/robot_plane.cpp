@@ -34,7 +34,7 @@ void Parser::check_gravity_given(Study& s) {
   if (std::abs(n.z()) <= kParallelTol) return;  // a vertical plane: base -z lies in it
   error(*robot_without_gravity_,
         "a " + robot_without_gravity_kind_ + " robot without gravity whose chain moves in a plane that is not vertical (normal " + vec(n) +
-            " in the base frame): the default, base -z (URDF's z up), is " +
+            " in the base frame): the default, base -z (" + (robot_without_gravity_kind_ == "URDF" ? "URDF's " : "") + "z up), is " +
             (std::abs(std::abs(n.z()) - 1.0) <= kParallelTol ? "normal to the plane" : "partly normal to the plane") +
             "; expected gravity = [gx, gy, gz] in [robot] (m/s^2, base frame), e.g. [0, 0, -9.81] for a horizontal "
             "arm (no gravity torques) or [0, -9.81, 0] for gravity along base -y (the seed arm's convention)");

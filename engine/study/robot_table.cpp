@@ -70,9 +70,11 @@ void Parser::parse_robot(const toml::table& root, Study& s) {
 }
 
 void Parser::parse_planar_robot(const toml::table& t, Study& s) {
-  for (const char* k : {"base", "tip", "gravity"})
+  for (const char* k : {"base", "tip"})
     if (const toml::node* n = t.get(k))
       error(*n, std::string(k) + " is a key of URDF robots; expected it with urdf = \"FILE\" (planar arms take g)");
+  if (const toml::node* n = t.get("gravity"))
+    error(*n, "gravity is a key of URDF and DH robots; expected it with urdf = \"FILE\" or dh (planar arms take g)");
   std::vector<double> l{1, 1, 1}, m{5, 2, 1};
   bool ok = true;
   if (auto v = get_joint_numbers(t, "l", 0, "robot l", "m")) {
