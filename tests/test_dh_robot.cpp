@@ -160,6 +160,30 @@ TEST(DhRobot, Planar2rEqualsUrdfAndKdl) { expect_same_robot("planar2r"); }
 TEST(DhRobot, ScaraEqualsUrdfAndKdl) { expect_same_robot("scara"); }
 TEST(DhRobot, Puma560EqualsUrdfAndKdl) { expect_same_robot("puma560"); }
 
+// The 2R's torques are those of the thesis's own planar model (its appendix, Listagem 5: uniform thin
+// rods, written there with 0.3333 and 1.3333 for the thirds), m = 10 kg, l = 1.2 m, gravity along -y.
+TEST(DhRobot, Planar2rIsTheThesisTwoLinkModel) {
+  const Chain c = dh_study_chain("planar2r");
+  const double m1 = 10, m2 = 10, l = 1.2, g = 9.81;
+  test::RandomJoints r;
+  for (int n = 0; n < 300; ++n) {
+    const VecN q = r.q(2), qd = r.v(2), qdd = r.a(2);
+    const double c1 = std::cos(q[0]), c2 = std::cos(q[1]), s2 = std::sin(q[1]), c12 = std::cos(q[0] + q[1]);
+    const double dq1 = qd[0], dq2 = qd[1], ddq1 = qdd[0], ddq2 = qdd[1];
+    VecN thesis(2);
+    thesis[0] = m1 * l * l * ddq1 / 3 + 4 * m2 * l * l * ddq1 / 3 + m2 * l * l * ddq2 / 3 + m2 * c2 * l * l * ddq1 +
+                0.5 * m2 * l * l * c2 * ddq2 - m2 * s2 * l * l * dq1 * dq2 - 0.5 * m2 * s2 * l * l * dq2 * dq2 +
+                0.5 * m1 * g * l * c1 + 0.5 * m2 * g * l * c12 + m2 * g * l * c1;
+    thesis[1] = m2 * l * l * ddq1 / 3 + m2 * l * l * ddq2 / 3 + 0.5 * m2 * l * l * c2 * ddq1 + 0.5 * m2 * g * l * c12 +
+                0.5 * m2 * l * l * s2 * dq1 * dq1;
+    ChainData d;
+    VecN tau;
+    rnea(c, d, q, qd, qdd, tau);
+    expect_near_all(tau, thesis, "state " + std::to_string(n));
+    if (::testing::Test::HasFailure()) return;
+  }
+}
+
 // Offsets the shipped robots do not exercise: theta offsets on revolute joints, a prismatic joint
 // with a theta and a d offset, twists other than +-90 deg, off-diagonal inertias, oblique gravity.
 TEST(DhRobot, OffsetsAndPrismaticJointsMatchKdl) {
@@ -364,6 +388,12 @@ TEST(DhRobot, ErrorsAreLocatedWithWhatWasExpected) {
                  "joint 'joint2' moves neither mass nor inertia");
   expect_located(with({{9, "mass = 0"}, {19, "mass = 0"}}), 3, 1, "zero total mass");
   expect_located(with({{2, "urdf = \"x.urdf\""}}), 2, 8, "urdf and dh both given");
+  // a planar arm in the base xy plane given no gravity: base -z would be normal to its plane
+  std::string traj = with({{2, "# no gravity"}});
+  traj = traj.substr(0, traj.find("[[block]]")) + kRows[12] + "\n" + kRows[13] + "\na = 0.5\nalpha = 0\nd = 0\ntheta = 0\n" +
+         "mass = 1\ncom = [-0.25, 0, 0]\ninertia = { ixx = 0.001, iyy = 0.02, izz = 0.02 }\n" +
+         "[task]\nvertices = [[0.8, 0.2], [1.0, 0.2]]\ndurations = [1]\n[[block]]\nname = \"t\"\nkind = \"trajectory\"\n";
+  expect_located(traj, 3, 1, "a DH robot without gravity whose chain moves in a plane that is not vertical");
   expect_located(with({{2, "l = [1, 1]"}}), 2, 5, "l describes a planar arm; expected no l with dh");
 }
 
