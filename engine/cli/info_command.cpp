@@ -326,8 +326,9 @@ int run_info(const InfoArgs& args) {
   if (m.robot_text.empty()) {
     os << "sha256      " << m.study_sha256 << "  (of the study file's text, stored in /study/text)\n";
   } else {
-    os << "robot       " << m.robot_path << "  (URDF, stored in /study/robot)\n";
-    os << "sha256      " << m.study_sha256 << "  (of the study file's text and the URDF's)\n";
+    const bool urdf = m.robot_path.ends_with(".urdf");  // else a DH robot file (TOML)
+    os << "robot       " << m.robot_path << (urdf ? "  (URDF" : "  (DH table") << ", stored in /study/robot)\n";
+    os << "sha256      " << m.study_sha256 << "  (of the study file's text and the " << (urdf ? "URDF's" : "robot file's") << ")\n";
   }
   os << "engine      kinesweep " << m.engine_version << "; format " << m.format << " v" << m.format_version
      << "; created " << m.created << '\n';

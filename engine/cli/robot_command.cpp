@@ -117,8 +117,10 @@ RobotView from_study(const Study& s) {
   if (s.base_chain) {
     v.chain = *s.base_chain;
     v.dynamics = "recursive";
-    v.origin = s.robot_file.empty() ? "[robot] of " + s.file + ": an n-link planar arm"
-                                    : "[robot] of " + s.file + ": URDF " + s.robot_file;
+    v.origin = s.robot_format == "urdf" ? "[robot] of " + s.file + ": URDF " + s.robot_file
+               : s.robot_format != "dh" ? "[robot] of " + s.file + ": an n-link planar arm"
+               : s.robot_file.empty()   ? "[robot] of " + s.file + ": a DH table"
+                                        : "[robot] of " + s.file + ": DH table " + s.robot_file;
   } else {
     v.chain = *s.robot_chain();
     v.dynamics = "closed_form";

@@ -6,7 +6,6 @@
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cerrno>
@@ -17,7 +16,7 @@
 #include <sstream>
 
 #include "common/did_you_mean.hpp"
-#include "model/chain_dynamics.hpp"
+#include "robot/inertia_check.hpp"
 #include "robot/urdf_check.hpp"
 
 namespace ks {
@@ -238,25 +237,13 @@ class Builder {
   }
 
  private:
-  // A link's mass properties: mass finite and >= 0, inertia finite with principal moments >= 0, each at
-  // most the sum of the other two (a rigid body's: I1 + I2 - I3 = 2 * integral of the squared distance
-  // along the third principal axis >= 0), both within 1e-6 of the trace (rounded printed digits).
+  // A link's mass properties: mass finite and >= 0, inertia one a rigid body can have (robot/inertia_check.hpp).
   void check_mass_properties(const std::string& name, double mass, const M3& Ic) const {
     const int line = link_line(name);
     if (!std::isfinite(mass) || mass < 0.0)
       fail(line, "link '" + name + "': <mass value=\"" + num(mass) + "\"> is " + (std::isfinite(mass) ? "negative" : "not finite") +
                      "; expected a mass >= 0 [kg]");
-    if (!Ic.allFinite()) fail(line, "link '" + name + "': the inertia (ixx..izz) is not finite; expected finite numbers [kg m^2]");
-    const V3 p = Eigen::SelfAdjointEigenSolver<M3>(Ic, Eigen::EigenvaluesOnly).eigenvalues();  // ascending
-    const double tol = 1e-6 * std::max(std::abs(p[0]) + std::abs(p[1]) + std::abs(p[2]), 1e-300);
-    const std::string moments = "(" + num(p[0]) + ", " + num(p[1]) + ", " + num(p[2]) + " kg m^2)";
-    if (p[0] < -tol)
-      fail(line, "link '" + name + "': the inertia's principal moments " + moments +
-                     " include a negative one; expected a positive semi-definite inertia (ixx..izz about the centre of mass)");
-    if (p[2] > p[0] + p[1] + tol)
-      fail(line, "link '" + name + "': the inertia's principal moments " + moments + " violate the triangle inequality (" +
-                     num(p[2]) + " > " + num(p[0]) + " + " + num(p[1]) +
-                     "); expected each moment <= the sum of the other two (no rigid body has such an inertia)");
+    if (const std::string why = inertia_problem(Ic); !why.empty()) fail(line, "link '" + name + "': " + why);
   }
 
   static std::string num(double v) {
@@ -326,33 +313,11 @@ class Builder {
     return j;
   }
 
-  // M must be positive definite: checked at q = 0 and three fixed configurations within the limits.
+  // M must be positive definite (robot/inertia_check.hpp).
   void check_inertia_matrix(const Chain& chain) const {
-    const int n = chain.dof();
-    ChainData data;
-    MatN M;
-    for (int k = 0; k < 4; ++k) {
-      VecN q = VecN::Zero(n);
-      for (int i = 0; k > 0 && i < n; ++i) {
-        const double u = std::fmod(0.318309886 * (k * 7 + i * 3 + 1), 1.0);  // spread in (0, 1)
-        const ChainJoint& j = chain.joints[i];
-        q[i] = std::isfinite(j.lower) && std::isfinite(j.upper) ? j.lower + u * (j.upper - j.lower) : (2 * u - 1) * 3.0;
-      }
-      crba(chain, data, q, M);
-      const Eigen::VectorXd ev = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(M, Eigen::EigenvaluesOnly).eigenvalues();
-      if (ev[0] > 1e-12 * std::max(1e-300, ev[n - 1])) continue;
-      int weakest = 0;
-      for (int i = 1; i < n; ++i)
-        if (M(i, i) < M(weakest, weakest)) weakest = i;
-      const std::string& name = chain.joints[weakest].name;
-      if (M(weakest, weakest) <= 1e-12 * M.diagonal().maxCoeff())
-        fail(joint_line(name), "the inertia matrix is singular: joint '" + name +
-                                   "' moves neither mass nor inertia (every link from it to the tip is massless "
-                                   "or lies on its axis)");
-      std::ostringstream s;
-      s << "the inertia matrix is singular at q = (" << q.transpose() << "): the joints move the same bodies the same way";
-      fail(0, s.str());
-    }
+    int joint = -1;
+    if (const std::string why = inertia_matrix_problem(chain, &joint); !why.empty())
+      fail(joint >= 0 ? joint_line(chain.joints[joint].name) : 0, why);
   }
 
   std::string_view text_;

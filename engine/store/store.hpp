@@ -86,7 +86,7 @@ struct StoreMeta {
   std::string study_path;    ///< attribute "path" of /study
   std::string study_text;    ///< the study file's text verbatim (/study/text)
   std::string study_sha256;  ///< hex (of the study text, and of the robot's URDF text when there is one)
-  std::string robot_path;    ///< the URDF file the study names (attribute "path" of /study/robot; "" when none)
+  std::string robot_path;    ///< the URDF or DH robot file the study names (attribute "path" of /study/robot; "" when none)
   std::string robot_text;    ///< its text verbatim (/study/robot; written only when non-empty)
   std::string engine_version = KINESWEEP_VERSION;
   std::string created;       ///< ISO 8601 UTC; filled at creation when empty

@@ -128,7 +128,7 @@ std::string StudyDiagnostic::str() const {
       out.append(1, '\n').append(std::size_t(gutter), ' ').append(" = note: ").append(n.message);
       continue;
     }
-    out += "\nnote: " + file + ":" + std::to_string(n.line) + ":" + std::to_string(n.column) + ": " + n.message;
+    out += "\nnote: " + (n.file.empty() ? file : n.file) + ":" + std::to_string(n.line) + ":" + std::to_string(n.column) + ": " + n.message;
     if (n.source_line) out += snippet(gutter, n.line, n.column, n.length, *n.source_line);
   }
   return out;

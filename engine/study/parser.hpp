@@ -3,6 +3,7 @@
 // study text; its parts live in the files named for their jobs:
 //   study_tables.cpp     [study], [task]
 //   robot_table.cpp      [robot]: the seed 3R, an n-link planar arm or a URDF robot
+//   robot_dh.cpp         [robot] dh: a standard DH table (in the study or a robot file)
 //   axes.cpp             parameter values and the [block.axes] forms (values, range, linspace, random, lhs)
 //   blocks.cpp           [[block]] tables: name, kind, keys, IK problem family, fixed parameters
 //   block_axes.cpp       a block's axes: lhs settings, [block.axes], lhs and zip groups, axes a run would ignore
@@ -105,11 +106,14 @@ class Parser : public ParserCore {
   void parse_robot(const toml::table& root, Study& s);
   void parse_planar_robot(const toml::table& t, Study& s);
   void parse_urdf_robot(const toml::table& t, Study& s);
+  /// robot_dh.cpp: a standard DH table, in the study ([[robot.dh]]) or in a robot file (dh = "FILE").
+  void parse_dh_robot(const toml::table& t, Study& s);
   /// After [robot] (robot_plane.cpp): base_chain, plane, and a planar chain in its plane's frame.
   void place_robot_in_plane(Study& s);
-  /// Trajectory studies: a URDF robot without gravity whose plane is not vertical is refused.
+  /// Trajectory studies: a URDF or DH robot without gravity whose plane is not vertical is refused.
   void check_gravity_given(Study& s);
-  const toml::node* urdf_without_gravity_ = nullptr;  ///< the urdf key of a URDF robot given no gravity
+  const toml::node* robot_without_gravity_ = nullptr;  ///< the urdf (dh) key of a URDF (DH) robot given no gravity
+  std::string robot_without_gravity_kind_ = "URDF";    ///< which: "URDF" or "DH"
   /// The plane coordinates of vertex x (base frame [m]) of a planar robot; nullopt, reported at
   /// `at`, when x is off the plane by more than kVertexOffPlane.
   std::optional<Eigen::Vector2d> vertex_in_plane(const toml::node& at, const Eigen::Vector3d& x, const ChainPlane& plane);

@@ -23,18 +23,18 @@ void Parser::place_robot_in_plane(Study& s) {
     return;
   }
   s.base_chain = s.chain;
-  s.gravity_defaulted = urdf_without_gravity_ != nullptr;
+  s.gravity_defaulted = robot_without_gravity_ != nullptr;
   s.plane = motion_plane(*s.chain);
   if (s.plane) s.chain = std::make_shared<const Chain>(in_plane_frame(*s.chain, *s.plane));
 }
 
 void Parser::check_gravity_given(Study& s) {
-  if (!urdf_without_gravity_ || !s.plane) return;
+  if (!robot_without_gravity_ || !s.plane) return;
   const Eigen::Vector3d n = s.plane->normal();
   if (std::abs(n.z()) <= kParallelTol) return;  // a vertical plane: base -z lies in it
-  error(*urdf_without_gravity_,
-        "a URDF robot without gravity whose chain moves in a plane that is not vertical (normal " + vec(n) +
-            " in the base frame): the default, base -z (URDF's z up), is " +
+  error(*robot_without_gravity_,
+        "a " + robot_without_gravity_kind_ + " robot without gravity whose chain moves in a plane that is not vertical (normal " + vec(n) +
+            " in the base frame): the default, base -z (" + (robot_without_gravity_kind_ == "URDF" ? "URDF's " : "") + "z up), is " +
             (std::abs(std::abs(n.z()) - 1.0) <= kParallelTol ? "normal to the plane" : "partly normal to the plane") +
             "; expected gravity = [gx, gy, gz] in [robot] (m/s^2, base frame), e.g. [0, 0, -9.81] for a horizontal "
             "arm (no gravity torques) or [0, -9.81, 0] for gravity along base -y (the seed arm's convention)");

@@ -3,6 +3,7 @@
 //   l, m (n values), b | lc + I,      an n-link planar arm (2 <= n <= 8; recursive dynamics; with
 //   limits, g, dynamics = "recursive"   3 links only when one of lc, I, limits or dynamics asks for it)
 //   urdf, base, tip, gravity          a URDF robot's chain from link `base` to link `tip`
+//   dh, gravity                       a standard DH table (robot_dh.cpp)
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -59,16 +60,21 @@ void Parser::parse_robot(const toml::table& root, Study& s) {
     error(*n, "'robot' is " + type_name(*n) + "; expected a [robot] table");
     return;
   }
-  check_keys(*t, {"l", "m", "b", "lc", "I", "limits", "g", "inertia", "dynamics", "urdf", "base", "tip", "gravity"},
+  check_keys(*t, {"l", "m", "b", "lc", "I", "limits", "g", "inertia", "dynamics", "urdf", "base", "tip", "gravity", "dh"},
              "[robot]");
-  if (t->get("urdf")) parse_urdf_robot(*t, s);
+  if (t->get("urdf") && t->get("dh"))
+    error(*t->get("urdf"), "urdf and dh both given; expected one robot description: urdf = \"FILE\" or dh (a DH table)");
+  else if (t->get("dh")) parse_dh_robot(*t, s);
+  else if (t->get("urdf")) parse_urdf_robot(*t, s);
   else parse_planar_robot(*t, s);
 }
 
 void Parser::parse_planar_robot(const toml::table& t, Study& s) {
-  for (const char* k : {"base", "tip", "gravity"})
+  for (const char* k : {"base", "tip"})
     if (const toml::node* n = t.get(k))
       error(*n, std::string(k) + " is a key of URDF robots; expected it with urdf = \"FILE\" (planar arms take g)");
+  if (const toml::node* n = t.get("gravity"))
+    error(*n, "gravity is a key of URDF and DH robots; expected it with urdf = \"FILE\" or dh (planar arms take g)");
   std::vector<double> l{1, 1, 1}, m{5, 2, 1};
   bool ok = true;
   if (auto v = get_joint_numbers(t, "l", 0, "robot l", "m")) {
@@ -201,11 +207,12 @@ void Parser::parse_urdf_robot(const toml::table& t, Study& s) {
     // gravity: as given, else base -z (URDF's z up; check_gravity_given refuses it for a trajectory
     // study when the chain's plane is not vertical)
     Chain c = parse_urdf(text.str(), *base, *tip, gravity.value_or(Eigen::Vector3d(0, 0, -9.81)), path.string());
-    if (!gravity) urdf_without_gravity_ = &at;
+    if (!gravity) robot_without_gravity_ = &at, robot_without_gravity_kind_ = "URDF";
     c.prepare();
     s.chain = std::make_shared<const Chain>(std::move(c));
     s.robot_file = *file;
     s.robot_text = text.str();
+    s.robot_format = "urdf";
   } catch (const UrdfError& e) {
     // an unknown link at its key, anything else at urdf; the URDF's file and line lead the message
     std::string what = e.message, hint;

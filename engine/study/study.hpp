@@ -32,6 +32,7 @@ struct StudyDiagnostic {
     std::string message;
     std::optional<std::string> source_line;  ///< the text of `line`, when known
     int length = 1;                          ///< code points underlined from `column`
+    std::string file;                        ///< the file of `line` when not the diagnostic's (a robot file's error noted in the study)
   };
 
   std::string file;
@@ -140,7 +141,8 @@ struct Study {
   /// angles and histories' x are in this plane's coordinates.
   std::optional<ChainPlane> plane;
   bool gravity_defaulted = false;  ///< a URDF robot given no gravity: base -z taken (URDF's z up)
-  std::string robot_file;   ///< the URDF file as the study names it ("" when none)
+  std::string robot_format;  ///< "urdf", "dh" (a DH table) or "" (the seed's 3R, an n-link planar arm)
+  std::string robot_file;   ///< the URDF or DH robot file as the study names it ("" when none)
   std::string robot_text;   ///< its text, verbatim (kept with the results)
   StudyTask task;
   std::string text;         ///< the study file's text, verbatim
