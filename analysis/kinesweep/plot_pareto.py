@@ -34,11 +34,7 @@ def parse_args(argv=None):
     p.add_argument("--where", "-w", action="append", default=[], metavar="EXPR",
                    help="keep the rows where EXPR holds (repeatable; `kinesweep query --where` syntax)")
     p.add_argument("--log", action="store_true", help="log scales on the metric axes")
-    argv = list(sys.argv[1:] if argv is None else argv)
-    for i in range(len(argv) - 1, 0, -1):  # an expression may start with '-'
-        if argv[i - 1] in ("-w", "--where"):
-            argv[i - 1:i + 1] = ["--where=" + argv[i]]
-    return p.parse_args(argv)
+    return p.parse_args(kswhere.where_argv(sys.argv[1:] if argv is None else argv))
 
 
 def fail(msg, code=2):

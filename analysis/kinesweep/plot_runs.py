@@ -54,12 +54,7 @@ def parse_args(argv=None):
                    "`kinesweep query --where`: COL OP VALUE, COL=A,B, COL=LO..HI, LO<COL<=HI, angles "
                    "in degrees; alternatives separated by ' | ' (any holds)")
     p.add_argument("--log", action="store_true", help="the metric on a log scale (axis or colour)")
-    # An expression may start with '-' (-10<alpha1A<10): take the word after -w / --where as its value.
-    argv = list(sys.argv[1:] if argv is None else argv)
-    for i in range(len(argv) - 1, 0, -1):
-        if argv[i - 1] in ("-w", "--where"):
-            argv[i - 1:i + 1] = ["--where=" + argv[i]]
-    return p.parse_args(argv)
+    return p.parse_args(kswhere.where_argv(sys.argv[1:] if argv is None else argv))
 
 
 def fail(msg, code=2):

@@ -245,3 +245,13 @@ def unheld_value_notes(table, exprs):
                             m += " (values: " + ", ".join(held) + ")"
                         notes.append(m)
     return notes
+
+
+def where_argv(argv):
+    """A command line with each `-w EXPR` / `--where EXPR` joined into `--where=EXPR`, so that argparse
+    takes an expression starting with '-' (-10<alpha1A<10) as the option's value."""
+    argv = list(argv)
+    for i in range(len(argv) - 1, 0, -1):
+        if argv[i - 1] in ("-w", "--where"):
+            argv[i - 1:i + 1] = ["--where=" + argv[i]]
+    return argv
