@@ -63,8 +63,11 @@ std::vector<std::vector<std::uint64_t>> lane_batches(const Block& block, const s
   for (std::size_t i = 0; i < picks.size(); ++i) {
     if (used[i]) continue;
     const auto* a = std::get_if<TrajectoryRun>(&runs[i]);
+    // a path-global run is one optimisation, never in lanes: one a batch, so that a block of runs of
+    // minutes each is not sampled whole before its first one is timed
+    const std::size_t cap = a && a->options.method == TrajectoryMethod::global_spline ? 1 : width;
     out.emplace_back();
-    for (std::size_t j = i; j < picks.size() && out.back().size() < width; ++j) {
+    for (std::size_t j = i; j < picks.size() && out.back().size() < cap; ++j) {
       const auto* b = std::get_if<TrajectoryRun>(&runs[j]);
       const bool shares = a && b && b->inertia == a->inertia && lane_compatible(a->options, b->options);
       if (used[j] || (j != i && a && !shares)) continue;  // (runs without lanes: any, in order)
@@ -99,15 +102,16 @@ struct BlockSamples {
   std::size_t n = 0;  // written
   double sum = 0, sq = 0, history_bytes = 0;
   /// True when sampling the block may stop: at least 4 runs handed out, the budget spent, and the
-  /// mean run time known within 10 % (or 10 budgets spent).
+  /// mean run time known within 10 %; or 10 budgets spent (then with any number of runs handed out:
+  /// a block of runs of minutes each, path-global ones, is estimated from the runs begun).
   bool enough(double budget) const {
-    if (handed < 4 || !started) return false;
+    if (handed == 0 || !started) return false;
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    if (elapsed <= budget) return false;
+    if (elapsed > 10 * budget) return true;
+    if (handed < 4 || elapsed <= budget) return false;
     const double k = static_cast<double>(n), mean = k > 0 ? sum / k : 0;
     const double var = k > 1 ? (sq - k * mean * mean) / (k - 1) : 0;
-    const bool settled = k > 1 && std::sqrt(std::max(var, 0.0) / k) <= 0.1 * mean;
-    return settled || elapsed > 10 * budget;
+    return k > 1 && std::sqrt(std::max(var, 0.0) / k) <= 0.1 * mean;
   }
 };
 
@@ -195,6 +199,9 @@ class DryRunBackend final : public SweepBackend {
     o.on_progress = nullptr;
     o.landscapes = false;
     o.source_runs = total_samples;
+    // a batch asked for when one is written, so that each decision knows the time of the runs done
+    o.tokens = r.options.threads > 0 ? static_cast<std::size_t>(r.options.threads)
+                                     : std::max<std::size_t>(1, std::thread::hardware_concurrency());
     o.source = [&](std::vector<std::uint64_t>& ids, std::size_t) {
       std::lock_guard lock(m);
       while (current < blocks.size()) {

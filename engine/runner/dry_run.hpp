@@ -10,8 +10,9 @@
 namespace ks {
 
 struct DryRunOptions {
-  /// Sampling budget per block [s]: at least 4 runs each, at most 64; past the budget, sampling goes
-  /// on (up to 10 budgets) while the block's mean run time is uncertain by more than 10 %.
+  /// Sampling budget per block [s]: at least 4 runs each within 10 budgets (at least 1 beyond), at
+  /// most 64; past the budget, sampling goes on (up to 10 budgets) while the block's mean run time is
+  /// uncertain by more than 10 %.
   double seconds_per_block = 0.25;
   /// Where the temporary files go (empty: the system's temporary directory).
   std::string temp_dir;

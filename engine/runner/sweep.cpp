@@ -357,7 +357,7 @@ SweepReport run_sweep(const Study& study, const StudySchema& schema, store::Resu
   tbb::task_arena arena(threads);
   arena.execute([&] {
     tbb::parallel_pipeline(
-        static_cast<std::size_t>(4 * threads),
+        options.tokens > 0 ? options.tokens : static_cast<std::size_t>(4 * threads),
         tbb::make_filter<void, std::shared_ptr<Batch>>(
             tbb::filter_mode::serial_in_order,
             [&](tbb::flow_control& fc) -> std::shared_ptr<Batch> {

@@ -41,6 +41,9 @@ struct SweepOptions {
   std::function<bool(std::vector<std::uint64_t>& ids, std::size_t max)> source;
   /// The number of runs `source` will hand out (for progress); 0: all runs not done.
   std::uint64_t source_runs = 0;
+  /// Batches in flight at most (0: four per thread). With `threads`, `source` is asked for the next
+  /// batch only when one is written (a dry run deciding from the runs it timed).
+  std::size_t tokens = 0;
   double progress_interval_s = 0.25;  ///< minimum time between on_progress calls
   /// Sets a block's landscape cells from elsewhere (a distributed sweep's shards): called once per
   /// block with a landscape, with the block's index and its begun landscape (the writer's handle);
