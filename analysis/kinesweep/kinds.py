@@ -6,7 +6,8 @@ Run with Debian's interpreter: /usr/bin/python3.
 import numpy as np
 
 TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged", "undersampled", "off_path",
-                       "out_of_limits", "max_evaluations", "not_converged", "infeasible", "singular_extension"]
+                       "out_of_limits", "max_evaluations", "not_converged", "infeasible", "singular_extension",
+                       "out_of_reach"]
 IK_STATUSES = ["converged", "stalled", "singular", "max_iter", "cycle", "diverged", "unsupported", "no_solution",
                "out_of_limits"]
 # What each run kind means, for files written before the engine recorded it under /kinds (the engine's
@@ -52,7 +53,7 @@ STATUS_COLOURS = {"unreachable_start": "#b0b0b0", "singular": "#7b3294", "diverg
                   "stalled": "#e08214", "max_iter": "#d7191c", "cycle": "#f4a582", "unsupported": "#6a6a6a",
                   "no_solution": "#8f8f8f", "out_of_limits": "#fdae61",
                   "max_evaluations": "#b35806", "not_converged": "#fee090", "infeasible": "#4d4d4d",
-                  "singular_extension": "#542788"}
+                  "singular_extension": "#542788", "out_of_reach": "#969696"}
 # Seed 000, Table 4 (copied from engine/methods/closed_form/seed_cases.cpp, checked against it by the tests):
 # case -> (method, k, alpha1A [deg], thesis E [Nm], thesis (|tau1|inf, |tau2|inf, |tau3|inf) [Nm]).
 THESIS_TABLE4 = {

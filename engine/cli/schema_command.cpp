@@ -56,17 +56,20 @@ std::vector<Listed> listed() {
   planar4.robot.joints = 4;
   planar4.scara = false;
   planar4.path_global = true;  // global_spline's columns (planar revolute chains on a position path)
+  planar4.placement = true;    // the task placement's columns (blocks that place their task)
   KindContext spatial7 = planar4;  // a spatial URDF chain (here 7 revolute joints)
   spatial7.robot.joints = 7;
   spatial7.robot.planar = false;
   spatial7.first_vertex = {0.5, 0.0, 0.5};
   KindContext seed;  // the seed's 3R, with the columns of global_spline (present in blocks that run it)
   seed.path_global = true;
+  seed.placement = true;
   return {{BlockKind::trajectory, "", seed},
           {BlockKind::ik, "scara", {}},
           {BlockKind::ik, "planar3r", planar},
           {BlockKind::trajectory, "chain_planar", planar4},
           {BlockKind::ik, "chain_planar", planar4},
+          {BlockKind::trajectory, "chain_spatial", spatial7},
           {BlockKind::ik, "chain_spatial", spatial7}};
 }
 bool is_chain(const Listed& l) { return l.context.robot.chain; }
@@ -140,7 +143,9 @@ void print_schema_markdown(std::ostream& os) {
     os << "\nMetrics of `" << to_string(kind) << "` runs (per-joint metrics: one per joint of the robot, "
           "as many as it has):\n\n| column | type | unit | in /landscapes | description |\n"
           "|---|---|---|---|---|\n";
-    for (const MetricDef& m : metrics(kind))
+    KindContext metric_context;
+    metric_context.placement = true;  // ik_error: blocks that place their task
+    for (const MetricDef& m : metrics(kind, metric_context))
       os << "| `" << m.name << "` | " << type_name(m.type) << " | " << (m.unit.empty() ? "-" : m.unit) << " | "
          << (m.gridded ? "yes" : "no") << " | " << cell(m.description) << " |\n";
     os << "\nStatuses of `" << to_string(kind) << "` runs:";

@@ -18,6 +18,7 @@
 #include "methods/chain/trajectory.hpp"
 #include "methods/base/trajectory.hpp"
 #include "methods/closed_form/lanes.hpp"
+#include "runner/placed_task.hpp"
 #include "schema/history_arrays.hpp"
 
 namespace ks {
@@ -77,8 +78,16 @@ std::vector<HistoryArray> ik_arrays(const std::vector<HistoryArrayDef>& defs, co
 
 struct RunWorkspace::Impl {
   const StudyTask* task = nullptr;
-  std::vector<SampledPath> paths;  // the study's path sampled at the last few dt asked for
-  std::vector<ChainTask> chain_tasks;  // the same for chains
+  /// The study's task at a placement (the identity: the task as written) and its IK error (NaN until
+  /// measured); the last few placements asked for.
+  struct Placed {
+    TaskPlacement placement;
+    StudyTask task;
+    double ik_error = std::numeric_limits<double>::quiet_NaN();
+  };
+  std::vector<Placed> placed;
+  std::vector<std::pair<TaskPlacement, SampledPath>> paths;  // a placed task sampled at the last few dt asked for
+  std::vector<std::pair<TaskPlacement, ChainTask>> chain_tasks;  // the same for chains
   TrajectoryHistory history;
   std::array<TrajectoryHistory, 8> lane_histories;  // one per lane of a batch
   ChainHistory chain_history;
@@ -86,29 +95,38 @@ struct RunWorkspace::Impl {
   ik::Summary<3, 2> s32;
   ik::ChainIkWorkspace chain_ik;
   ik::ChainIkResult chain_result;
-  const ChainTask& chain_task_of(const StudyTask& t, TaskSpace space, double dt) {
-    if (task != &t) {
-      paths.clear();
-      chain_tasks.clear();
-      task = &t;
-    }
-    for (const ChainTask& c : chain_tasks)
-      if (c.path.dt() == dt && c.space == space) return c;
-    if (chain_tasks.size() == 8) chain_tasks.erase(chain_tasks.begin());
-    std::vector<Eigen::Vector3d> v;
-    for (std::size_t i = 0; i < t.vertices.size(); ++i) v.push_back(t.vertex(i));
-    return chain_tasks.emplace_back(space, Path3(std::move(v), t.durations), dt);
+  /// Forget every cached task when the study's task is another one.
+  void use(const StudyTask& t) {
+    if (task == &t) return;
+    placed.clear();
+    paths.clear();
+    chain_tasks.clear();
+    task = &t;
   }
-  const SampledPath& path_of(const StudyTask& t, double dt) {
-    if (task != &t) {
-      paths.clear();
-      chain_tasks.clear();
-      task = &t;
-    }
-    for (const SampledPath& p : paths)  // a dt axis alternates between a few values: keep them all
-      if (p.dt() == dt) return p;
+  /// The study's task `t` at placement `p` (`planar`: the robot's task is in its plane).
+  Placed& placed_of(const StudyTask& t, const TaskPlacement& p, bool planar) {
+    use(t);
+    for (Placed& x : placed)
+      if (x.placement.same_transform(p)) return x;
+    if (placed.size() == 8) placed.erase(placed.begin());
+    return placed.emplace_back(Placed{p, p.identity() ? t : place_task(t, p, planar)});
+  }
+  const ChainTask& chain_task_of(const StudyTask& t, const TaskPlacement& p, bool planar, TaskSpace space, double dt) {
+    use(t);
+    for (const auto& [q, c] : chain_tasks)
+      if (c.path.dt() == dt && c.space == space && q.same_transform(p)) return c;
+    if (chain_tasks.size() == 8) chain_tasks.erase(chain_tasks.begin());
+    const StudyTask& pt = placed_of(t, p, planar).task;
+    std::vector<Eigen::Vector3d> v;
+    for (std::size_t i = 0; i < pt.vertices.size(); ++i) v.push_back(pt.vertex(i));
+    return chain_tasks.emplace_back(p, ChainTask(space, Path3(std::move(v), pt.durations), dt)).second;
+  }
+  const SampledPath& path_of(const StudyTask& t, const TaskPlacement& p, double dt) {
+    use(t);
+    for (const auto& [q, path] : paths)  // a dt axis alternates between a few values: keep them all
+      if (path.dt() == dt && q.same_transform(p)) return path;
     if (paths.size() == 8) paths.erase(paths.begin());
-    return paths.emplace_back(t.path(), dt);
+    return paths.emplace_back(p, SampledPath(placed_of(t, p, true).task.path(), dt)).second;
   }
 };
 RunWorkspace::RunWorkspace() : impl_(std::make_unique<Impl>()) {}
@@ -136,18 +154,23 @@ VecN start_guess(const Chain& chain, const VecN& q0) {
   return g;
 }
 
-RunOutcome run_chain_trajectory(const Scenario& sc, const TrajectoryRun& run, int stride, RunWorkspace::Impl& ws) {
+/// The most samples a trajectory run takes (its path's duration / dt; a time scale lengthens the
+/// path): more are not simulated (undersampled: the run would hold more samples than a sweep keeps).
+constexpr double kMaxRunSamples = 1e7;
+
+RunOutcome run_chain_trajectory(const Scenario& sc, const TrajectoryRun& run, const StudyTask& placed, int stride,
+                                RunWorkspace::Impl& ws) {
   const Chain& chain = *sc.chain;
-  TaskSpace space = task_space(chain, *sc.task);
+  TaskSpace space = task_space(chain, placed);
   // vertex_alpha: the seed's baseline prescribes the tip angle at the vertices (alpha1A and the run's
   // vertex_alpha_i): a planar pose task of a 3-joint arm
   const bool vertex_alpha = run.options.method == TrajectoryMethod::vertex_alpha && space == TaskSpace::planar_position;
   if (vertex_alpha) space = TaskSpace::planar_pose;
-  const ChainTask& task = ws.chain_task_of(*sc.task, space, run.options.dt);
+  const ChainTask& task = ws.chain_task_of(*sc.task, run.placement, chain.planar(), space, run.options.dt);
   TrajectoryOptions o = run.options;
   if (space == TaskSpace::planar_pose && !vertex_alpha) {  // the path's orientation: alpha1A and the later vertices
-    o.alpha1A = sc.task->orientation.front();
-    o.vertex_alpha.assign(sc.task->orientation.begin() + 1, sc.task->orientation.end());
+    o.alpha1A = placed.orientation.front();
+    o.vertex_alpha.assign(placed.orientation.begin() + 1, placed.orientation.end());
   }
   ChainHistory* h = nullptr;
   if (stride > 0) {
@@ -168,31 +191,54 @@ RunOutcome trajectory_outcome(const TrajectoryMetrics& metrics, const Trajectory
   return out;
 }
 
-/// Whether a run may share SIMD lanes: a closed-form 3R trajectory run that samples its path.
+/// Whether a run may share SIMD lanes: a closed-form 3R trajectory run that samples its path, on the
+/// study's task as written (a placed task's runs run one at a time).
 const TrajectoryRun* lane_run(const Scenario& sc, const RunSpec& run) {
   const auto* t = std::get_if<TrajectoryRun>(&run);
-  return t && !sc.chain && t->options.method != TrajectoryMethod::global_spline &&
-                 samples_path(sc.task->durations, t->options.dt)
+  return t && !sc.chain && t->options.method != TrajectoryMethod::global_spline && t->placement.identity() &&
+                 !t->placement.measured && samples_path(sc.task->durations, t->options.dt)
              ? t
              : nullptr;
 }
 
 RunOutcome run_trajectory(const Scenario& sc, const TrajectoryRun& run, int stride, RunWorkspace::Impl& ws) {
-  if (!samples_path(sc.task->durations, run.options.dt)) {  // a swept dt too coarse for the path
+  const int joints = sc.chain ? sc.chain->dof() : 3;
+  const bool planar = !sc.chain || sc.chain->planar();
+  RunWorkspace::Impl::Placed& placed = ws.placed_of(*sc.task, run.placement, planar);
+  const StudyTask& task = placed.task;
+  double ik_error = std::numeric_limits<double>::quiet_NaN();
+  if (run.placement.measured) {  // seed 002's IK error of the placed task, once per placement
+    if (std::isnan(placed.ik_error)) placed.ik_error = task_ik_error(task, *sc.robot, sc.chain);
+    ik_error = placed.ik_error;
+  }
+  const auto ended = [&](RunStatus status) {
     RunOutcome out;
-    out.result = not_simulated(RunStatus::undersampled, sc.chain ? sc.chain->dof() : 3);
+    TrajectoryMetrics m = not_simulated(status, joints);
+    m.ik_error = ik_error;
+    out.result = m;
     return out;
+  };
+  if (ik_error > 0.0) return ended(RunStatus::out_of_reach);
+  double duration = 0.0;
+  for (double d : task.durations) duration += d;
+  if (!samples_path(task.durations, run.options.dt) || !(duration / run.options.dt < kMaxRunSamples))
+    return ended(RunStatus::undersampled);  // a swept dt (or time scale) the path cannot be sampled at
+  RunOutcome out;
+  if (sc.chain) {
+    out = run_chain_trajectory(sc, run, task, stride, ws);
+  } else {
+    PlanarArm3 arm = *sc.robot;
+    arm.inertia_form = run.inertia;
+    const SampledPath& path = ws.path_of(*sc.task, run.placement, run.options.dt);
+    TrajectoryHistory* h = nullptr;
+    if (stride > 0) {
+      ws.history.stride = stride;
+      h = &ws.history;
+    }
+    out = trajectory_outcome(simulate(arm, path, run.options, h), h);
   }
-  if (sc.chain) return run_chain_trajectory(sc, run, stride, ws);
-  PlanarArm3 arm = *sc.robot;
-  arm.inertia_form = run.inertia;
-  const SampledPath& path = ws.path_of(*sc.task, run.options.dt);
-  TrajectoryHistory* h = nullptr;
-  if (stride > 0) {
-    ws.history.stride = stride;
-    h = &ws.history;
-  }
-  return trajectory_outcome(simulate(arm, path, run.options, h), h);
+  std::get<TrajectoryMetrics>(out.result).ik_error = ik_error;
+  return out;
 }
 
 /// The restarts' generator seed of an IK run: its restart_seed mixed (splitmix64 steps) with the bits
@@ -332,7 +378,7 @@ void execute_batch(const Scenario& scenario, const RunSpec* runs, std::size_t n,
     }
     PlanarArm3 arm = *scenario.robot;
     arm.inertia_form = first->inertia;
-    const SampledPath& path = ws.path_of(*scenario.task, first->options.dt);
+    const SampledPath& path = ws.path_of(*scenario.task, first->placement, first->options.dt);
     simulate_lanes(count == 1 ? 1 : lanes, arm, path, options.data(), count, results.data(), histories.data());
     const double each = std::chrono::duration<double>(Clock::now() - t0).count() / count;
     for (int k = 0; k < count; ++k) {

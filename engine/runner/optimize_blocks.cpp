@@ -17,6 +17,7 @@
 
 #include "methods/closed_form/seed_cases.hpp"
 #include "runner/execute.hpp"
+#include "runner/placed_task.hpp"
 
 namespace ks {
 
@@ -37,6 +38,7 @@ struct Evaluator {
   std::vector<const ParamDef*> vars;         // the variables' table entries
   std::vector<std::pair<const MetricDef*, double>> terms;  // metric (nullptr: failure_rate), weight
   const MetricDef* stop_time = nullptr;      // trajectory: penalty of runs that stopped early
+  const MetricDef* ik_error = nullptr;       // trajectory, a placed task: penalty of runs out of reach
   double duration = 0.0;
   bool reach_varies = false;
   tbb::enumerable_thread_specific<RunWorkspace> workspaces;
@@ -49,7 +51,9 @@ struct Evaluator {
 
   /// Reach margin of a run: its start (local methods) or every vertex (vertex_alpha).
   double margin_of(const RunSpec& r) const {
-    const auto& verts = study->task.vertices;
+    const TaskPlacement& p = std::get<TrajectoryRun>(r).placement;  // the vertices at the run's place
+    const StudyTask placed = p.identity() ? StudyTask{} : place_task(study->task, p, true);
+    const auto& verts = p.identity() ? study->task.vertices : placed.vertices;
     const TrajectoryOptions& o = std::get<TrajectoryRun>(r).options;
     double m = reach_margin(study->robot, verts.front(), o.alpha1A);
     if (o.method == TrajectoryMethod::vertex_alpha)
@@ -73,9 +77,14 @@ struct Evaluator {
         for (const auto& [m, w] : terms) v += m ? w * metric(*m) : 0.0;  // failure_rate: 0 for a good run
       } else if (status == to_string(RunStatus::unreachable_start)) {
         v = ob->penalty * (2.0 + std::max(0.0, margin_of(r)));
+      } else if (status == to_string(RunStatus::out_of_reach) && ik_error) {
+        // a placed task out of reach: the farther (seed 002's IK error [m]), the worse
+        const double e = metric(*ik_error);
+        v = ob->penalty * (2.0 + (std::isfinite(e) ? e : 1.0));
       } else {  // singular / diverged: the earlier it stopped, the worse
         const double t = metric(*stop_time);
-        v = ob->penalty * (1.0 + std::clamp(1.0 - (std::isfinite(t) ? t : 0.0) / duration, 0.0, 1.0));
+        const double d = duration * std::get<TrajectoryRun>(r).placement.time_scale;  // the run's path
+        v = ob->penalty * (1.0 + std::clamp(1.0 - (std::isfinite(t) ? t : 0.0) / d, 0.0, 1.0));
       }
     } else {
       for (const auto& [m, w] : terms) {
@@ -149,6 +158,7 @@ std::shared_ptr<Evaluator> make_evaluator(const Study& study, std::size_t index,
     else throw std::invalid_argument("optimization " + ob.name + ": no metric " + m);
   }
   e->stop_time = metric("stop_time");
+  e->ik_error = metric("ik_error");
   for (double d : study.task.durations) e->duration += d;
   if (e->duration <= 0) e->duration = 1.0;
   return e;

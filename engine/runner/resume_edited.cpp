@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <limits>
 
+#include "runner/placed_task.hpp"
 #include "runner/run_identity.hpp"
 #include "runner/study_meta.hpp"
 
@@ -87,9 +89,11 @@ std::vector<Entry> done_identities(const store::ResultsReader& file, const Study
 /// Copies the old file's runs `pairs` (new run id, old run id; ascending new ids) into `writer`:
 /// each row with the edited study's run id and block (the other cells by column name), and its
 /// history. Rows are read in pieces.
+/// `identity_ik_error`: the ik_error of the study's task as written (a block that places its task
+/// measures it), for the rows of such blocks copied from a file without that column; NaN: none.
 void copy_runs(const store::ResultsReader& file, const Study& study, const StudySchema& schema,
                const std::vector<std::pair<std::uint64_t, std::int64_t>>& pairs, int compression,
-               store::ResultsWriter& writer) {
+               double identity_ik_error, store::ResultsWriter& writer) {
   std::vector<std::size_t> from(schema.columns.size(), npos);  // new column -> old column
   for (std::size_t c = 0; c < schema.columns.size(); ++c)
     for (std::size_t o = 0; o < file.columns().size(); ++o)
@@ -109,6 +113,21 @@ void copy_runs(const store::ResultsReader& file, const Study& study, const Study
       Record rec = schema.blank;
       for (std::size_t c = 0; c < rec.cells.size(); ++c)
         if (from[c] != npos) rec.cells[c] = row.cells[from[c]];
+      // a parameter column the old file lacks (a placement axis added at its identity value): the
+      // edited study's value, which the identity left out
+      const RunRef ref = study.locate(id);
+      const auto& pc = schema.param_column[ref.block];
+      if (std::any_of(pc.begin(), pc.end(), [&](std::size_t c) { return from[c] == npos; })) {
+        const std::vector<Cell> cells = study.blocks[ref.block].params(ref.local);
+        for (std::size_t i = 0; i < pc.size(); ++i)
+          if (from[pc[i]] == npos) rec.cells[pc[i]] = cells[i];
+      }
+      if (study.blocks[ref.block].context().placement && !std::isnan(identity_ik_error)) {
+        const auto& bm = study.blocks[ref.block].metrics();
+        for (std::size_t j = 0; j < bm.size(); ++j)
+          if (bm[j].name == "ik_error" && from[schema.metric_column[ref.block][j]] == npos)
+            rec.cells[schema.metric_column[ref.block][j]] = identity_ik_error;
+      }
       rec.cells[schema.run_id] = static_cast<std::int64_t>(id);
       rec.cells[schema.block] = study.blocks[study.locate(id).block].name();
       // the stored chunks, copied as they are (a format 2 file's histories are encoded at `compression`)
@@ -174,13 +193,28 @@ EditedResume begin_edited_resume(const Study& study, const StudySchema& schema, 
     }
   }
 
+  // Blocks that now place their task measure ik_error; a file without that column did not. The
+  // runs reused there are at the identity placement (the identity leaves it out otherwise): their
+  // ik_error is the task's as written, and when that is not 0 a fresh run would end out_of_reach,
+  // so they are computed again instead.
+  double identity_ik_error = std::numeric_limits<double>::quiet_NaN();
+  const bool file_has_ik_error = std::any_of(file.columns().begin(), file.columns().end(),
+                                             [](const ColumnSpec& c) { return c.name == "ik_error"; });
+  const bool placing = std::any_of(study.blocks.begin(), study.blocks.end(),
+                                   [](const Block& b) { return b.context().placement; });
+  if (placing && !file_has_ik_error) {
+    identity_ik_error = task_ik_error(study.task, study.robot, study.chain.get());
+    if (identity_ik_error > 0.0)
+      std::erase_if(pairs, [&](const auto& p) { return study.blocks[study.locate(p.first).block].context().placement; });
+  }
+
   r.staging = store::staging_path(out);
   store::StoreOptions so = options.store;
   so.overwrite = false;
   r.writer = store::ResultsWriter::create(r.staging, store_meta(study, options.histories), schema.columns,
                                           static_cast<std::int64_t>(study.run_count()), so);
   try {
-    copy_runs(file, study, schema, pairs, options.compression, *r.writer);
+    copy_runs(file, study, schema, pairs, options.compression, identity_ik_error, *r.writer);
   } catch (...) {
     r.writer.reset();
     store::remove_results_file(r.staging);

@@ -91,6 +91,7 @@ void append_u64(std::string& out, std::uint64_t v) {
 }
 
 void append_cell(std::string& out, const std::string& name, const Cell& c) {
+  if (identity_neutral(name, c)) return;  // a placement at the identity: as if the column were absent
   out += name;
   out.push_back('\0');
   if (const double* d = std::get_if<double>(&c)) {

@@ -24,7 +24,9 @@
 // Canonical bytes of a run (run_identity_bytes), hashed with SHA-256 into its 256-bit identity:
 //   "kinesweep-run-identity-1\n", the 32-byte context digest of the kind, the kind ("trajectory" | "ik"), "\n",
 //   then per parameter column, in byte order of the column names: the name, a NUL, a type tag and the
-//   value: 'f' + the f64's 8 IEEE bytes (little-endian, NaN payloads and -0 as they are), 'i' + the
+//   value (a cell schema/params.hpp identity_neutral calls neutral, a task placement parameter at the
+//   identity, is left out: a block that gains a placement axis keeps its runs' identities):
+//   'f' + the f64's 8 IEEE bytes (little-endian, NaN payloads and -0 as they are), 'i' + the
 //   i64's 8 bytes (little-endian), 's' + the length (u64, little-endian) and the UTF-8 bytes.
 // The context digest of a kind is SHA-256 of "key\0value\n" of the context fields of the kind's parts,
 // in run_context's order.

@@ -108,17 +108,26 @@ RankKey rank_key(double objective, double tie, std::uint64_t run) {
 }
 std::span<const std::string_view> statuses(BlockKind kind) {
   using ik::Status;
-  static const std::array<std::string_view, 11> trajectory{
+  static const std::array<std::string_view, 12> trajectory{
       to_string(RunStatus::ok),           to_string(RunStatus::unreachable_start), to_string(RunStatus::singular),
       to_string(RunStatus::diverged),     to_string(RunStatus::undersampled),      to_string(RunStatus::off_path),
       to_string(RunStatus::out_of_limits), to_string(RunStatus::max_evaluations),  to_string(RunStatus::not_converged),
-      to_string(RunStatus::infeasible),   to_string(RunStatus::singular_extension)};
+      to_string(RunStatus::infeasible),   to_string(RunStatus::singular_extension),
+      to_string(RunStatus::out_of_reach)};
   static const std::array<std::string_view, 9> ik{
       ik::to_string(Status::converged), ik::to_string(Status::stalled),  ik::to_string(Status::singular),
       ik::to_string(Status::max_iter),  ik::to_string(Status::cycle),    ik::to_string(Status::diverged),
       ik::to_string(Status::unsupported), ik::to_string(Status::no_solution), ik::to_string(Status::out_of_limits)};
   if (kind == BlockKind::trajectory) return trajectory;
   return ik;
+}
+
+bool identity_neutral(std::string_view name, const Cell& value) {
+  const double* v = std::get_if<double>(&value);
+  if (!v) return false;
+  if (name == "task_rotation" || name == "task_dx" || name == "task_dy" || name == "task_dz") return *v == 0.0;
+  if (name == "task_time_scale") return *v == 1.0;
+  return false;
 }
 
 RunSpec default_run(BlockKind kind, const KindContext& c) {
@@ -135,6 +144,7 @@ RunSpec default_run(BlockKind kind, const KindContext& c) {
   r.options.vertex_alpha.assign(c.path_vertices >= 1 ? c.path_vertices - 1 : 0, 0.0);
   r.inertia = c.inertia;
   if (c.robot.chain && !c.robot.planar) r.options.global.extension = Extension::joints;  // no planar chart
+  r.placement.measured = c.placement;
   return r;
 }
 

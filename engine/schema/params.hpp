@@ -47,6 +47,9 @@ struct KindContext {
   RobotShape robot;                                    ///< [robot]
   Eigen::Vector3d first_vertex{1.5, 1.5, 0.0};         ///< the path's first vertex [m] (chain IK's default target)
   bool path_global = false;  ///< the block runs global_spline: its parameters and metrics are columns
+  /// The block places its task (it names a task placement parameter: fixed, an axis or an [[optimize]]
+  /// variable): those parameters and the metric ik_error are columns, and its runs measure ik_error.
+  bool placement = false;
 };
 
 /// When a parameter has an effect: always (no controller), or only while another text parameter
@@ -133,6 +136,12 @@ std::span<const std::string_view> key_metrics(BlockKind kind);
 /// so a resume of the edited study reuses it. Trajectory: robot, task, settings. IK: robot, settings
 /// (its target is a parameter, its initial guess too; it reads no path).
 std::span<const std::string_view> context_parts(BlockKind kind);
+
+/// True when parameter `name` at value `value` leaves a run as it is without that parameter: the task
+/// placement parameters at the identity (task_rotation, task_dx, task_dy, task_dz = 0; task_time_scale
+/// = 1). A run's identity (runner/run_identity.hpp) leaves such cells out, so a block that gains a
+/// placement axis keeps the identities of the runs it had.
+bool identity_neutral(std::string_view name, const Cell& value);
 
 /// What an [[optimize]] block of a kind may minimise (a weighted sum of these): every numeric metric
 /// in `metrics` (the block's, per-joint columns for its robot), and "failure_rate" (the fraction of

@@ -15,6 +15,7 @@
 #include "model/arm.hpp"
 #include "model/chain.hpp"
 #include "store/record.hpp"
+#include "methods/base/task_placement.hpp"
 
 namespace ks {
 
@@ -33,6 +34,8 @@ struct TrajectoryRun {
   /// Chains: the initial guess of the start configuration, placed on the first vertex by an IK
   /// solve [rad or m per joint]. Unused by the seed's closed-form 3R (its start is analytic).
   VecN q0 = VecN::Zero(3);
+  /// The task's placement and time scale (identity by default: the study's task as written).
+  TaskPlacement placement;
 };
 
 /// The IK problems of seed 001 (SCARA, lengths in mm) and the planar 3R arm (m, rad).

@@ -84,6 +84,30 @@ void global_params(std::vector<ParamDef>& t, const RobotShape& robot) {
                            [](auto& r) -> auto& { return r.options.global.refinements; }, kGlobalOnly));
 }
 
+/// The task's placement and time scale (methods/base/task_placement.hpp): blocks that name one of them.
+void placement_params(std::vector<ParamDef>& t, const RobotShape& robot) {
+  const std::string about = robot.planar ? "the normal of the robot's plane (the base z for the xy plane)" : "the base z axis";
+  t.push_back(real<Run>("task_rotation", FileUnit::none, "rad", TaskPlacement::rotation_rule,
+                        "the whole task (path and orientations) rotated by this angle about " + about +
+                            " before the translation (seed 002 Eq. 2.21's beta; a multiple of pi/2 is exact)",
+                        [](auto& r) -> auto& { return r.placement.rotation; }));
+  const std::string along = robot.planar ? " of the robot's plane" : " of the base";
+  t.push_back(real<Run>("task_dx", FileUnit::none, "m", TaskPlacement::translation_rule,
+                        "the whole task translated along the x axis" + along + " (seed 002's delta_x)",
+                        [](auto& r) -> auto& { return r.placement.dx; }));
+  t.push_back(real<Run>("task_dy", FileUnit::none, "m", TaskPlacement::translation_rule,
+                        "the whole task translated along the y axis" + along + " (seed 002's delta_y)",
+                        [](auto& r) -> auto& { return r.placement.dy; }));
+  if (!robot.planar)  // a planar robot's task cannot leave its plane
+    t.push_back(real<Run>("task_dz", FileUnit::none, "m", TaskPlacement::translation_rule,
+                          "the whole task translated along the base z axis (seed 002's delta_z; spatial robots)",
+                          [](auto& r) -> auto& { return r.placement.dz; }));
+  t.push_back(real<Run>("task_time_scale", FileUnit::none, "", TaskPlacement::time_scale_rule,
+                        "every segment duration of the task multiplied by this (2: the same path in twice the "
+                        "time; dt is kept)",
+                        [](auto& r) -> auto& { return r.placement.time_scale; }));
+}
+
 /// The preset: sets the row's method, k, alpha1A and vertex orientations (explicit keys override).
 ParamDef preset_param() {
   ParamDef p;
@@ -190,6 +214,7 @@ std::vector<ParamDef> trajectory_params(const KindContext& ctx) {
                               " (placed on the first vertex by an IK solve)",
                           [j](auto& r) -> auto& { return r.q0[j]; }));
   }
+  if (ctx.placement) placement_params(t, robot);
   return t;
 }
 
@@ -317,6 +342,14 @@ std::vector<MetricDef> trajectory_metrics(const KindContext& ctx) {
                             "optimum (ratio within 1e-4 of the bound)",
                             false, [](const M& r) { return r.opt_active_limits; }));
   }
+  if (ctx.placement)
+    m.push_back(metric<M>("ik_error", CellType::f64, "m",
+                          "seed 002's inverse-kinematics error of the placed task (Eqs. 2.24-2.25): the sum over "
+                          "its vertices of the distance from each to the tip of the robot's position IK solution "
+                          "there, each counted when 1 mm or more (0: every vertex within reach; > 0: the run is "
+                          "out_of_reach)",
+                          true, [](const M& r) { return r.ik_error; })
+                    .labelled("IK error"));
   if (robot.chain) {
     m.push_back(metric<M>("max_q_limit_ratio", CellType::f64, "",
                           "max over samples and joints of |q - mid| / half range (1 = at a position limit; NaN: none)",

@@ -56,7 +56,9 @@ void Parser::read_axes(BlockDraft& d) {
     const std::string key(k->str());
     const ParamDef* info = d.info_of(key);
     if (!info) {
-      if (key == "vertex_alpha" && d.kind == BlockKind::trajectory)
+      if (const std::string why = placement_refusal(key, d.ctx.robot); d.kind == BlockKind::trajectory && !why.empty())
+        error(*k, why);
+      else if (key == "vertex_alpha" && d.kind == BlockKind::trajectory)
         error(*k, "vertex_alpha cannot be an axis as a whole; expected one axis per vertex: vertex_alpha_2 .. vertex_alpha_" +
                       std::to_string(d.nverts));
       else if (d.belongs_to_other(key))
@@ -64,7 +66,7 @@ void Parser::read_axes(BlockDraft& d) {
                       " parameter); expected " + d.a_kind + " parameter: " + join(d.param_names));
       else
         error(*k, "unknown axis '" + key + "' in " + d.kname + " block '" + d.spec.name + "'; expected " + d.a_kind +
-                      " parameter: " + join(d.param_names) + suggest_either(key, d.param_names, d.other, d.other_kname));
+                      " parameter: " + join(d.param_names) + suggest_either(key, with_placement(d.param_names, d), d.other, d.other_kname));
       continue;
     }
     if (auto a = parse_axis(*info, *k, *n, d.lhs_node, d.design)) d.drafts.push_back(std::move(*a));

@@ -39,6 +39,19 @@ bool names_global_spline(const toml::table& b) {
   return axes && is_global(axes->get("method"));
 }
 
+/// Whether the block names a task placement parameter: a key of the table, of its axes or (an
+/// [[optimize]] table) of its variables.
+bool names_placement(const toml::table& b) {
+  const auto any_in = [](const toml::node* n) {
+    const toml::table* t = n ? n->as_table() : nullptr;
+    if (!t) return false;
+    for (auto&& [k, v] : *t)
+      if (is_placement_param(k.str())) return true;
+    return false;
+  };
+  return any_in(&b) || any_in(b.get("axes")) || any_in(b.get("variables"));
+}
+
 /// Why `name` cannot name an HDF5 group (/landscapes/<block>, /optimizations/<name>); "" when it can.
 std::string hdf5_name_problem(const std::string& name) {
   if (name == "." || name == "..") return "is '" + name + "', which HDF5 paths reserve";
@@ -49,6 +62,24 @@ std::string hdf5_name_problem(const std::string& name) {
 }
 
 }  // namespace
+
+bool is_placement_param(std::string_view name) {
+  return name == "task_rotation" || name == "task_dx" || name == "task_dy" || name == "task_dz" ||
+         name == "task_time_scale";
+}
+
+std::vector<std::string> placement_names(const RobotShape& robot) {
+  std::vector<std::string> n{"task_rotation", "task_dx", "task_dy"};
+  if (!robot.planar) n.emplace_back("task_dz");
+  n.emplace_back("task_time_scale");
+  return n;
+}
+
+std::string placement_refusal(std::string_view name, const RobotShape& robot) {
+  if (name != "task_dz" || !robot.planar) return "";
+  return "task_dz would move the task out of the plane the planar robot moves in; expected task_dx, task_dy, "
+         "task_rotation (about the plane's normal) or task_time_scale";
+}
 
 const ParamDef* BlockDraft::info_of(std::string_view n) const {
   for (const auto& i : infos)
@@ -71,6 +102,7 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
   d.scara = !s.chain;  // an IK block without a problem: the SCARA, or the study's chain's position problem
   d.ctx = block_context(s, d.scara);
   d.ctx.path_global = names_global_spline(b);
+  d.ctx.placement = names_placement(b);
 
   read_block_name(d, names);
   if (!read_block_kind(d)) return std::nullopt;
@@ -87,6 +119,7 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
   if (!d.lhs_group.empty()) d.spec.groups.push_back(d.lhs_group);  // after the zip groups
   d.ctx = block_context(s, d.scara);
   d.ctx.path_global = names_global_spline(d.table);
+  d.ctx.placement = names_placement(d.table);
   check_robot_supports(d, s);
   reject_ineffective_axes(d);
   return finish_block(d, errors_before);
@@ -148,6 +181,13 @@ bool Parser::read_block_kind(BlockDraft& d) {
   return true;
 }
 
+std::vector<std::string> with_placement(std::vector<std::string> names, const BlockDraft& d) {
+  if (d.kind != BlockKind::trajectory) return names;
+  for (std::string& n : placement_names(d.ctx.robot))
+    if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(std::move(n));
+  return names;
+}
+
 void Parser::check_block_keys(const BlockDraft& d) {
   std::vector<std::string> block_keys{"name", "kind", "axes", "zip", "lhs", "saltelli"};
   if (d.optimize)
@@ -158,6 +198,11 @@ void Parser::check_block_keys(const BlockDraft& d) {
   for (auto&& [k, n] : ordered(d.table)) {
     const std::string key(k->str());
     if (std::find(block_keys.begin(), block_keys.end(), key) != block_keys.end()) continue;
+    if (d.kind == BlockKind::trajectory)
+      if (const std::string why = placement_refusal(key, d.ctx.robot); !why.empty()) {
+        error(*k, why);
+        continue;
+      }
     if (d.belongs_to_other(key))
       error(*k, "parameter '" + key + "' does not belong to " + d.a_kind + " block (it is " + d.a_other +
                     " parameter); expected " + d.a_kind + " parameter: " + join(d.param_names));
@@ -165,7 +210,7 @@ void Parser::check_block_keys(const BlockDraft& d) {
       error(*k, "unknown key '" + key + "' in " + d.kname + " block '" + d.spec.name +
                     "'; expected name, kind, axes, zip, lhs, saltelli" +
                     (d.kind == BlockKind::trajectory ? ", vertex_alpha" : "") + " or " + d.a_kind +
-                    " parameter: " + join(d.param_names) + suggest_either(key, block_keys, d.other, d.other_kname));
+                    " parameter: " + join(d.param_names) + suggest_either(key, with_placement(block_keys, d), d.other, d.other_kname));
   }
 }
 

@@ -158,9 +158,17 @@ void Parser::parse_optimizations(const toml::table& root, Study& s) {
         const ParamDef* info = nullptr;
         for (const auto& in : infos)
           if (in.name == params.front()) info = &in;
+        if (!info && kind == BlockKind::trajectory && !placement_refusal(key, s.robot_shape()).empty()) {
+          error(*k, placement_refusal(key, s.robot_shape()));
+          continue;
+        }
         if (!info) {
+          std::vector<std::string> candidates = f64_names;
+          if (kind == BlockKind::trajectory)
+            for (std::string& n : placement_names(s.robot_shape()))
+              if (std::find(candidates.begin(), candidates.end(), n) == candidates.end()) candidates.push_back(n);
           error(*k, "unknown variable '" + key + "' for " + std::string(to_string(kind)) + " runs; expected a numeric parameter: " +
-                        join(f64_names) + suggest(key, f64_names));
+                        join(f64_names) + suggest(key, candidates));
           continue;
         }
         if (info->type != CellType::f64) {

@@ -28,6 +28,16 @@ namespace ks::study_parse {
 /// path, and a full history holds 16 doubles per sample.
 constexpr double kMaxSamples = 1e7;
 
+/// True for the task placement parameters' names (task_rotation, task_dx, task_dy, task_dz,
+/// task_time_scale: schema/trajectory_table.cpp).
+bool is_placement_param(std::string_view name);
+/// The placement parameters a trajectory block of `robot` may name (task_dz: spatial robots only), for
+/// did-you-mean suggestions in blocks that name none yet.
+std::vector<std::string> placement_names(const RobotShape& robot);
+/// Why `name` cannot be a parameter of a trajectory block of `robot` though it is a placement
+/// parameter ("" when nothing refuses it): task_dz for a planar robot, whose task stays in its plane.
+std::string placement_refusal(std::string_view name, const RobotShape& robot);
+
 /// A place in a study's text where toml++ 3.3 would reach undefined behaviour (see toml_prescan.cpp).
 struct TomlHazard {
   int line = 1, column = 1;
@@ -84,6 +94,9 @@ struct BlockDraft {
   /// True for a parameter of the other kind (and vertex_alpha in an IK block).
   bool belongs_to_other(std::string_view n) const;
 };
+
+/// `names` and the placement parameters a trajectory block of the draft may name (did-you-mean candidates).
+std::vector<std::string> with_placement(std::vector<std::string> names, const BlockDraft& d);
 
 class Parser : public ParserCore {
  public:

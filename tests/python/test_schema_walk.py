@@ -38,6 +38,12 @@ kind = "ik"
 name = "g"
 kind = "trajectory"
 method = "global_spline"
+
+# the task placement's columns (and ik_error) exist in blocks that name one of them
+[[block]]
+name = "pl"
+kind = "trajectory"
+task_rotation = 0.0
 """,
     "walk_planar": """
 [study]
@@ -54,6 +60,7 @@ kind = "ik"
 problem = "planar3r_position"
 """}
 BLOCK_FAMILY = {("walk", "t"): ("trajectory", ""), ("walk", "s"): ("ik", "scara"), ("walk", "g"): ("trajectory", ""),
+                ("walk", "pl"): ("trajectory", ""),
                 ("walk_planar", "t"): ("trajectory", ""), ("walk_planar", "p"): ("ik", "planar3r")}
 
 
@@ -96,10 +103,14 @@ class SchemaWalk(TempDirTest):
             if not rows:
                 continue
             global_rows = [i for i in rows if blocks[i] == "g"]
+            placement_rows = [i for i in rows if blocks[i] == "pl"]
             for p in table["params"]:
                 only_global = p.get("effect_when") == ["global_spline"]
                 if only_global and not global_rows:
                     continue  # a study without global_spline blocks has none of its columns
+                only_placement = p["name"].startswith("task_")
+                if only_placement and not placement_rows:
+                    continue  # nor one without a block that places its task the placement's
                 with self.subTest(study=name, kind=kind, family=family, param=p["name"]):
                     ds = runs[p["name"]]
                     self.assertEqual(text(ds.attrs["role"]), "parameter")
@@ -108,7 +119,8 @@ class SchemaWalk(TempDirTest):
                     self.assertIn(p["description"], text(ds.attrs["description"]))
                     if p["name"] == "problem":
                         continue  # the planar block names its problem
-                    stored, default = runs_column(ds)[(global_rows if only_global else rows)[0]], p["default"]
+                    first = (global_rows if only_global else placement_rows if only_placement else rows)[0]
+                    stored, default = runs_column(ds)[first], p["default"]
                     if p["type"] == "str":
                         self.assertEqual(stored, default)
                     elif default is None:
@@ -117,6 +129,8 @@ class SchemaWalk(TempDirTest):
                         self.assertEqual(float(stored), float(default))
             for m in table["metrics"]:
                 if m["name"].startswith("opt_") and not global_rows:
+                    continue
+                if m["name"] == "ik_error" and not placement_rows:
                     continue
                 with self.subTest(study=name, kind=kind, metric=m["name"]):
                     ds = runs[m["name"]]

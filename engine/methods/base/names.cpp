@@ -13,7 +13,7 @@ constexpr NameTable<TrajectoryMethod, 4> kMethods{{{TrajectoryMethod::local_weig
                                                {TrajectoryMethod::global_spline, "global_spline"}}};
 constexpr NameTable<Integrator, 2> kIntegrators{
     {{Integrator::semi_implicit_euler, "semi_implicit_euler"}, {Integrator::rk4, "rk4"}}};
-constexpr NameTable<RunStatus, 12> kStatuses{{{RunStatus::ok, "ok"},
+constexpr NameTable<RunStatus, 13> kStatuses{{{RunStatus::ok, "ok"},
                                          {RunStatus::unreachable_start, "unreachable_start"},
                                          {RunStatus::singular, "singular"},
                                          {RunStatus::diverged, "diverged"},
@@ -24,6 +24,7 @@ constexpr NameTable<RunStatus, 12> kStatuses{{{RunStatus::ok, "ok"},
                                          {RunStatus::not_converged, "not_converged"},
                                          {RunStatus::infeasible, "infeasible"},
                                          {RunStatus::singular_extension, "singular_extension"},
+                                         {RunStatus::out_of_reach, "out_of_reach"},
                                          {RunStatus::interrupted, "interrupted"}}};
 constexpr NameTable<GlobalObjective, 4> kObjectives{{{GlobalObjective::E, "E"},
                                                      {GlobalObjective::E_M, "E_M"},

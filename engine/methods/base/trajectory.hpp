@@ -41,7 +41,8 @@ enum class RunStatus {
   diverged,           ///< a non-finite value, or a torque above TrajectoryOptions::torque_bound
   /// the sampling is too coarse for the motion: dt leaves fewer than kMinSamplesPerSegment samples on a
   /// segment (nothing simulated), or (global_spline) the trajectory between the samples departs from the
-  /// sampled figures beyond verify_tolerance (the metrics kept, the dense figures beside them)
+  /// sampled figures beyond verify_tolerance (the metrics kept, the dense figures beside them); a task
+  /// time scale whose path would take more than 1e7 samples at dt ends so too (nothing simulated)
   undersampled,
   off_path,           ///< the tip left the path by more than tracking_bound (or orientation_bound)
   out_of_limits,      ///< a joint position, velocity or effort went beyond the robot's limits
@@ -50,6 +51,9 @@ enum class RunStatus {
   not_converged,       ///< the optimiser stopped without meeting its tolerance (NLopt failure)
   infeasible,          ///< alpha(t) puts the wrist out of reach at a sample: the run ends there
   singular_extension,  ///< the extended task [tip; alpha] is singular at a sample: the run ends there
+  /// a placed task (TaskPlacement::measured) has a vertex the robot cannot reach: seed 002's inverse-
+  /// kinematics error (TrajectoryMetrics::ik_error) is not 0; nothing simulated, every other metric NaN
+  out_of_reach,
   /// global_spline: the process was asked to stop (SIGINT, SIGTERM; set_optimiser_stop_flag in
   /// methods/path_global/slsqp.hpp) during the optimisation, which ended at once; metrics NaN. Never
   /// stored: the run is not written, and `run --resume` computes it.
@@ -138,6 +142,9 @@ struct TrajectoryOptions {
   bool IsValid(std::string* why = nullptr) const;
 };
 
+/// Seed 002's epsilon of Eq. 2.24 (its Section 7.3 value): an IK residual below this counts as 0 [m].
+inline constexpr double kIkErrorEpsilon = 1e-3;
+
 /// Room in TrajectoryMetrics for the metrics of methods/metrics/sample_metrics.hpp's table.
 inline constexpr int kMaxSampleMetrics = 8;
 
@@ -165,6 +172,10 @@ struct TrajectoryMetrics {
   double E_force = std::numeric_limits<double>::quiet_NaN();
   double final_alpha = 0.0;           ///< alpha at the last sample [rad]
   double stop_time = 0.0;             ///< time of the last sample computed [s]
+  /// Seed 002's inverse-kinematics error (Eqs. 2.24-2.25) of a placed task: over the task's vertices,
+  /// the distance from each to the tip of the robot's position IK solution there, counted when it is
+  /// kIkErrorEpsilon or more [m]; NaN when not measured (TaskPlacement::measured)
+  double ik_error = std::numeric_limits<double>::quiet_NaN();
   /// global_spline (NaN for the other methods): the objective at the start and at the end (its
   /// units: see GlobalObjective), objective evaluations made, and the infinity norm of the objective's
   /// projected gradient at the end [objective units per rad]
