@@ -1,16 +1,13 @@
 // kinesweep: the command-line front end (run, table4, schema, robot; info, query and sensitivity read
 // results files).
 #include <malloc.h>
-#include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <cerrno>
-#include <cstring>
-#include <filesystem>
 #include <iostream>
 
 #include "cli/compare_command.hpp"
 #include "cli/info_command.hpp"
+#include "cli/mpi_program.hpp"
 #include "cli/query_command.hpp"
 #include "cli/query_util.hpp"
 #include "cli/robot_command.hpp"
@@ -149,25 +146,6 @@ CompareArgs& add_compare_command(CLI::App& app) {
 
 }  // namespace ks::cli
 
-#ifdef KINESWEEP_MPI_PROGRAM
-namespace {
-// This program does not link MPI (its libraries would be loaded at every start, whatever the
-// command): a run that an MPI launcher started continues in KINESWEEP_MPI_PROGRAM, the same program
-// with MPI, from this program's directory. exec keeps the process (its id, its environment, its
-// connection to the launcher) and the arguments, argv[0] included.
-int exec_mpi_program(char** argv) {
-  std::error_code ec;
-  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  const std::filesystem::path program = (ec ? std::filesystem::path(argv[0]).parent_path() : self.parent_path()) /
-                                        KINESWEEP_MPI_PROGRAM;
-  execv(program.c_str(), argv);
-  std::cerr << "Error: started by an MPI launcher, but " << program.string()
-            << " (kinesweep with MPI) cannot be run: " << std::strerror(errno) << '\n';
-  return 1;
-}
-}  // namespace
-#endif
-
 int main(int argc, char** argv) {
   // A sweep's histories travel as buffers of a few hundred KiB, made by the workers and freed by
   // the writer thread. glibc's defaults return memory to the kernel once 128 KiB lie free at the
@@ -203,9 +181,8 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (app.got_subcommand("run")) {
-#ifdef KINESWEEP_MPI_PROGRAM
-    if (ks::launched_under_mpi()) return exec_mpi_program(argv);
-#endif
+    // a kinesweep without MPI linked leaves a run an MPI launcher started to the one with MPI
+    if (ks::cli::has_mpi_program() && ks::launched_under_mpi()) return ks::cli::exec_mpi_program(argv);
     return ks::cli::run_command(run);
   }
   if (app.got_subcommand("info")) return ks::cli::info_command(info);
