@@ -7,6 +7,7 @@
 
 #include "cli/compare_command.hpp"
 #include "cli/info_command.hpp"
+#include "cli/mpi_program.hpp"
 #include "cli/query_command.hpp"
 #include "cli/query_util.hpp"
 #include "cli/robot_command.hpp"
@@ -15,6 +16,7 @@
 #include "cli/sensitivity_command.hpp"
 #include "cli/table4.hpp"
 #include "common/shell_word.hpp"
+#include "runner/mpi_launch.hpp"
 #include "store/store.hpp"
 
 #include "git_commit.hpp"  // KINESWEEP_GIT_COMMIT, generated at build time (engine/package/git_commit.cmake)
@@ -178,7 +180,11 @@ int main(int argc, char** argv) {
     ks::print_table4(std::cout);
     return 0;
   }
-  if (app.got_subcommand("run")) return ks::cli::run_command(run);
+  if (app.got_subcommand("run")) {
+    // a kinesweep without MPI linked leaves a run an MPI launcher started to the one with MPI
+    if (ks::cli::has_mpi_program() && ks::launched_under_mpi()) return ks::cli::exec_mpi_program(argv);
+    return ks::cli::run_command(run);
+  }
   if (app.got_subcommand("info")) return ks::cli::info_command(info);
   if (app.got_subcommand("query")) return ks::cli::query_command(query);
   if (app.got_subcommand("schema")) return ks::cli::schema_command(schema);

@@ -1,5 +1,5 @@
 # Install rules (included from engine/CMakeLists.txt, after the engine's targets and the CLI).
-#   bin/kinesweep
+#   bin/kinesweep (and bin/kinesweep-mpi with MPI)
 #   lib/libks_*.a, include/kinesweep/<part>/*.hpp, lib/cmake/kinesweep/ (find_package(kinesweep))
 #   share/kinesweep/studies/, share/doc/kinesweep/analysis.md
 #   lib/python3.X/dist-packages/kinesweep/ (the Python package: `python3 -m kinesweep.plot_cases FILE`)
@@ -12,6 +12,9 @@ foreach(part IN LISTS KS_PARTS ITEMS ks_model ks_hdf5)
   set_target_properties(${part} PROPERTIES EXPORT_NAME ${short})
 endforeach()
 install(TARGETS kinesweep RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+if(TARGET kinesweep-mpi)  # a run started by an MPI launcher continues in it (engine/cli/main.cpp)
+  install(TARGETS kinesweep-mpi RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+endif()
 install(TARGETS kinesweep_engine ks_model ks_hdf5 ${KS_PARTS} EXPORT kinesweepTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/kinesweep

@@ -34,11 +34,6 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using namespace ks::mpi;
 
-bool env_set(const char* name) {
-  const char* v = std::getenv(name);
-  return v && *v;
-}
-
 
 /// Rank 0 after the sweep: final file (or a new one) + every shard -> the final file, in run-id
 /// order; then landscapes via run_sweep (which computes nothing, every run being done); then the
@@ -395,11 +390,6 @@ SweepResult MpiBackend::sweep(const Study& study, const StudySchema& schema, con
 }
 
 }  // namespace
-
-bool launched_under_mpi() {
-  return env_set("OMPI_COMM_WORLD_SIZE") || env_set("PMIX_RANK") || env_set("PMI_RANK") || env_set("PMI_SIZE") ||
-         env_set("MPI_LOCALNRANKS");
-}
 
 std::string shard_path(const std::string& output, int rank) { return output + ".rank" + std::to_string(rank) + ".h5"; }
 

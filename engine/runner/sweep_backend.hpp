@@ -8,6 +8,7 @@
 #include <ostream>
 #include <string>
 
+#include "runner/mpi_launch.hpp"
 #include "runner/run_request.hpp"
 #include "schema/history_arrays.hpp"
 #include "store/store.hpp"
@@ -53,9 +54,6 @@ std::unique_ptr<SweepBackend> local_backend();
 #ifdef KINESWEEP_HAVE_MPI
 /// MPI ranks (MPI_Init here, MPI_Finalize in finish()).
 std::unique_ptr<SweepBackend> mpi_backend();
-/// True when an MPI launcher (mpirun/mpiexec of Open MPI or MPICH, srun with PMI/PMIx) started this
-/// process, judged from its environment (no MPI call).
-bool launched_under_mpi();
 #endif
 
 /// A results file opened for a sweep: its writer, and what it already held (resume).

@@ -81,7 +81,7 @@ def rank_pid(mpirun_pid, rank):
                 comm = f.read().strip()
         except OSError:
             continue
-        if comm == "kinesweep" and f"OMPI_COMM_WORLD_RANK={rank}".encode() in env:
+        if comm in ("kinesweep", "kinesweep-mpi") and f"OMPI_COMM_WORLD_RANK={rank}".encode() in env:
             return pid
     return None
 
