@@ -27,7 +27,8 @@ MARKER = re.compile(r"^<!-- kinesweep compare (\S+)(.*?) -->\s*$")
 
 def verdict_blocks(path):
     """(line number, study, args, block text) of every marked block of a markdown file."""
-    lines = open(path, encoding="utf-8").read().split("\n")
+    with open(path, encoding="utf-8") as f:
+        lines = f.read().split("\n")
     out = []
     for i, line in enumerate(lines):
         m = MARKER.match(line)
