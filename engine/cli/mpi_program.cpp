@@ -21,7 +21,8 @@ int exec_mpi_program(char** argv) {
       (ec ? std::filesystem::path(argv[0]).parent_path() : self.parent_path()) / KINESWEEP_MPI_PROGRAM;
   execv(program.c_str(), argv);
   std::cerr << "Error: started by an MPI launcher, but " << program.string()
-            << " (kinesweep with MPI) cannot be run: " << std::strerror(errno) << '\n';
+            << " (kinesweep with MPI) cannot be run: " << std::strerror(errno)
+            << " (build it: cmake --build BUILD_DIR --target " KINESWEEP_MPI_PROGRAM ")\n";
   return 1;
 }
 #else
