@@ -24,6 +24,7 @@
 
 #include "common/human_units.hpp"
 #include "methods/closed_form/lanes.hpp"
+#include "runner/execute.hpp"
 #include "runner/landscape.hpp"
 #include "runner/study_meta.hpp"
 #include "store/store.hpp"
@@ -51,9 +52,10 @@ std::vector<std::uint64_t> spread_indices(std::uint64_t n, std::size_t max) {
 
 /// `picks` as batches of up to `lanes` runs that can share SIMD lanes, as the sweep's consecutive
 /// runs mostly can: each batch opens with the next pick not taken, in the spread order, and takes the
-/// later picks lane-compatible with it (same inertia form and lane options; other runs: one a batch
-/// slot as in the sweep, which runs them one at a time).
-std::vector<std::vector<std::uint64_t>> lane_batches(const Block& block, const std::vector<std::uint64_t>& picks,
+/// later picks lane-compatible with it (same inertia form and lane options); a run that never shares
+/// lanes (execute.hpp lane_run: the sweep's rule) is a batch of its own.
+std::vector<std::vector<std::uint64_t>> lane_batches(const Scenario& scenario, const Block& block,
+                                                     const std::vector<std::uint64_t>& picks,
                                                      int lanes) {
   std::vector<RunSpec> runs;
   for (std::uint64_t p : picks) runs.push_back(block.run(p));
@@ -62,15 +64,15 @@ std::vector<std::vector<std::uint64_t>> lane_batches(const Block& block, const s
   const std::size_t width = static_cast<std::size_t>(std::max(1, lanes));
   for (std::size_t i = 0; i < picks.size(); ++i) {
     if (used[i]) continue;
-    const auto* a = std::get_if<TrajectoryRun>(&runs[i]);
-    // a path-global run is one optimisation, never in lanes: one a batch, so that a block of runs of
-    // minutes each is not sampled whole before its first one is timed
-    const std::size_t cap = a && a->options.method == TrajectoryMethod::global_spline ? 1 : width;
+    const auto* a = lane_run(scenario, runs[i]);
+    // a run that never shares lanes (a chain's, a path-global one) is a batch of its own, so that a
+    // block of runs of minutes each is not sampled whole before its first one is timed
+    const std::size_t cap = a ? width : 1;
     out.emplace_back();
     for (std::size_t j = i; j < picks.size() && out.back().size() < cap; ++j) {
-      const auto* b = std::get_if<TrajectoryRun>(&runs[j]);
+      const auto* b = lane_run(scenario, runs[j]);
       const bool shares = a && b && b->inertia == a->inertia && lane_compatible(a->options, b->options);
-      if (used[j] || (j != i && a && !shares)) continue;  // (runs without lanes: any, in order)
+      if (used[j] || (j != i && !shares)) continue;
       used[j] = 1;
       out.back().push_back(picks[j]);
     }
@@ -182,7 +184,7 @@ class DryRunBackend final : public SweepBackend {
       if (shape.empty()) out << " 1";
       for (std::size_t d = 0; d < shape.size(); ++d) out << (d ? " x " : " ") << shape[d];
       out << '\n';
-      for (auto batch : lane_batches(block, spread_indices(block.run_count(), 64), lanes)) {
+      for (auto batch : lane_batches(Scenario::of(study), block, spread_indices(block.run_count(), 64), lanes)) {
         for (std::uint64_t& local : batch) local += study.first_run(b);
         std::sort(batch.begin(), batch.end());
         total_samples += batch.size();

@@ -191,15 +191,6 @@ RunOutcome trajectory_outcome(const TrajectoryMetrics& metrics, const Trajectory
   return out;
 }
 
-/// Whether a run may share SIMD lanes: a closed-form 3R trajectory run that samples its path, on the
-/// study's task as written (a placed task's runs run one at a time).
-const TrajectoryRun* lane_run(const Scenario& sc, const RunSpec& run) {
-  const auto* t = std::get_if<TrajectoryRun>(&run);
-  return t && !sc.chain && t->options.method != TrajectoryMethod::global_spline && t->placement.identity() &&
-                 !t->placement.measured && samples_path(sc.task->durations, t->options.dt)
-             ? t
-             : nullptr;
-}
 
 RunOutcome run_trajectory(const Scenario& sc, const TrajectoryRun& run, int stride, RunWorkspace::Impl& ws) {
   const int joints = sc.chain ? sc.chain->dof() : 3;
@@ -334,6 +325,15 @@ RunOutcome run_ik(const Scenario& sc, const IkRun& run, int stride, RunWorkspace
 }
 
 }  // namespace
+
+// (a placed task's runs run one at a time)
+const TrajectoryRun* lane_run(const Scenario& sc, const RunSpec& run) {
+  const auto* t = std::get_if<TrajectoryRun>(&run);
+  return t && !sc.chain && t->options.method != TrajectoryMethod::global_spline && t->placement.identity() &&
+                 !t->placement.measured && samples_path(sc.task->durations, t->options.dt)
+             ? t
+             : nullptr;
+}
 
 RunOutcome execute(const Scenario& scenario, const RunSpec& run, int history_stride, RunWorkspace& workspace) {
   if (const auto* t = std::get_if<TrajectoryRun>(&run))

@@ -36,6 +36,10 @@ class RunWorkspace {
 /// iteration (ik). Never throws on bad numbers: trouble is the outcome's status.
 RunOutcome execute(const Scenario& scenario, const RunSpec& run, int history_stride, RunWorkspace& workspace);
 
+/// The run itself when it may share SIMD lanes with others (a closed-form 3R trajectory run that
+/// samples its path, on the study's task as written), else null: execute_batch's rule.
+const TrajectoryRun* lane_run(const Scenario& scenario, const RunSpec& run);
+
 /// Execute runs[0..n) into out[0..n), wall_s[i] the seconds spent on run i (runs that share lanes
 /// share their time equally). Closed-form 3R trajectory runs that can share SIMD lanes (the same
 /// inertia form, dt, method and integrator: lane_compatible) run up to `lanes` at a time
