@@ -36,11 +36,21 @@ struct Evaluator {
   BlockKind kind = BlockKind::trajectory;
   std::vector<RunSpec> set;                  // the evaluation set's runs
   std::vector<const ParamDef*> vars;         // the variables' table entries
-  std::vector<std::pair<const MetricDef*, double>> terms;  // metric (nullptr: failure_rate), weight
+  /// One objective term: scale * metric (or scale / metric); scale = weight / reference value.
+  struct Term {
+    const MetricDef* metric = nullptr;  // nullptr: failure_rate
+    double scale = 1.0;
+    bool reciprocal = false;
+    double of(double m) const { return reciprocal ? scale * (1.0 / m) : scale * m; }
+  };
+  std::vector<Term> terms;
   const MetricDef* stop_time = nullptr;      // trajectory: penalty of runs that stopped early
   const MetricDef* ik_error = nullptr;       // trajectory, a placed task: penalty of runs out of reach
   double duration = 0.0;
   bool reach_varies = false;
+  /// A normalised objective: each term's metric and the design at the reference, as stored in
+  /// /optimizations/<name> ("reference_<metric>", "reference_x_<variable>").
+  std::vector<std::pair<std::string, double>> references;
   tbb::enumerable_thread_specific<RunWorkspace> workspaces;
 
   RunSpec run_at(std::size_t run, std::span<const double> x) const {
@@ -74,7 +84,7 @@ struct Evaluator {
     double v = 0.0;
     if (kind == BlockKind::trajectory) {
       if (good) {
-        for (const auto& [m, w] : terms) v += m ? w * metric(*m) : 0.0;  // failure_rate: 0 for a good run
+        for (const Term& t : terms) v += t.metric ? t.of(metric(*t.metric)) : 0.0;  // failure_rate: 0 for a good run
       } else if (status == to_string(RunStatus::unreachable_start)) {
         v = ob->penalty * (2.0 + std::max(0.0, margin_of(r)));
       } else if (status == to_string(RunStatus::out_of_reach) && ik_error) {
@@ -87,10 +97,10 @@ struct Evaluator {
         v = ob->penalty * (1.0 + std::clamp(1.0 - (std::isfinite(t) ? t : 0.0) / d, 0.0, 1.0));
       }
     } else {
-      for (const auto& [m, w] : terms) {
-        if (!m) v += w * (good ? 0.0 : 1.0);
-        else if (m->if_failed && !good) v += w * m->if_failed(r);
-        else v += w * metric(*m);
+      for (const Term& t : terms) {
+        if (!t.metric) v += t.scale * (good ? 0.0 : 1.0);
+        else if (t.metric->if_failed && !good) v += t.of(t.metric->if_failed(r));
+        else v += t.of(metric(*t.metric));
       }
     }
     if (!std::isfinite(v)) v = ob->penalty * 3.0;
@@ -129,9 +139,20 @@ struct Evaluator {
   }
 };
 
+std::string fmt_x(const std::vector<std::string>& names, const std::vector<std::string>& units, std::span<const double> x) {
+  std::ostringstream os;
+  os.precision(6);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (i) os << ", ";
+    if (units[i] == "rad") os << names[i] << " = " << x[i] * kRad2Deg << " deg";
+    else os << names[i] << " = " << x[i] << (units[i].empty() ? "" : " " + units[i]);
+  }
+  return os.str();
+}
+
 /// The evaluator of optimisation `index` over the runs of `block` (its base block, or the
 /// polish_from block whose cells are ranked).
-std::shared_ptr<Evaluator> make_evaluator(const Study& study, std::size_t index, const Block& block) {
+std::shared_ptr<Evaluator> make_plain_evaluator(const Study& study, std::size_t index, const Block& block) {
   const OptimizeBlock& ob = study.optimizations.at(index);
   auto e = std::make_shared<Evaluator>();
   e->study = &study;
@@ -152,10 +173,10 @@ std::shared_ptr<Evaluator> make_evaluator(const Study& study, std::size_t index,
       if (m.name == n) return &m;
     return nullptr;
   };
-  for (const auto& [m, w] : ob.objective) {
-    if (m == kFailureRate) e->terms.emplace_back(nullptr, w);
-    else if (const MetricDef* d = metric(m)) e->terms.emplace_back(d, w);
-    else throw std::invalid_argument("optimization " + ob.name + ": no metric " + m);
+  for (const ObjectiveTerm& t : ob.objective) {
+    if (t.metric == kFailureRate) e->terms.push_back({nullptr, t.weight, false});
+    else if (const MetricDef* d = metric(t.metric)) e->terms.push_back({d, t.weight, t.reciprocal});
+    else throw std::invalid_argument("optimization " + ob.name + ": no metric " + t.metric);
   }
   e->stop_time = metric("stop_time");
   e->ik_error = metric("ik_error");
@@ -164,15 +185,61 @@ std::shared_ptr<Evaluator> make_evaluator(const Study& study, std::size_t index,
   return e;
 }
 
-std::string fmt_x(const std::vector<std::string>& names, const std::vector<std::string>& units, std::span<const double> x) {
-  std::ostringstream os;
-  os.precision(6);
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    if (i) os << ", ";
-    if (units[i] == "rad") os << names[i] << " = " << x[i] * kRad2Deg << " deg";
-    else os << names[i] << " = " << x[i] << (units[i].empty() ? "" : " " + units[i]);
+/// The reference design of a normalised objective [stored units]: each variable at the value the
+/// reference names, else at its start (the file's start, else the block's value).
+std::vector<double> reference_x(const OptimizeBlock& ob, const Evaluator& base) {
+  std::vector<double> x;
+  for (std::size_t i = 0; i < ob.variables.size(); ++i) {
+    const OptimizeVariable& v = ob.variables[i];
+    double value = std::isnan(v.start) ? cell_number(base.vars[i]->get(base.set.front())) : v.start;
+    for (const auto& [name, d] : ob.reference.design)
+      if (name == v.name) value = d;
+    x.push_back(value);
   }
-  return os.str();
+  return x;
+}
+
+/// The evaluator of optimisation `index` over `block`, its terms divided by their reference values
+/// when the objective is normalised (seed 002 Eq. 7.6: f1^0 / f1, f6 / f6^0): each term's value
+/// averaged over the base block's runs at the reference design. Throws std::runtime_error when a
+/// reference run is not good or a term's reference value is 0 or not finite.
+std::shared_ptr<Evaluator> make_evaluator(const Study& study, std::size_t index, const Block& block) {
+  auto e = make_plain_evaluator(study, index, block);
+  const OptimizeBlock& ob = study.optimizations.at(index);
+  if (!ob.reference.active()) return e;
+  auto base = &block == &ob.block() ? e : make_plain_evaluator(study, index, ob.block());
+  const std::vector<double> x = reference_x(ob, *base);
+  auto where = [&] {
+    std::vector<std::string> names, units;
+    for (const auto& v : ob.variables) names.push_back(v.name), units.push_back(v.unit);
+    return fmt_x(names, units, x);
+  };
+  std::vector<double> raw(e->terms.size(), 0.0);  // each term without its weight: metric or 1 / metric
+  for (std::size_t r = 0; r < base->set.size(); ++r) {
+    const RunOutcome o = execute(base->scenario, base->run_at(r, x), 0, base->workspaces.local());
+    if (!o.good())
+      throw std::runtime_error("optimization " + ob.name + ": the reference design (" + where() + ") ended " +
+                               std::string(o.status()) + " (run " + std::to_string(r + 1) + " of " +
+                               std::to_string(base->set.size()) +
+                               "); a normalised objective needs a good reference run: expected another reference");
+    for (std::size_t j = 0; j < e->terms.size(); ++j) {
+      const double m = cell_number(e->terms[j].metric->get(o));
+      raw[j] += e->terms[j].reciprocal ? 1.0 / m : m;
+    }
+  }
+  for (std::size_t j = 0; j < e->terms.size(); ++j) {
+    Evaluator::Term& t = e->terms[j];
+    const double ref = raw[j] / static_cast<double>(base->set.size());
+    const double metric = t.reciprocal ? 1.0 / ref : ref;
+    if (!std::isfinite(ref) || ref == 0.0 || !std::isfinite(metric))
+      throw std::runtime_error("optimization " + ob.name + ": " + t.metric->name + " at the reference design (" +
+                               where() + ") is " + [&] { std::ostringstream os; os.precision(6); os << metric; return os.str(); }() +
+                               "; a normalised objective divides by it: expected a reference where it is finite and nonzero");
+    e->references.emplace_back("reference_" + t.metric->name, metric);
+    t.scale /= ref;  // weight / (the term at the reference)
+  }
+  for (std::size_t i = 0; i < x.size(); ++i) e->references.emplace_back("reference_x_" + ob.variables[i].name, x[i]);
+  return e;
 }
 
 std::string stage_text(const char* what, const opt::StageOptions& s) {
@@ -240,8 +307,8 @@ std::vector<opt::Start> best_cells(const Study& study, std::size_t index, const 
       for (std::uint64_t r = 0; all && r < n; ++r) all = done[first + r] != 0;
       if (all) {
         std::map<const MetricDef*, std::vector<double>> column;  // the metrics the objective reads
-        for (const auto& [m, w] : e->terms)
-          if (m) column[m] = options.cells->read_f64(m->name);
+        for (const auto& t : e->terms)
+          if (t.metric) column[t.metric] = options.cells->read_f64(t.metric->name);
         if (e->stop_time) column[e->stop_time] = options.cells->read_f64(e->stop_time->name);
         const auto st = options.cells->read_str("status");
         const std::string good(statuses(e->kind).front());
@@ -389,6 +456,8 @@ OptimizeResult run_optimization(const Study& study, std::size_t index, const Opt
       r.reference.emplace_back("objective_at_thesis_x", res.value_at_thesis);
     }
   }
+  r.reference.insert(r.reference.end(), e->references.begin(), e->references.end());
+  if (!std::isnan(ob.trade_off_k)) r.reference.emplace_back("trade_off_k", ob.trade_off_k);
   return res;
 }
 
@@ -414,6 +483,26 @@ void print_optimization(std::ostream& os, const Study& study, std::size_t index,
           shown = true;
         }
   if (shown) os << '\n';
+  if (ob.reference.active()) {  // each term normalised at the best point, and their unweighted sum (seed 002 Eq. 7.9)
+    double index_sum = 0.0;
+    std::string terms;
+    for (const ObjectiveTerm& t : ob.objective) {
+      double ref = kNaN, best = kNaN;
+      for (const auto& [k, v] : r.reference)
+        if (k == "reference_" + t.metric) ref = v;
+      for (const auto& [k, v] : r.best_metrics)
+        if (k == t.metric) best = v;
+      const double ratio = t.reciprocal ? ref / best : best / ref;
+      index_sum += ratio;
+      std::snprintf(line, sizeof line, "    %s: %.6g at the reference, %.6g at the best (%s = %.4f)\n", t.metric.c_str(),
+                    ref, best, t.reciprocal ? "f_0/f" : "f/f_0", ratio);
+      terms += line;
+    }
+    os << terms;
+    std::snprintf(line, sizeof line, "    normalised terms' sum (seed 002 Eq. 7.9) = %.4f (%.4f at the reference)\n",
+                  index_sum, double(ob.objective.size()));
+    os << line;
+  }
   if (const SeedCase* c = ob.preset.empty() ? nullptr : find_seed_case(ob.preset)) {
     std::vector<double> xt;
     for (const auto& [k, v] : r.reference)

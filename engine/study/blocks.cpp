@@ -191,7 +191,8 @@ std::vector<std::string> with_placement(std::vector<std::string> names, const Bl
 void Parser::check_block_keys(const BlockDraft& d) {
   std::vector<std::string> block_keys{"name", "kind", "axes", "zip", "lhs", "saltelli"};
   if (d.optimize)
-    for (const char* k : {"variables", "objective", "global", "local", "polish_from", "seed", "constraint", "penalty"})
+    for (const char* k : {"variables", "objective", "reference", "trade_off", "global", "local", "polish_from", "seed",
+                          "constraint", "penalty"})
       block_keys.push_back(k);
   for (const auto& n : d.param_names) block_keys.push_back(n);
   if (d.kind == BlockKind::trajectory) block_keys.push_back("vertex_alpha");

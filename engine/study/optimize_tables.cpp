@@ -257,40 +257,7 @@ void Parser::parse_optimizations(const toml::table& root, Study& s) {
       }
     }
 
-    // objective = "E" | { E = 1, tau_inf = 0.01 }
-    const auto allowed = objective_names(block->metrics());
-    auto check_metric = [&](const std::string& m, const toml::node& at) {
-      if (std::find(allowed.begin(), allowed.end(), m) != allowed.end()) return true;
-      error(at, "unknown objective '" + m + "' for " + std::string(to_string(kind)) + " runs; expected one of " +
-                    join(allowed) + " or a weighted sum { metric = weight, ... }" + suggest(m, allowed));
-      return false;
-    };
-    if (const toml::node* on = t.get("objective")) {
-      if (const auto* os = on->as_string()) {
-        if (check_metric(os->get(), *on)) ob.objective.emplace_back(os->get(), 1.0);
-      } else if (const auto* ot = on->as_table()) {
-        if (ot->empty()) error(*on, "objective is an empty table; expected { metric = weight, ... }");
-        for (auto&& [k, wn] : ordered(*ot)) {
-          const std::string m(k->str());
-          if (!check_metric(m, *wn)) continue;
-          if (auto w = get_number(*wn, "weight of " + m)) {
-            if (*w == 0) error(*wn, "weight of " + m + " is 0; expected a nonzero weight (negative: maximise)");
-            else ob.objective.emplace_back(m, *w);
-          }
-        }
-      } else {
-        error(*on, "objective is " + type_name(*on) + "; expected a metric name (\"E\") or { metric = weight, ... }");
-      }
-    } else {
-      // Default: the kind's ranking objective (case 3 of the seed minimises mean sqrt(tau^T M^-1 tau): E_M).
-      ob.objective.emplace_back(ob.preset == "3" ? "E_M" : std::string(ranking(kind).objective), 1.0);
-    }
-    for (std::size_t j = 0; j < ob.objective.size(); ++j) {
-      const auto& [m, w] = ob.objective[j];
-      if (j) ob.objective_text += " + ";
-      if (w != 1.0) ob.objective_text += fmt(w) + "*";
-      ob.objective_text += m;
-    }
+    parse_objective(t, *block, kind, ob);
 
     // stages
     const toml::node* gn = t.get("global");
@@ -348,7 +315,13 @@ void Parser::parse_optimizations(const toml::table& root, Study& s) {
     }
     if (diags_.size() != errors_before) continue;
     ob.base.push_back(std::move(*block));
-    s.optimizations.push_back(std::move(ob));
+    for (OptimizeBlock& x : expand_trade_off(std::move(ob))) {
+      for (const OptimizeBlock& y : s.optimizations)
+        if (y.name == x.name)
+          error(bpos, label + ": trade_off names an optimisation '" + x.name + "', which another [[optimize]] has; "
+                      "expected distinct names");
+      s.optimizations.push_back(std::move(x));
+    }
   }
 }
 

@@ -186,6 +186,12 @@ class Parser : public ParserCore {
   // optimisation keys.
   void parse_optimizations(const toml::table& root, Study& s);
   std::optional<opt::StageOptions> parse_stage(const toml::node& n, bool global, OptimizeBlock& ob);
+  // optimize_objective.cpp
+  /// objective, reference and trade_off of an [[optimize]] table into `ob` (its variables read first).
+  void parse_objective(const toml::table& t, const Block& block, BlockKind kind, OptimizeBlock& ob);
+  /// `ob` as the optimisations it stands for: itself, or one per trade_off weight k.
+  std::vector<OptimizeBlock> expand_trade_off(OptimizeBlock ob) const;
+  std::vector<double> trade_off_ks_;  ///< the trade_off weights of the [[optimize]] table being read
 
   // axes.cpp
   /// One axis of [block.axes] (its values in stored units; LHS axes get their values later).

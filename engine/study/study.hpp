@@ -99,13 +99,32 @@ struct OptimizeVariable {
   double lower = 0.0, upper = 0.0;  ///< stored units
   double start = std::numeric_limits<double>::quiet_NaN();  ///< NaN: the block's value of the parameter
 };
+/// One term of an [[optimize]] objective: weight * metric, or weight / metric (`reciprocal`: a
+/// criterion to maximise as seed 002 Eq. 7.6 writes it, f1^0 / f1); with a reference, the term is
+/// divided by its value at the reference (so it is 1 there).
+struct ObjectiveTerm {
+  std::string metric;
+  double weight = 1.0;
+  bool reciprocal = false;
+};
+/// Where a normalised objective takes its references f^0 (seed 002 Eqs. 7.1 and 7.6: the criteria
+/// at the initial design). None: the objective is the plain weighted sum.
+struct ObjectiveReference {
+  bool start = false;                                  ///< the variables' start point
+  std::vector<std::pair<std::string, double>> design;  ///< variable -> value [stored units]; the others at their start
+  bool active() const { return start || !design.empty(); }
+};
 struct OptimizeBlock {
   std::string name;    ///< the HDF5 group /optimizations/<name> (default: the preset's name)
   std::string preset;  ///< seed 000 Table 4 row, "" when none
   std::vector<Block> base;  ///< exactly one: the runs one evaluation executes (vector: Block has no default)
   std::vector<OptimizeVariable> variables;                  ///< file order
-  std::vector<std::pair<std::string, double>> objective;    ///< metric -> weight (a weighted sum)
-  std::string objective_text;                               ///< as the file wrote it, e.g. "E" or "E + 0.01*tau_inf"
+  std::vector<ObjectiveTerm> objective;                     ///< a weighted sum of terms
+  ObjectiveReference reference;                             ///< normalise each term by its value there
+  /// trade_off: this block is one weight k of a two-term objective swept as k f_a + (1 - k) f_b
+  /// (named <name>_k<k>); NaN when the file wrote the weights.
+  double trade_off_k = std::numeric_limits<double>::quiet_NaN();
+  std::string objective_text;                               ///< e.g. "E", "E + 0.01*tau_inf", "0.9*min_manipulability_0/min_manipulability + ..."
   std::optional<opt::StageOptions> global, local;
   int local_starts = 1;     ///< best distinct global points polished by the local stage
   double distinct = 1e-2;   ///< range-normalised distance that makes two points distinct
