@@ -457,6 +457,67 @@ TEST(ChainTrajectory, ArgumentsThatDoNotFitThrow) {
   EXPECT_THROW(simulate(spatial_arm7(), task, spatial_guess(7), o), std::invalid_argument);  // planar task, spatial chain
 }
 
+// A spatial arm of three joints on a position path has no redundancy: J qdd = b. The tip follows the
+// path, the local methods (and k) are the same run bit for bit, and the history's tip acceleration is
+// the path's.
+TEST(ChainTrajectory, NonRedundantSpatialArmSolvesTheTask) {
+  Chain c;
+  c.name = "elbow3";
+  c.source = "test";
+  c.gravity = {0, 0, -9.81};
+  const double z[3] = {0.3, 0.0, 0.45};
+  const Eigen::Vector3d axis[3] = {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitY()};
+  for (int i = 0; i < 3; ++i) {
+    ChainJoint j;
+    j.name = "j" + std::to_string(i + 1);
+    j.origin.p = {0, 0, z[i]};
+    j.axis = axis[i];
+    j.mass = 3.0 - i;
+    j.com = {0, 0, 0.2};
+    j.inertia = Eigen::Vector3d(0.02, 0.02, 0.005).asDiagonal();
+    c.joints.push_back(j);
+  }
+  c.tip.p = {0, 0, 0.4};
+  c.prepare();
+  const Path3 path({Eigen::Vector3d(0.4, 0.1, 0.5), Eigen::Vector3d(0.45, -0.1, 0.4), Eigen::Vector3d(0.35, 0.0, 0.6)},
+                   {1.0, 1.0});
+  TrajectoryOptions o;
+  o.integrator = Integrator::rk4;
+  o.dt = 1e-3;
+  const ChainTask task(TaskSpace::spatial_position, path, o.dt);
+  const VecN q0 = (VecN(3) << 0.2, 0.6, 0.9).finished();
+  ChainHistory h;
+  h.stride = 100;
+  const TrajectoryMetrics a = simulate(c, task, q0, o, &h);
+  ASSERT_EQ(a.status, RunStatus::ok);
+  EXPECT_LT(a.max_tracking_error, 1e-6);
+  EXPECT_GT(a.min_manipulability, 0.0);
+  for (TrajectoryMethod method : {TrajectoryMethod::local_unweighted, TrajectoryMethod::local_weighted}) {
+    TrajectoryOptions p = o;
+    p.method = method;
+    p.k = 0.7;
+    const TrajectoryMetrics b = simulate(c, task, q0, p);
+    EXPECT_EQ(b.E, a.E);
+    EXPECT_EQ(b.tau_inf, a.tau_inf);
+    EXPECT_EQ(b.power_sq_integral, a.power_sq_integral);
+  }
+  ChainData data;
+  Mat6N Jp, Jm, J;
+  for (Eigen::Index col = 1; col < h.size; col += 4) {
+    const VecN q = h.q.col(col), qd = h.qd.col(col), qdd = h.qdd.col(col);
+    const double eps = 1e-6;
+    forward_kinematics(c, data, q + eps * qd);
+    tip_jacobian(c, data, Jp);
+    forward_kinematics(c, data, q - eps * qd);
+    tip_jacobian(c, data, Jm);
+    forward_kinematics(c, data, q);
+    tip_jacobian(c, data, J);
+    const Vec6 acc = J * qdd + (Jp - Jm) / (2 * eps) * qd;
+    const Eigen::Vector3d want = task.path.acceleration(static_cast<std::size_t>(col * h.stride));
+    EXPECT_LT((acc.head<3>() - want).norm(), 1e-6 * (1 + want.norm())) << "row " << col;
+  }
+}
+
 TEST(ChainTrajectory, TaskSpaceNamesRoundTrip) {
   for (auto s : {TaskSpace::planar_position, TaskSpace::planar_pose, TaskSpace::spatial_position, TaskSpace::spatial_pose}) {
     TaskSpace back;

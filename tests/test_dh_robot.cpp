@@ -19,7 +19,9 @@
 #include "kdl_chain.hpp"
 #include "model/chain_dynamics.hpp"
 #include "model/chain_kinematics.hpp"
+#include "ik/chain_ik.hpp"
 #include "robot/urdf.hpp"
+#include "runner/placed_task.hpp"
 #include "study/study.hpp"
 
 using namespace ks;
@@ -57,15 +59,17 @@ KdlDh kdl_from_file(const std::string& name) {
     const toml::table& t = *row.as_table();
     const auto num = [&](const char* key) { return t[key].value<double>().value(); };
     const bool prismatic = t["type"].value<std::string>().value() == "prismatic";
+    const bool fixed = t["type"].value<std::string>().value() == "fixed";
     const auto& c = *t["com"].as_array();
     const auto& in = *t["inertia"].as_table();
     const auto I = [&](const char* key) { return in[key].value<double>().value_or(0.0); };
     const KDL::RigidBodyInertia inertia(
         num("mass"), KDL::Vector(c[0].value<double>().value(), c[1].value<double>().value(), c[2].value<double>().value()),
         KDL::RotationalInertia(I("ixx"), I("iyy"), I("izz"), I("ixy"), I("ixz"), I("iyz")));
-    k.chain.addSegment(KDL::Segment(KDL::Joint(prismatic ? KDL::Joint::TransZ : KDL::Joint::RotZ),
+    k.chain.addSegment(KDL::Segment(KDL::Joint(fixed ? KDL::Joint::None : prismatic ? KDL::Joint::TransZ : KDL::Joint::RotZ),
                                     KDL::Frame::DH(num("a"), num("alpha") * kDegree, num("d"), num("theta") * kDegree),
                                     inertia));
+    if (fixed) continue;
     const double unit = prismatic ? 1.0 : kDegree;
     const auto* lim = t["limits"].as_table();
     k.limits.emplace_back(lim ? lim->get("lower")->value<double>().value() * unit : -INFINITY,
@@ -91,11 +95,12 @@ Eigen::Matrix3d rotation(const KDL::Rotation& R) {
 
 /// The DH chain, the URDF chain and KDL's chain of the same rows agree: joints, limits, then tip pose,
 /// Jacobian and RNEA torques at 300 random states (q within the limits where there are some).
-void expect_same_robot(const std::string& name) {
+/// `with_urdf` false: a robot file without a URDF twin (DH and KDL only).
+void expect_same_robot(const std::string& name, bool with_urdf = true) {
   SCOPED_TRACE(name);
   const Chain dh = dh_study_chain(name);
   KdlDh k = kdl_from_file(name);
-  const Chain urdf = load_urdf(kRobots + name + ".urdf", "base_link", "tool", k.gravity);
+  const Chain urdf = with_urdf ? load_urdf(kRobots + name + ".urdf", "base_link", "tool", k.gravity) : dh;
   const int n = dh.dof();
   ASSERT_EQ(urdf.dof(), n);
   ASSERT_EQ(static_cast<int>(k.chain.getNrOfJoints()), n);
@@ -138,6 +143,7 @@ void expect_same_robot(const std::string& name) {
     const Mat6N kJ = test::from_kdl(kj);
     const VecN ktau_v = test::from_kdl(ktau);
     for (const Chain* c : {&dh, &urdf}) {
+      if (c == &urdf && !with_urdf) continue;
       const std::string what = std::string(c == &dh ? "DH" : "URDF") + " chain, state " + std::to_string(s);
       ChainData d;
       forward_kinematics(*c, d, q);
@@ -159,9 +165,62 @@ void expect_same_robot(const std::string& name) {
 TEST(DhRobot, Planar2rEqualsUrdfAndKdl) { expect_same_robot("planar2r"); }
 TEST(DhRobot, ScaraEqualsUrdfAndKdl) { expect_same_robot("scara"); }
 TEST(DhRobot, Puma560EqualsUrdfAndKdl) { expect_same_robot("puma560"); }
+// Fixed rows (the wrist locked): KDL's chain of the same six rows with Joint::None for rows 4-6, its
+// segments' inertias summed by KDL's own RNEA: tip pose, 3-column Jacobian and torques.
+TEST(DhRobot, FixedRowsEqualKdlSegmentsWithoutJoints) {
+  expect_same_robot("puma560_arm", false);
+  const Chain arm = dh_study_chain("puma560_arm"), full = dh_study_chain("puma560");
+  ASSERT_EQ(arm.dof(), 3);
+  double m = 0.0;
+  for (const ChainJoint& j : full.joints) m += j.mass;
+  EXPECT_NEAR(arm.joints[0].mass + arm.joints[1].mass + arm.joints[2].mass, m, 1e-12);  // no mass lost
+}
 
 // The 2R's torques are those of the thesis's own planar model (its appendix, Listagem 5: uniform thin
 // rods, written there with 0.3333 and 1.3333 for the thirds), m = 10 kg, l = 1.2 m, gravity along -y.
+// Seed 002's third placement path (Section 7.3) lies in the Puma's workspace within its joint limits:
+// unlimited IK solutions exist inside the limits at every vertex (the proof), so the IK error of the
+// task on the limited arm is 0 (the clamped solves must find them, from one start or another).
+TEST(DhRobot, Puma560ReachesSeed002sThirdPathWithinItsLimits) {
+  const Chain limited = dh_study_chain("puma560");
+  Chain free = limited;
+  for (ChainJoint& j : free.joints) j.lower = -INFINITY, j.upper = INFINITY;
+  StudyTask task;
+  const double v[7][3] = {{0.4, 0.1, 0}, {0.4, 0, 0}, {0.4, 0, -0.4}, {0.4, -0.3, -0.4},
+                          {0.4, -0.4, 0}, {0.4, -0.3, 0}, {0.4, -0.4, -0.4}};
+  ik::Options o;
+  o.method = ik::Method::lm_adaptive;
+  o.tolerance = 1e-12;
+  o.max_iter = 500;
+  o.keep_history = false;
+  ik::ChainIkWorkspace ws;
+  ik::ChainIkResult r;
+  ik::ChainIkTask t;
+  t.kind = ik::ChainIkTask::Kind::spatial_position;
+  for (const auto& p : v) {
+    task.vertices.emplace_back(p[0], p[1]);
+    task.z.push_back(p[2]);
+    task.durations.push_back(1.0);
+    t.position = Eigen::Vector3d(p[0], p[1], p[2]);
+    bool inside = false;  // some unlimited solution within the limits, from a few starts
+    for (double s : {0.3, -0.5, 1.0, 2.0})
+      for (double e : {-2.5, -1.0, 0.5}) {
+        VecN q = VecN::Constant(6, s);
+        q[2] = e;
+        ik::solve_chain(free, t, q, o, r, ws);
+        bool within = r.error < 1e-9;
+        for (int j = 0; j < 6 && within; ++j) {
+          const double w = std::remainder(r.q[j] - 0.5 * (limited.joints[j].lower + limited.joints[j].upper), 2 * std::numbers::pi);
+          within = std::abs(w) <= 0.5 * (limited.joints[j].upper - limited.joints[j].lower);
+        }
+        inside = inside || within;
+      }
+    EXPECT_TRUE(inside) << p[0] << " " << p[1] << " " << p[2];
+  }
+  task.durations.pop_back();
+  EXPECT_EQ(task_ik_error(task, PlanarArm3{}, &limited), 0.0);
+}
+
 TEST(DhRobot, Planar2rIsTheThesisTwoLinkModel) {
   const Chain c = dh_study_chain("planar2r");
   const double m1 = 10, m2 = 10, l = 1.2, g = 9.81;
@@ -395,6 +454,10 @@ TEST(DhRobot, ErrorsAreLocatedWithWhatWasExpected) {
          "[task]\nvertices = [[0.8, 0.2], [1.0, 0.2]]\ndurations = [1]\n[[block]]\nname = \"t\"\nkind = \"trajectory\"\n";
   expect_located(traj, 3, 1, "a DH robot without gravity whose chain moves in a plane that is not vertical");
   expect_located(with({{2, "l = [1, 1]"}}), 2, 5, "l describes a planar arm; expected no l with dh");
+  expect_located(with({{4, "type = \"fixed\""}}), 12, 10, "dh row 1 is fixed (no joint) and has limits");
+  expect_located(with({{4, "type = \"fixed\""}, {12, "# no limits"}, {14, "type = \"fixed\""}}), 3, 1,
+                 "every DH row is fixed");
+  expect_located(with({{4, "type = \"fxed\""}}), 4, 8, "did you mean 'fixed'?");
 }
 
 TEST(DhRobot, TooManyRowsAndRowsThatAreNotTables) {

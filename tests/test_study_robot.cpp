@@ -163,7 +163,7 @@ TEST(StudyRobot, VertexOutOfReachIsLocated) {
 
 TEST(StudyRobot, RedundancyAndVertexAlphaAreCheckedAgainstTheRobot) {
   // two links on a planar position path: no redundancy left
-  expect_error("[robot]\nl = [1.5, 1.5]\nm = [1, 1]\n" + kTraj, 4, 1, "redundancy 0");
+  expect_error("[robot]\nl = [1.5, 1.5]\nm = [1, 1]\n" + kTraj, 4, 1, "its start fixes the tip angle too");
   // vertex_alpha is the seed's 3-joint baseline
   expect_error("[robot]\nl = [0.8, 0.8, 0.7, 0.5]\nm = [1, 1, 1, 1]\n" + kTraj + "method = \"vertex_alpha\"\n", 7, 10,
                "not for a planar arm of more than 3 joints");

@@ -27,6 +27,23 @@ Frame move(double x, double y, double z) {
   return f;
 }
 
+/// Add a body of mass m [kg], centre of mass com and inertia I about it (the joint frame's axes,
+/// kg m^2) to the body joint j moves: the combined mass, centre of mass and inertia about it
+/// (parallel-axis theorem).
+void add_body(ChainJoint& j, double m, const Eigen::Vector3d& com, const Eigen::Matrix3d& I) {
+  const double total = j.mass + m;
+  if (!(total > 0.0)) return;
+  const Eigen::Vector3d c = (j.mass * j.com + m * com) / total;
+  const auto shift = [&](double mass, const Eigen::Vector3d& at) {  // a point mass's inertia about c
+    const Eigen::Vector3d r = at - c;
+    return (mass * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose())).eval();
+  };
+  const Eigen::Matrix3d sum = j.inertia + shift(j.mass, j.com) + I + shift(m, com);
+  j.inertia = 0.5 * (sum + sum.transpose());
+  j.com = c;
+  j.mass = total;
+}
+
 }  // namespace
 
 Frame dh_frame(double a, double alpha, double d, double theta) {
@@ -41,6 +58,12 @@ Chain dh_chain(const std::vector<DhLink>& links, const Eigen::Vector3d& gravity,
   Frame before;  // the rest of the previous row: this joint's frame starts there (identity: frame 0)
   for (std::size_t i = 0; i < links.size(); ++i) {
     const DhLink& l = links[i];
+    if (l.fixed) {
+      const Frame row = before * dh_frame(l.a, l.alpha, l.d, l.theta);  // frame i in the last joint's frame
+      if (!c.joints.empty()) add_body(c.joints.back(), l.mass, row.R * l.com + row.p, row.R * l.inertia * row.R.transpose());
+      before = row;
+      continue;
+    }
     const bool prismatic = l.type == JointType::prismatic;
     ChainJoint j;
     j.name = l.name.empty() ? "joint" + std::to_string(i + 1) : l.name;

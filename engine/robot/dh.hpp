@@ -18,6 +18,9 @@ namespace ks {
 struct DhLink {
   std::string name;                  ///< the joint's name ("joint<i>" when empty)
   JointType type = JointType::revolute;
+  /// A row without a joint: its frame T_i(theta, d, a, alpha) is fixed in the previous link, which
+  /// carries its mass (e.g. a wrist locked at its offsets). No limits.
+  bool fixed = false;
   double a = 0.0;                    ///< along x_i [m]
   double alpha = 0.0;                ///< about x_i [rad]
   double d = 0.0;                    ///< along z_{i-1} [m]; a prismatic joint's offset (q = 0 at d)
@@ -36,6 +39,9 @@ struct DhLink {
 /// turned by theta_i (and, prismatic, moved by d_i) about its z axis, the joint axis +z; the rest of
 /// the row, Tz(d_i) (revolute) Tx(a_i) Rx(alpha_i), becomes the next joint's origin (the tip frame
 /// after the last row), and the link's mass properties are moved from frame i into the joint frame.
+/// A fixed row adds no joint: its frame is composed into the next joint's origin (or the tip frame)
+/// and its mass properties are added to the body of the joint before it (the base's, which does not
+/// move, when none is). At least one row must be a joint.
 /// No check: the caller validates the values (Chain::IsValid, robot/inertia_check.hpp). prepare()d.
 Chain dh_chain(const std::vector<DhLink>& links, const Eigen::Vector3d& gravity, std::string name, std::string source);
 

@@ -59,6 +59,12 @@ double chain_ik_error(const StudyTask& task, const Chain& chain) {
     if (c.limited() && std::isfinite(c.lower) && std::isfinite(c.upper))
       guess[j] = c.type == JointType::prismatic ? 0.5 * (c.lower + c.upper) : std::clamp(guess[j], c.lower, c.upper);
   }
+  // a second start for arms whose limits leave the first one's branch: each limited joint mid-range
+  VecN middle = guess;
+  for (int j = 0; j < chain.dof(); ++j) {
+    const ChainJoint& c = chain.joints[j];
+    if (c.limited() && std::isfinite(c.lower) && std::isfinite(c.upper)) middle[j] = 0.5 * (c.lower + c.upper);
+  }
   VecN q = guess;
   double sum = 0.0;
   for (std::size_t i = 0; i < task.vertices.size(); ++i) {
@@ -67,8 +73,9 @@ double chain_ik_error(const StudyTask& task, const Chain& chain) {
     ik::solve_chain(chain, t, q, o, r, ws);
     double best = std::isfinite(r.error) ? r.error : std::numeric_limits<double>::infinity();
     VecN best_q = r.q;
-    if (best >= kIkErrorEpsilon) {  // again from the automatic guess
-      ik::solve_chain(chain, t, guess, o, r, ws);
+    for (const VecN* start : {&guess, &middle}) {  // again from the automatic guess, then mid-range
+      if (best < kIkErrorEpsilon || (start == &middle && middle == guess)) break;
+      ik::solve_chain(chain, t, *start, o, r, ws);
       if (std::isfinite(r.error) && r.error < best) {
         best = r.error;
         best_q = r.q;

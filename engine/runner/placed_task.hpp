@@ -21,8 +21,9 @@ StudyTask place_task(const StudyTask& task, const TaskPlacement& p, bool planar)
 /// distance from P_i to the annulus the tip reaches, radii max(0, 2 max l - sum l) .. sum l about the
 /// base. A chain: Levenberg-Marquardt position solves (ik::solve_chain, lm_adaptive, joint limits
 /// clamped when the robot has them) from the previous vertex's solution (the first from the
-/// automatic start guess), again from that guess when the residual is 1 mm or more; e_i is the smaller
-/// residual. Deterministic: a pure function of its inputs.
+/// automatic start guess), again from that guess and then from mid-range of every limited joint when
+/// the residual is 1 mm or more; e_i is the smallest residual. Deterministic: a pure function of its
+/// inputs.
 double task_ik_error(const StudyTask& task, const PlanarArm3& arm, const Chain* chain);
 
 }  // namespace ks

@@ -348,17 +348,22 @@ void Parser::check_robot_supports(const BlockDraft& d, const Study& s) {
   if (d.kind != BlockKind::trajectory || !s.chain) return;
   const RobotShape& r = d.ctx.robot;
   const int m = (r.planar ? 2 : 3) + (s.task.orientation.empty() ? 0 : 1) + (s.task.hold_orientation ? 3 : 0);
-  if (m >= r.joints) {
-    error(d.pos, d.label + " resolves redundancy, but the task has " + std::to_string(m) + " equations and the robot " +
-                     std::to_string(r.joints) + " joints (redundancy " + std::to_string(r.joints - m) +
-                     "); expected a robot with more joints than task equations, or a position task");
+  // a spatial arm may have no redundancy (J qdd = b); a planar arm's start fixes its tip angle too
+  if (m > r.joints || (r.planar && m == r.joints)) {
+    error(d.pos, d.label + " follows a path of " + std::to_string(m) + " task equations with a robot of " +
+                     std::to_string(r.joints) + " joints; expected " +
+                     (r.planar ? "a planar robot with more joints than task equations (its start fixes the tip angle too)"
+                               : "a robot with at least as many joints as task equations") +
+                     ", or a position task");
     return;
   }
   // global_spline on a chain: revolute joints, a position path; cubic splines from a local or random
   // start (the vertex family and start are the seed's 3R's)
   bool prismatic = false;
   for (int j = 0; j < r.joints; ++j) prismatic = prismatic || r.is_prismatic(j);
-  const char* global_why = r.pose_task || s.task.hold_orientation ? "an orientation path" : prismatic ? "prismatic joints" : nullptr;
+  const char* global_why = m == r.joints ? "a robot without redundancy (as many joints as task equations)"
+                           : r.pose_task || s.task.hold_orientation ? "an orientation path"
+                           : prismatic ? "prismatic joints" : nullptr;
   const auto refuse_global = [&](const std::string& key, const std::string& value, const std::string& why,
                                  const auto& at, bool axis) {
     error(at, key + " = \"" + value + "\" " + why + (axis ? " (the " + key + " axis includes it)" : "") + "; expected " +

@@ -7,6 +7,7 @@
 //   (optional each: deg, deg/s, Nm for revolute joints; m, m/s, N for prismatic ones), name.
 // The rows are read by a DhReader over the text they are written in, so that their errors carry that
 // text's file, line and column; the study parser adds them to its own.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -24,7 +25,7 @@ namespace {
 const std::vector<std::string> kRowKeys{"name", "type", "a", "alpha", "d", "theta", "mass", "com", "inertia", "limits"};
 const std::vector<std::string> kInertiaKeys{"ixx", "iyy", "izz", "ixy", "ixz", "iyz"};
 const std::vector<std::string> kLimitKeys{"lower", "upper", "velocity", "effort"};
-const std::vector<std::string> kTypes{"revolute", "prismatic"};
+const std::vector<std::string> kTypes{"revolute", "prismatic", "fixed"};
 
 /// Reads DH rows from one TOML text (the study's or a robot file's), collecting located diagnostics.
 class DhReader : public ParserCore {
@@ -65,6 +66,10 @@ class DhReader : public ParserCore {
       links.push_back(row(*t, "dh row " + std::to_string(i + 1)));
     }
     if (diags_.size() > before) return std::nullopt;
+    if (std::all_of(links.begin(), links.end(), [](const DhLink& l) { return l.fixed; })) {
+      error(dh, "every DH row is fixed; expected at least one revolute or prismatic row (a joint)");
+      return std::nullopt;
+    }
     return links;
   }
 
@@ -84,12 +89,13 @@ class DhReader : public ParserCore {
     DhLink l;
     if (auto v = get_string(t, "name", what + " name")) l.name = *v;
     if (!t.get("type")) {
-      error(t.source(), what + " has no 'type'; expected type = \"revolute\" or \"prismatic\"");
+      error(t.source(), what + " has no 'type'; expected type = \"revolute\", \"prismatic\" or \"fixed\"");
     } else if (auto v = get_string(t, "type", what + " type")) {
       if (*v == "prismatic") l.type = JointType::prismatic;
+      else if (*v == "fixed") l.fixed = true;
       else if (*v != "revolute")
-        error(*t.get("type"), "unknown joint type '" + *v + "' in " + what + "; expected \"revolute\" or \"prismatic\"" +
-                                  suggest(*v, kTypes));
+        error(*t.get("type"), "unknown joint type '" + *v + "' in " + what + "; expected \"revolute\", \"prismatic\" or "
+                              "\"fixed\" (a row without a joint)" + suggest(*v, kTypes));
     }
     const bool prismatic = l.type == JointType::prismatic;
     l.a = required(t, "a", what, "A [m] (along x_i)").value_or(0.0);
@@ -106,7 +112,10 @@ class DhReader : public ParserCore {
       error(t.source(), what + " has no 'inertia'; expected inertia = { ixx = .., iyy = .., izz = .. } [kg m^2] "
                                "(about the centre of mass, link frame axes)");
     else read_inertia(*t.get("inertia"), what, l);
-    if (const toml::node* n = t.get("limits")) read_limits(*n, what, prismatic, l);
+    if (const toml::node* n = t.get("limits")) {
+      if (l.fixed) error(*n, what + " is fixed (no joint) and has limits; expected no limits on a fixed row");
+      else read_limits(*n, what, prismatic, l);
+    }
     return l;
   }
 
@@ -240,7 +249,10 @@ void Parser::parse_dh_robot(const toml::table& t, Study& s) {
     else if (!chain->IsValid(&why)) why = "not a chain the engine can simulate: " + why;
     else if (!(why = inertia_matrix_problem(*chain, &joint)).empty()) why += "; expected links that move mass";
     if (!why.empty()) {
-      reader.report(joint >= 0 ? *rows->as_array()->get(std::size_t(joint)) : *rows, why);
+      std::size_t row = 0;  // the row of chain joint `joint` (fixed rows have none)
+      for (int seen = -1; joint >= 0 && row < links->size(); ++row)
+        if (!(*links)[row].fixed && ++seen == joint) break;
+      reader.report(joint >= 0 && row < links->size() ? *rows->as_array()->get(row) : *rows, why);
       chain.reset();
     }
   }

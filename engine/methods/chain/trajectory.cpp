@@ -316,6 +316,9 @@ TrajectoryMetrics run(const Chain& chain, const ChainTask& task, const VecN& q_s
 template <TaskSpace S>
 TrajectoryMetrics run_method(const Chain& chain, const ChainTask& task, const VecN& q, const TrajectoryOptions& o,
                              const std::optional<Profile1>& alpha, ChainHistory* h) {
+  // as many joints as task rows: no redundancy to resolve, J qdd = b solved (the local methods agree)
+  if (chain.dof() == task_dimension(S) && o.method != TrajectoryMethod::global_spline)
+    return run<S, Resolution::nonredundant>(chain, task, q, o, alpha, h);
   switch (o.method) {
     case TrajectoryMethod::local_weighted: return run<S, Resolution::weighted>(chain, task, q, o, alpha, h);
     case TrajectoryMethod::local_unweighted: return run<S, Resolution::unweighted>(chain, task, q, o, alpha, h);
@@ -348,8 +351,9 @@ TrajectoryMetrics simulate_local(const Chain& chain, const ChainTask& task, cons
   if (o.method == TrajectoryMethod::vertex_alpha) {
     if (task.space != TaskSpace::planar_pose || n != 3)
       throw std::invalid_argument("simulate: vertex_alpha needs the planar_pose task and 3 joints");
-  } else if (n <= m) {
-    throw std::invalid_argument("simulate: " + std::string(to_string(o.method)) + " needs more joints (" +
+  } else if (n < m || (is_planar(task.space) && n == m)) {  // a planar start fixes the tip angle too
+    throw std::invalid_argument("simulate: " + std::string(to_string(o.method)) + " needs " +
+                                (is_planar(task.space) ? "more joints (" : "at least as many joints (") +
                                 std::to_string(n) + ") than task rows (" + std::to_string(m) + ")");
   }
   const Path3& path = sampled.path();
