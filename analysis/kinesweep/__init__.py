@@ -16,12 +16,12 @@ Submodules (each importable alone):
     plotting    shared matplotlib helpers of the plot commands
 Commands (`python3 -m kinesweep.NAME --help`; in a source tree with analysis/ on PYTHONPATH):
     plot_landscape, plot_histories, plot_cases, plot_basins, plot_convergence, plot_runs, plot_pareto,
-    compare_landscapes, importance, report, make_examples
+    plot_trade_off, compare_landscapes, importance, report, make_examples
 `python3 -m kinesweep` lists them. Old scripts that import the former flat names (ksread, kswhere,
 kshistory, kslive, kstypes, kssolutions, ksplot, plot_landscape, ...) run after `import kinesweep.compat`.
 """
 COMMANDS = ("plot_landscape", "plot_histories", "plot_cases", "plot_basins", "plot_convergence", "plot_runs",
-            "plot_pareto", "compare_landscapes", "importance", "report", "make_examples")
+            "plot_pareto", "plot_trade_off", "compare_landscapes", "importance", "report", "make_examples")
 _READ_API = ("open_results", "read_runs", "read_history", "read_landscape", "read_optimization", "Results",
              "FormatVersionError", "THESIS_TABLE4")
 

@@ -49,7 +49,7 @@ struct Evaluator {
   double duration = 0.0;
   bool reach_varies = false;
   /// A normalised objective: each term's metric and the design at the reference, as stored in
-  /// /optimizations/<name> ("reference_<metric>", "reference_x_<variable>").
+  /// /optimizations/<name> ("<metric>_0", "<variable>_0").
   std::vector<std::pair<std::string, double>> references;
   tbb::enumerable_thread_specific<RunWorkspace> workspaces;
 
@@ -235,10 +235,10 @@ std::shared_ptr<Evaluator> make_evaluator(const Study& study, std::size_t index,
       throw std::runtime_error("optimization " + ob.name + ": " + t.metric->name + " at the reference design (" +
                                where() + ") is " + [&] { std::ostringstream os; os.precision(6); os << metric; return os.str(); }() +
                                "; a normalised objective divides by it: expected a reference where it is finite and nonzero");
-    e->references.emplace_back("reference_" + t.metric->name, metric);
+    e->references.emplace_back(t.metric->name + "_0", metric);
     t.scale /= ref;  // weight / (the term at the reference)
   }
-  for (std::size_t i = 0; i < x.size(); ++i) e->references.emplace_back("reference_x_" + ob.variables[i].name, x[i]);
+  for (std::size_t i = 0; i < x.size(); ++i) e->references.emplace_back(ob.variables[i].name + "_0", x[i]);
   return e;
 }
 
@@ -489,7 +489,7 @@ void print_optimization(std::ostream& os, const Study& study, std::size_t index,
     for (const ObjectiveTerm& t : ob.objective) {
       double ref = kNaN, best = kNaN;
       for (const auto& [k, v] : r.reference)
-        if (k == "reference_" + t.metric) ref = v;
+        if (k == t.metric + "_0") ref = v;
       for (const auto& [k, v] : r.best_metrics)
         if (k == t.metric) best = v;
       const double ratio = t.reciprocal ? ref / best : best / ref;
