@@ -164,6 +164,21 @@ void print_optimizations(store::ResultsReader& reader, const RunsTable& t, std::
           if (n == k) return &v;
         return nullptr;
       };
+      // a normalised objective: the design and metrics at its reference, the best beside them
+      std::vector<double> rx;
+      for (const auto& v : o.variables)
+        if (const double* p = ref(v + "_0")) rx.push_back(*p);
+      if (rx.size() == o.variables.size() && !rx.empty()) {
+        os << "    reference   at " << point_text(o, rx);
+        const double* k = ref("trade_off_k");
+        if (k) os << " (trade_off k = " << format_double(*k) << ")";
+        os << '\n';
+        for (const auto& [m, best] : o.best_metrics)
+          if (const double* r = ref(m + "_0"))
+            os << "                " << m << " = " << format_double(*r) << " there, " << format_double(best)
+               << " at the best (x " << format_double(best / *r) << ")\n";
+      }
+      if (!ref("thesis_E")) continue;
       os << "    thesis      ";
       if (const double* e = ref("thesis_E")) os << "E = " << format_double(*e);
       std::vector<double> tx;
