@@ -1,7 +1,8 @@
 // Point-to-point motions (engine/motion): the clamped joint spline against a dense solve of its
 // interpolation system; the criteria against closed forms and fine-grid Simpson integrals; every
 // gradient against central differences of the whole evaluation (Puma 560 arm and planar 2R, with and
-// without an obstacle).
+// without an obstacle); seed 002 §7.2's weighted torque/power motions (Puma 560, planar 2R) beside the
+// seed's figures; and the least duration under effort limits against a bisection on feasibility.
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
@@ -13,6 +14,7 @@
 #include "model/chain_dynamics.hpp"
 #include "motion/joint_spline.hpp"
 #include "motion/motion_problem.hpp"
+#include "motion/solve_motion.hpp"
 #include "study/study.hpp"
 
 using namespace ks;
@@ -363,4 +365,156 @@ TEST(MotionGradients, PumaAndPlanar2rAgainstCentralDifferences) {
       EXPECT_EQ(P.constraints(), 4 * (3 * spec.chain.dof() + (obstacle ? 1 : 0))) << label;
       EXPECT_LT(check_gradients(P, generic_point(P, 3.0, 11 + robot), label.c_str()), 1e-6);
     }
+}
+
+namespace {
+
+/// Seed 002's weighted objective p = k f5/f5⁰ + (1 - k) f6/f6⁰ (Eq. 7.1) over K controls per joint.
+MotionSummary weighted_torque_power(MotionSpec spec, int K, double k, Criteria* reference) {
+  spec.controls = K;
+  at(spec.weights, Criterion::torque_sq) = k;
+  at(spec.weights, Criterion::power_sq) = 1 - k;
+  spec.normalise = true;
+  const MotionProblem P(spec);
+  *reference = P.reference();
+  return solve_motion(P);
+}
+
+}  // namespace
+
+// Seed 002 §7.2, Puma 560 (wrist locked at 0): θ from 0 to (1.5708, 0.7854, -0.5236) rad in 9 s,
+// k = 0.4. The seed's reference and optimum: f5 23.03 -> 22.66 "kNm" (-1.6 %), f6 206.66 -> 137.97 "W"
+// (-33.2 %), p = 0.4 (22.66 / 23.03) + 0.6 (137.97 / 206.66) = 0.7941. Our model (Armstrong et al.'s
+// parameters through Corke's toolbox, studies/robots/puma560_arm.toml) gives other reference values;
+// what is ours to assert: both criteria fall, f5 by at least the seed's 1.6 %, and with K = 3 the
+// weighted objective p ends at or below the seed's.
+TEST(MotionSeed002, PumaTorquePowerK04) {
+  const double seed_p = 0.4 * 22.66 / 23.03 + 0.6 * 137.97 / 206.66;
+  for (int K = 1; K <= 3; ++K) {
+    Criteria ref;
+    const MotionSummary S = weighted_torque_power(puma_spec(), K, 0.4, &ref);
+    const double f50 = at(ref, Criterion::torque_sq), f60 = at(ref, Criterion::power_sq);
+    const double f5 = at(S.final, Criterion::torque_sq), f6 = at(S.final, Criterion::power_sq);
+    if (K == 1)
+      std::printf("seed 002 7.2 Puma reference (rest-to-rest cubic, T = 9 s): f5 %.3f kN^2m^2s (seed 23.03 \"kNm\")  "
+                  "f6 %.2f W^2s (seed 206.66 \"W\")\n", f50 / 1e3, f60);
+    std::printf("seed 002 7.2 Puma k = 0.4, K = %d: f5 %.3f -> %.3f k (%+.1f %%; seed -1.6 %%)  f6 %.2f -> %.2f (%+.1f %%; "
+                "seed -33.2 %%)  p %.4f (seed %.4f)  %s, %d evaluations\n",
+                K, f50 / 1e3, f5 / 1e3, 100 * (f5 / f50 - 1), f60, f6, 100 * (f6 / f60 - 1), S.final_objective, seed_p,
+                std::string(to_string(S.termination)).c_str(), S.evaluations);
+    EXPECT_TRUE(S.feasible);  // the Puma's position limits hold at every sample
+    EXPECT_NE(S.termination, MotionTermination::failure);
+    EXPECT_LT(f5 / f50 - 1, -0.016);
+    EXPECT_LT(f6 / f60 - 1, 0.0);
+    if (K == 3) {
+      EXPECT_LE(S.final_objective, seed_p);
+    }
+  }
+  // how far f6 alone can fall on our model (k = 0): the seed's -33 % is compared with this
+  for (int K : {3, 8}) {
+    Criteria ref;
+    const MotionSummary S = weighted_torque_power(puma_spec(), K, 0.0, &ref);
+    std::printf("seed 002 7.2 Puma k = 0 (f6 alone), K = %d: f6 %.2f -> %.2f (%+.1f %%), f5 %+.1f %%\n", K,
+                at(ref, Criterion::power_sq), at(S.final, Criterion::power_sq),
+                100 * (at(S.final, Criterion::power_sq) / at(ref, Criterion::power_sq) - 1),
+                100 * (at(S.final, Criterion::torque_sq) / at(ref, Criterion::torque_sq) - 1));
+  }
+}
+
+// Seed 002 §7.2, planar 2R (a = 1.2 m, m = 10 kg per link, uniform rods), k = 0.2, 9 s. The seed gives
+// no start or goal: ours are the Puma's first two joints' motion, θ from (0, 0) (stretched along +x)
+// to (1.5708, 0.7854) rad. The seed's figures: f6 8.83 -> 7.39 "kW" (-16.3 %), f5 446.85 -> 370.51
+// "kNm" (-17.1 %), p = 0.2 (370.51 / 446.85) + 0.8 (7.39 / 8.83) = 0.8354.
+TEST(MotionSeed002, Planar2rTorquePowerK02) {
+  const double seed_p = 0.2 * 370.51 / 446.85 + 0.8 * 7.39 / 8.83;
+  MotionSpec spec = planar2r_spec();
+  spec.q_start = joint_vector({0.0, 0.0});
+  spec.q_goal = joint_vector({1.5708, 0.7854});
+  for (int K = 1; K <= 3; ++K) {
+    Criteria ref;
+    const MotionSummary S = weighted_torque_power(spec, K, 0.2, &ref);
+    const double f50 = at(ref, Criterion::torque_sq), f60 = at(ref, Criterion::power_sq);
+    const double f5 = at(S.final, Criterion::torque_sq), f6 = at(S.final, Criterion::power_sq);
+    std::printf("seed 002 7.2 planar 2R k = 0.2, K = %d: f6 %.2f -> %.2f k (%+.1f %%; seed 8.83 -> 7.39, -16.3 %%)  "
+                "f5 %.2f -> %.2f k (%+.1f %%; seed 446.85 -> 370.51, -17.1 %%)  p %.4f (seed %.4f)  %s, %d evaluations\n",
+                K, f60 / 1e3, f6 / 1e3, 100 * (f6 / f60 - 1), f50 / 1e3, f5 / 1e3, 100 * (f5 / f50 - 1), S.final_objective,
+                seed_p, std::string(to_string(S.termination)).c_str(), S.evaluations);
+    EXPECT_TRUE(S.feasible);
+    EXPECT_LT(f5, f50);
+    EXPECT_LT(f6, f60);
+    EXPECT_LE(S.final_objective, seed_p);
+  }
+  // the multistart keeps the best of its starts; the first is the single start's run
+  MotionSpec two = spec;
+  two.controls = 2;
+  at(two.weights, Criterion::torque_sq) = 0.2, at(two.weights, Criterion::power_sq) = 0.8, two.normalise = true;
+  const MotionProblem P(two);
+  MotionSolveOptions o;
+  const double single = solve_motion(P, o).final_objective;
+  o.starts = 4;
+  const MotionSummary multi = solve_motion(P, o);
+  std::printf("planar 2R k = 0.2, K = 2, 4 starts: p %.6f (one start %.6f), best start %d\n", multi.final_objective,
+              single, multi.best_start);
+  EXPECT_LE(multi.final_objective, single);
+}
+
+// Time optimality on a fixed path: the 2R's path shape fixed (K = 2 controls off the cubic), only T
+// free, |τ_i| within effort limits at every sample; minimising T must end at the least feasible T,
+// found here by a scan down from a feasible T and a bisection on feasibility.
+TEST(MotionTime, LeastDurationUnderEffortLimits) {
+  MotionSpec spec = planar2r_spec();
+  spec.q_start = joint_vector({-1.2, 0.3});
+  spec.q_goal = joint_vector({0.8, -0.4});
+  spec.chain.joints[0].effort = 400.0;  // Nm; the static torques along the path stay below both
+  spec.chain.joints[1].effort = 150.0;
+  spec.controls = 2;
+  spec.vary_controls = false;
+  spec.fixed_controls = {-0.7, 0.3, 0.5, -0.2};
+  spec.vary_duration = true;
+  spec.duration = 5.0;
+  spec.min_duration = 0.05;
+  spec.max_duration = 20.0;
+  at(spec.weights, Criterion::duration) = 1.0;
+  const MotionProblem P(spec);
+  ASSERT_EQ(P.variables(), 1);
+  MotionEvaluation e;
+  const auto feasible = [&](double T) {
+    const std::vector<double> x = {T};
+    P.evaluate(x, false, e);
+    for (double c : e.constraints)
+      if (c > 0) return false;
+    return true;
+  };
+  ASSERT_TRUE(feasible(5.0));
+  double hi = 5.0, lo = hi;
+  while (feasible(lo)) hi = lo, lo *= 0.98;  // the first infeasible T going down
+  for (int it = 0; it < 100 && hi - lo > 1e-12 * hi; ++it) (feasible(0.5 * (lo + hi)) ? hi : lo) = 0.5 * (lo + hi);
+  MotionSolveOptions o;
+  o.constraint_tolerance = 1e-10;
+  const MotionSummary S = solve_motion(P, o);
+  const double T = at(S.final, Criterion::duration);
+  std::printf("least duration under effort limits (400, 150) Nm: SLSQP T = %.9f s (%s, %d evaluations), bisection "
+              "T = %.9f s, relative difference %.2e; peak |tau| %.3f Nm\n",
+              T, std::string(to_string(S.termination)).c_str(), S.evaluations, hi, T / hi - 1,
+              at(S.final, Criterion::peak_torque));
+  EXPECT_TRUE(S.feasible);
+  EXPECT_NEAR(T, hi, 0.01 * hi);
+}
+
+TEST(MotionOptions, IsValidNamesTheRule) {
+  std::string why;
+  MotionSolveOptions o;
+  EXPECT_TRUE(o.IsValid(&why));
+  o.starts = 0;
+  EXPECT_FALSE(o.IsValid(&why));
+  EXPECT_NE(why.find("starts"), std::string::npos);
+  MotionSpec spec = planar2r_spec();
+  spec.controls = 0;
+  EXPECT_FALSE(spec.IsValid(&why));  // no variable
+  spec.vary_duration = true;
+  EXPECT_TRUE(spec.IsValid(&why)) << why;
+  at(spec.weights, Criterion::min_clearance) = 1.0;
+  EXPECT_FALSE(spec.IsValid(&why));
+  EXPECT_NE(why.find("obstacles"), std::string::npos);
+  EXPECT_THROW(MotionProblem{spec}, std::invalid_argument);
 }
