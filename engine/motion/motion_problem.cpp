@@ -61,6 +61,9 @@ bool MotionSpec::IsValid(std::string* why) const {
     return fail(why, "the clearance weight needs obstacles");
   if (!obstacles.empty() && static_cast<int>(radii.size()) != n)
     return fail(why, "obstacles need one link radius per joint");
+  for (double r : radii)
+    if (!(r >= 0.0) || !std::isfinite(r)) return fail(why, "link radii must be finite and >= 0");
+  if (!std::isfinite(clearance_margin)) return fail(why, "clearance_margin must be finite");
   if (!(limit_margin >= 0.0 && limit_margin < 1.0)) return fail(why, "limit_margin must be in [0, 1)");
   if (windows < 0) return fail(why, "windows must be >= 0");
   return true;

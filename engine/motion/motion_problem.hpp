@@ -71,7 +71,8 @@ struct MotionSpec {
 
   /// False (with the reason in *why) when the chain is invalid, sizes disagree, K or the samples are
   /// out of range, a duration bound is not 0 < min <= duration <= max, a weight is negative or not
-  /// finite, no variable is free, the clearance weight is set without obstacles, or radii are missing.
+  /// finite, no variable is free, the clearance weight is set without obstacles, radii are missing or
+  /// negative, or a margin is out of range (limit_margin in [0, 1), clearance_margin finite).
   bool IsValid(std::string* why = nullptr) const;
 };
 
@@ -97,7 +98,9 @@ struct MotionConstraint {
 /// then T when vary_duration. evaluate() uses the problem's own workspace: one thread at a time.
 class MotionProblem {
  public:
-  /// Throws std::invalid_argument when !spec.IsValid().
+  /// Samples the motion and evaluates the initial point (reference()). Throws std::invalid_argument
+  /// when !spec.IsValid(), or when spec.normalise meets a weighted criterion whose reference value is
+  /// 0 or not finite (e.g. the manipulability of a motion that starts at a singularity).
   explicit MotionProblem(MotionSpec spec);
 
   const MotionSpec& spec() const { return spec_; }
