@@ -32,7 +32,7 @@ std::vector<double> random_coefficients(int n, double centre, double spread, uns
   return c;
 }
 
-/// E of alpha(t) given as a QuinticPath<1> through `vertices`, computed without the evaluator: the
+/// E of alpha(t) given as a TaskPath<1> through `vertices`, computed without the evaluator: the
 /// analytic IK, the 3x3 Jacobian's LU solves with the full Jdot, and inverse_dynamics' dense M.
 double independent_E(const PlanarArm3& arm, const SampledPath& path, const std::vector<double>& vertices,
                      double* max_tracking) {

@@ -15,7 +15,7 @@
 #include "methods/path_global/sample_3r.hpp"
 #include "model/dual.hpp"
 #include "path_global_fixtures.hpp"
-#include "task/quintic_path.hpp"
+#include "task/task_path.hpp"
 
 namespace ks {
 namespace {

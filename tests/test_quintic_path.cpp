@@ -1,7 +1,7 @@
 // The quintic path: boundary conditions, derivatives by finite differences, the seed's square and polynomial.
 #include <gtest/gtest.h>
 
-#include "task/quintic_path.hpp"
+#include "task/task_path.hpp"
 #include "task/sampled_path.hpp"
 
 using namespace ks;

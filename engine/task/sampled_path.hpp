@@ -1,9 +1,9 @@
 #pragma once
 // A path sampled the way the seed samples it: t_i = i dt for i = 0 .. n - 1, n = floor(T / dt) + 1,
-// each sample on the segment QuinticPath::segment_at(t_i) picks (t <= 0.5 -> A, ...).
+// each sample on the segment TaskPath::segment_at(t_i) picks (t <= 0.5 -> A, ...).
 // Every run of a sweep follows the same path at the same dt, so the samples are computed once and
 // shared read-only by all runs and threads; the simulation step then reads 2 Dim numbers instead of
-// choosing a segment and evaluating 3 Dim quintics. Dim = 2: the planar arm's tip path
+// choosing a segment and evaluating 3 Dim polynomials. Dim = 2: the planar arm's tip path
 // (SampledPath); Dim = 3: a chain's tip path in space (SampledPath3).
 #include <cmath>
 #include <cstdint>
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "task/quintic_path.hpp"
+#include "task/task_path.hpp"
 
 namespace ks {
 
@@ -21,13 +21,13 @@ inline std::size_t sample_count(double duration, double dt) {
 }
 
 template <int Dim>
-class SampledQuinticPath {
+class SampledTaskPath {
  public:
   using Point = Eigen::Matrix<double, Dim, 1>;
 
   /// path: positions [m] over time [s]; dt > 0 [s] (std::invalid_argument otherwise, or for more
   /// than 1e8 samples: study files are checked for that before any run).
-  SampledQuinticPath(QuinticPath<Dim> path, double dt) : path_(std::move(path)), dt_(dt) {
+  SampledTaskPath(TaskPath<Dim> path, double dt) : path_(std::move(path)), dt_(dt) {
     if (!(dt_ > 0) || !(path_.duration() / dt_ < 1e8))
       throw std::invalid_argument("SampledPath: dt = " + std::to_string(dt_) + " s on a " +
                                   std::to_string(path_.duration()) + " s path");
@@ -45,7 +45,7 @@ class SampledQuinticPath {
       segment_[i] = static_cast<std::uint32_t>(s);
     }
   }
-  const QuinticPath<Dim>& path() const { return path_; }
+  const TaskPath<Dim>& path() const { return path_; }
   double dt() const { return dt_; }
   std::size_t size() const { return segment_.size(); }
   /// t_i [s], computed as the simulation loop computes it
@@ -60,13 +60,13 @@ class SampledQuinticPath {
   const std::uint32_t* segments() const { return segment_.data(); }
 
  private:
-  QuinticPath<Dim> path_;
+  TaskPath<Dim> path_;
   double dt_;
   std::vector<double> xa_;               // position, then acceleration, per sample
   std::vector<std::uint32_t> segment_;
 };
 
-using SampledPath = SampledQuinticPath<2>;
-using SampledPath3 = SampledQuinticPath<3>;
+using SampledPath = SampledTaskPath<2>;
+using SampledPath3 = SampledTaskPath<3>;
 
 }  // namespace ks

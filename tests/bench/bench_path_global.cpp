@@ -10,7 +10,7 @@
 #include "methods/path_global/closed_form.hpp"
 #include "methods/path_global/solve_closed_form.hpp"
 #include "path_global_fixtures.hpp"
-#include "task/quintic_path.hpp"
+#include "task/task_path.hpp"
 
 using namespace ks;
 

@@ -13,7 +13,7 @@
 #include "model/chain.hpp"
 #include "model/kinematics.hpp"
 #include "methods/base/path_global_options.hpp"
-#include "task/quintic_path.hpp"
+#include "task/task_path.hpp"
 #include "task/sampled_path.hpp"
 
 namespace ks {

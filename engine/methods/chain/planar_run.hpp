@@ -9,7 +9,7 @@
 
 #include "methods/chain/start.hpp"
 #include "methods/chain/task.hpp"
-#include "task/quintic_path.hpp"
+#include "task/task_path.hpp"
 
 namespace ks {
 

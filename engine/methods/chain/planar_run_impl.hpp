@@ -60,7 +60,7 @@ class Stepper {
  public:
   static constexpr int m = task_dimension(S);
 
-  Stepper(const PlanarChainConstants<N>& k, const QuinticPath<3>& path, const TrajectoryOptions& o,
+  Stepper(const PlanarChainConstants<N>& k, const TaskPath<3>& path, const TrajectoryOptions& o,
           const std::optional<Profile1>& alpha, const LimitTable& limits)
       : k_(k), path_(path), o_(o), alpha_(alpha) {
     spring_ = o.limit_centring != 0.0 && limits.any_position;
@@ -172,7 +172,7 @@ class Stepper {
   }
 
   const PlanarChainConstants<N>& k_;
-  const QuinticPath<3>& path_;
+  const TaskPath<3>& path_;
   const TrajectoryOptions& o_;
   const std::optional<Profile1>& alpha_;
   // the limit spring (TrajectoryOptions::limit_centring): the limits' middle in u = sigma q
@@ -276,7 +276,7 @@ class PlanarModel {
   }
 
   void stages(double t, double dt) {
-    const QuinticPath<3>& path = sampled_.path();
+    const TaskPath<3>& path = sampled_.path();
     const double th = t + 0.5 * dt, t1 = t + dt;
     const std::size_t sh = path.segment_at(th), s1 = path.segment_at(t1);
     stepper_.task(th, sh, xh_);

@@ -74,7 +74,7 @@ class ChainResolver {
  public:
   static constexpr int m = task_dimension(S);
 
-  ChainResolver(const Chain& chain, const QuinticPath<3>& path, const TrajectoryOptions& o,
+  ChainResolver(const Chain& chain, const TaskPath<3>& path, const TrajectoryOptions& o,
                 const std::optional<Profile1>& alpha)
       : chain_(chain), path_(path), o_(o), alpha_(alpha) {
     if (o.limit_centring != 0.0) {
@@ -159,7 +159,7 @@ class ChainResolver {
   }
 
   const Chain& chain_;
-  const QuinticPath<3>& path_;
+  const TaskPath<3>& path_;
   const TrajectoryOptions& o_;
   const std::optional<Profile1>& alpha_;
   ChainData data_;
@@ -264,7 +264,7 @@ class ChainModel {
   }
 
   void stages(double t, double dt) {
-    const QuinticPath<3>& path = sampled_.path();
+    const TaskPath<3>& path = sampled_.path();
     const double th = t + 0.5 * dt, t1 = t + dt;
     const std::size_t sh = path.segment_at(th), s1 = path.segment_at(t1);
     xh_ = resolver_.task(th, sh), x1_ = resolver_.task(t1, s1);

@@ -28,7 +28,7 @@ struct StageTasks {
   double a_h[2], a_1[2];     ///< path accelerations [m/s^2]
   double unit_h, unit_1;     ///< vertex_alpha: the orientation acceleration per radian of segment rise [1/s^2]
 };
-/// Out of line (methods/closed_form/run.cpp): the tasks of QuinticPath::sample_on at RK4's stage times, and
+/// Out of line (methods/closed_form/run.cpp): the tasks of TaskPath::sample_on at RK4's stage times, and
 /// the orientation acceleration per radian of rise of a vertex_alpha segment (a profile whose segments
 /// each rise by exactly 1: `unit`, null when the method is not vertex_alpha).
 void stage_tasks(const Path2& path, const Profile1* unit, double t, double dt, StageTasks& out);

@@ -123,7 +123,7 @@ void prepare(Batch& b, int lanes, const PlanarArm3& arm, const SampledPath& samp
     L.tracking_bound[i] = o.tracking_bound;
     L.orientation_bound[i] = o.orientation_bound;
     if (o.method == TrajectoryMethod::vertex_alpha) {
-      // the rise of each segment, as QuinticPath::sample_on takes it: vertex i + 1 - vertex i
+      // the rise of each segment, as TaskPath::sample_on takes it: vertex i + 1 - vertex i
       double prev = o.alpha1A;
       for (std::size_t k = 0; k < segments; ++k) {
         b.alpha_from[k * kMaxLanes + i] = prev;

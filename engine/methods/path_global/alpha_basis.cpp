@@ -102,7 +102,7 @@ AlphaBasis cubic_spline_basis(std::size_t samples, double dt, double duration, i
   b.coefficients = count;
   b.rows.resize(samples);
   for (std::size_t i = 0; i < samples; ++i) {
-    const double t = std::clamp(static_cast<double>(i) * dt, 0.0, T);  // SampledQuinticPath::time
+    const double t = std::clamp(static_cast<double>(i) * dt, 0.0, T);  // SampledTaskPath::time
     int span = 3;
     while (span < m - 1 && t >= U[span + 1]) ++span;
     double ders[3][4];

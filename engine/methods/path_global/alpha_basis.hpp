@@ -4,7 +4,7 @@
 // alpha, its rate and its acceleration are weighted sums of at most kBasisWidth consecutive
 // coefficients. Two families share this form, so one evaluator serves both:
 // - vertex_quintic: the coefficients are alpha at the path's vertices, each segment a quintic between
-//   them with zero rate and acceleration at the vertices (seed 000's cases 3-5, QuinticPath<1>);
+//   them with zero rate and acceleration at the vertices (seed 000's cases 3-5, TaskPath<1>);
 // - cubic: a clamped uniform cubic B-spline over the whole path (C2), `knots` breakpoints evenly spaced
 //   in time, at rest at the start (zero rate) and, unless asked otherwise, at the end; its coefficients
 //   are the B-spline's control points with the first two (and the last two) tied, so there are exactly
