@@ -139,6 +139,78 @@ integrator = "rk4"
   expect_bitwise_equal(placed, by_hand);
 }
 
+/// A spline task through timed waypoints (times 0, 0.5, 1.25, 2 s: uneven, so the spline is no
+/// quintic in disguise), placed as kSquarePlaced places the square, and written out there by hand:
+/// (x, y) -> (-y + 0.25, x - 0.5), the times doubled.
+std::string waypoints_placed(const std::string& spline) {
+  return "[task]\nwaypoints = [[0, 1.5, 1.5], [0.5, 1.5, 2.0], [1.25, 2.0, 2.0], [2, 2.0, 1.5]]\n" + spline +
+         "[[block]]\nname = \"b\"\nkind = \"trajectory\"\nmethod = \"local_weighted\"\nk = 0.5\n"
+         "task_rotation = 1.5707963267948966\ntask_dx = 0.25\ntask_dy = -0.5\ntask_time_scale = 2.0\n";
+}
+std::string waypoints_by_hand(const std::string& spline) {
+  return "[task]\nwaypoints = [[0, -1.25, 1.0], [1, -1.75, 1.0], [2.5, -1.75, 1.5], [4, -1.25, 1.5]]\n" + spline +
+         "[[block]]\nname = \"b\"\nkind = \"trajectory\"\nmethod = \"local_weighted\"\nk = 0.5\ntask_dx = 0.0\n";
+}
+
+TEST(TaskPlacement, WaypointTaskPlacedEqualsWrittenOutThere) {
+  const std::string chain = "[robot]\nl = [1.0, 1.0, 0.5, 0.5]\nm = [5.0, 2.0, 0.5, 0.5]\nb = 0.1\n";
+  for (const std::string spline : {"", "spline = \"natural\"\n"}) {
+    // the seed's closed-form arm and a planar chain
+    for (const std::string& robot : {std::string(), chain}) {
+      SCOPED_TRACE(spline + robot);
+      const std::string start = robot.empty() ? "alpha1A = 120\n" : "";
+      const Study placed = parse_study(robot + waypoints_placed(spline) + start, "placed.toml");
+      const Study by_hand = parse_study(robot + waypoints_by_hand(spline) + start, "by_hand.toml");
+      ASSERT_NE(placed.task.shape, PathShape::quintic);
+      ASSERT_EQ(placed.task.shape, by_hand.task.shape);
+      ASSERT_TRUE(placed.blocks[0].context().placement);
+      const RunOutcome o = run0(placed);
+      EXPECT_EQ(std::get<TrajectoryMetrics>(o.result).samples, 4001u) << o.status();
+      EXPECT_EQ(std::get<TrajectoryMetrics>(o.result).ik_error, 0.0);
+      expect_bitwise_equal(placed, by_hand);
+    }
+  }
+}
+
+TEST(TaskPlacement, SpatialWaypointTaskPlacedEqualsWrittenOutThere) {
+  StudyOptions so;
+  so.robot_text = read_text(std::string(KS_SOURCE_DIR) + "/studies/robots/arm7.urdf");
+  const std::string robot = "[robot]\nurdf = \"robots/arm7.urdf\"\nbase = \"base_link\"\ntip = \"tool\"\n"
+                            "gravity = [0, 0, -9.81]\n";
+  const std::string block = "[[block]]\nname = \"b\"\nkind = \"trajectory\"\nmethod = \"local_weighted\"\nK_N = 20\n";
+  // (x, y, z) -> (-y - 0.25, x, z + 0.125), times doubled
+  const Study placed = parse_study(robot + R"([task]
+waypoints = [[0, 0.5, -0.125, 0.375], [0.75, 0.5, 0.125, 0.375], [1.5, 0.5, 0.125, 0.625], [2, 0.5, -0.125, 0.625]]
+integrator = "rk4"
+)" + block + "task_rotation = 1.5707963267948966\ntask_dx = -0.25\ntask_dz = 0.125\ntask_time_scale = 2.0\n",
+                                   "placed.toml", so);
+  const Study by_hand = parse_study(robot + R"([task]
+waypoints = [[0, -0.125, 0.5, 0.5], [1.5, -0.375, 0.5, 0.5], [3, -0.375, 0.5, 0.75], [4, -0.125, 0.5, 0.75]]
+integrator = "rk4"
+)" + block + "task_dz = 0.0\n",
+                                    "by_hand.toml", so);
+  ASSERT_EQ(placed.task.shape, PathShape::clamped_spline);
+  const RunOutcome o = run0(placed);
+  EXPECT_EQ(std::get<TrajectoryMetrics>(o.result).ik_error, 0.0) << o.status();
+  expect_bitwise_equal(placed, by_hand);
+}
+
+TEST(TaskPlacement, WaypointTaskSampledOnTheWholePath) {
+  // a 0.5 s spline at dt = 1 ms: 10 samples on the path at time scale 0.02 (its 0.25 s intervals get 5
+  // each: a quintic path would end undersampled), 5 at 0.01
+  const Study s = parse_study("[task]\nwaypoints = [[0, 1.5, 1.5], [0.25, 1.5, 2.0], [0.5, 2.0, 2.0]]\n"
+                              "[[block]]\nname = \"b\"\nkind = \"trajectory\"\n[block.axes]\n"
+                              "task_time_scale = [0.02, 0.01]\n",
+                              "fast.toml");
+  RunWorkspace ws;
+  EXPECT_NE(execute(Scenario::of(s), s.blocks[0].run(0), 0, ws).status(), "undersampled");
+  EXPECT_EQ(execute(Scenario::of(s), s.blocks[0].run(1), 0, ws).status(), "undersampled");
+  const Study q = parse_study("[task]\nvertices = [[1.5, 1.5], [1.5, 2.0], [2.0, 2.0]]\ndurations = [0.25, 0.25]\n"
+                              "[[block]]\nname = \"b\"\nkind = \"trajectory\"\ntask_time_scale = 0.02\n",
+                              "fast.toml");
+  EXPECT_EQ(execute(Scenario::of(q), q.blocks[0].run(0), 0, ws).status(), "undersampled");
+}
+
 TEST(TaskPlacement, QuarterTurnsAreExactAndRotationsKeepDistances) {
   std::mt19937_64 gen(7);
   std::uniform_real_distribution<double> u(-3.0, 3.0);

@@ -215,6 +215,26 @@ TEST(Lanes, SeedCasesEqualSingleRuns) {
   }
 }
 
+// A spline task (timed waypoints, natural and clamped): the lanes evaluate the same path, so every run
+// of every method and integrator gets the bits of its single run.
+TEST(Lanes, SplinePathsEqualSingleRuns) {
+  std::mt19937_64 rng(2007);
+  const PlanarArm3 arm = PlanarArm3::seed();
+  for (PathShape shape : {PathShape::natural_spline, PathShape::clamped_spline}) {
+    const SampledPath path(Path2({{1.5, 1.5}, {1.5, 2.0}, {2.0, 2.0}, {2.0, 1.5}, {1.6, 1.45}}, {0.25, 0.75, 0.5, 0.5}, shape),
+                           1e-3);
+    for (int lanes : lane_widths())
+      for (TrajectoryMethod m :
+           {TrajectoryMethod::local_weighted, TrajectoryMethod::local_unweighted, TrajectoryMethod::vertex_alpha})
+        for (Integrator integ : {Integrator::semi_implicit_euler, Integrator::rk4}) {
+          SCOPED_TRACE(std::string(to_string(shape)) + ", " + std::string(to_string(m)) + ", " +
+                       std::string(to_string(integ)) + ", " + std::to_string(lanes) + " lanes");
+          const std::vector<TrajectoryOptions> runs = random_runs(rng, m, integ, 2 * lanes);
+          expect_lanes_equal_single_runs(lanes, arm, path, runs, 3);
+        }
+  }
+}
+
 // The same run gives the same bits whatever its neighbours and its lane.
 TEST(Lanes, ARunsBitsDoNotDependOnItsNeighbours) {
   if (supported_lanes() < 4) GTEST_SKIP() << "no AVX2";

@@ -119,7 +119,7 @@ struct RunWorkspace::Impl {
     const StudyTask& pt = placed_of(t, p, planar).task;
     std::vector<Eigen::Vector3d> v;
     for (std::size_t i = 0; i < pt.vertices.size(); ++i) v.push_back(pt.vertex(i));
-    return chain_tasks.emplace_back(p, ChainTask(space, Path3(std::move(v), pt.durations), dt)).second;
+    return chain_tasks.emplace_back(p, ChainTask(space, Path3(std::move(v), pt.durations, pt.shape), dt)).second;
   }
   const SampledPath& path_of(const StudyTask& t, const TaskPlacement& p, double dt) {
     use(t);
@@ -212,7 +212,7 @@ RunOutcome run_trajectory(const Scenario& sc, const TrajectoryRun& run, int stri
   if (ik_error > 0.0) return ended(RunStatus::out_of_reach);
   double duration = 0.0;
   for (double d : task.durations) duration += d;
-  if (!samples_path(task.durations, run.options.dt) || !(duration / run.options.dt < kMaxRunSamples))
+  if (!samples_path(task.sampled_spans(), run.options.dt) || !(duration / run.options.dt < kMaxRunSamples))
     return ended(RunStatus::undersampled);  // a swept dt (or time scale) the path cannot be sampled at
   RunOutcome out;
   if (sc.chain) {
@@ -330,7 +330,7 @@ RunOutcome run_ik(const Scenario& sc, const IkRun& run, int stride, RunWorkspace
 const TrajectoryRun* lane_run(const Scenario& sc, const RunSpec& run) {
   const auto* t = std::get_if<TrajectoryRun>(&run);
   return t && !sc.chain && t->options.method != TrajectoryMethod::global_spline && t->placement.identity() &&
-                 !t->placement.measured && samples_path(sc.task->durations, t->options.dt)
+                 !t->placement.measured && samples_path(sc.task->sampled_spans(), t->options.dt)
              ? t
              : nullptr;
 }

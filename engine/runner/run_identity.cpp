@@ -81,6 +81,8 @@ void task_fields(const Study& s, std::vector<ContextField>& out) {
   }
   add("vertices", v + "]");
   add("durations", list(t.durations));
+  // a spline through the same points is another path; a quintic task lists no shape (its context as before)
+  if (t.shape != PathShape::quintic) add("spline", std::string(to_string(t.shape)));
   add("dt", num(t.dt));
   add("integrator", t.integrator == Integrator::rk4 ? "rk4" : "semi_implicit_euler");
   add("orientation [rad]", t.hold_orientation ? "hold" : list(t.orientation));

@@ -16,9 +16,14 @@ std::string Parser::domain_problem(const ParamDef& info, double v) {
   return "";
 }
 
-std::string Parser::sampling_problem(const std::vector<double>& durations, double dt) const {
-  if (durations.empty() || samples_path(durations, dt)) return "";
-  const double shortest = *std::min_element(durations.begin(), durations.end());
+std::string Parser::sampling_problem(const StudyTask& task, double dt) const {
+  const std::vector<double> spans = task.sampled_spans();
+  if (task.durations.empty() || samples_path(spans, dt)) return "";
+  const double shortest = *std::min_element(spans.begin(), spans.end());
+  if (task.shape != PathShape::quintic)
+    return "dt = " + fmt(dt) + " s samples the " + fmt(shortest) + " s spline path " + fmt(shortest / dt) +
+           " times; expected at least " + fmt(kMinSamplesPerSegment) + " samples on the path (dt <= " +
+           fmt(shortest / kMinSamplesPerSegment) + " s; a dt axis may go beyond: those runs end undersampled)";
   return "dt = " + fmt(dt) + " s samples the shortest segment (" + fmt(shortest) + " s) " + fmt(shortest / dt) +
          " times; expected at least " + fmt(kMinSamplesPerSegment) + " samples per segment (dt <= " +
          fmt(shortest / kMinSamplesPerSegment) + " s; a dt axis may go beyond: those runs end undersampled)";
@@ -30,12 +35,12 @@ void Parser::check_block_dt(const BlockDraft& d, const Study& s) {
     if (const toml::node* v = d.table.get("variables"); v && v->as_table() && v->as_table()->get("dt")) return;
   for (const auto& [name, v] : d.spec.fixed)
     if (name == "dt") {
-      if (auto p = sampling_problem(s.task.durations, std::get<double>(v)); !p.empty()) error(*d.table.get("dt"), p);
+      if (auto p = sampling_problem(s.task, std::get<double>(v)); !p.empty()) error(*d.table.get("dt"), p);
       return;
     }
   if (task_dt_reported_ || s.task.durations.empty()) return;
   const double dt = s.task.dt;
-  std::string p = sampling_problem(s.task.durations, dt);
+  std::string p = sampling_problem(s.task, dt);
   if (p.empty() && !task_dt_pos_) {  // the default dt: the path's length bounds it too
     p = domain_problem(*find_param(block_params(BlockKind::trajectory), "dt"), dt);
     if (!p.empty()) p = "the default " + p + " (set [task] dt)";

@@ -2,6 +2,7 @@
 // Internal to engine/study (not included from outside it): the study parser. One Parser reads one
 // study text; its parts live in the files named for their jobs:
 //   study_tables.cpp     [study], [task]
+//   task_waypoints.cpp   [task] waypoints and spline: the spline form of the task's path
 //   robot_table.cpp      [robot]: the seed 3R, an n-link planar arm or a URDF robot
 //   robot_dh.cpp         [robot] dh: a standard DH table (in the study or a robot file)
 //   axes.cpp             parameter values and the [block.axes] forms (values, range, linspace, random, lhs)
@@ -112,6 +113,9 @@ class Parser : public ParserCore {
   void parse_task(const toml::table& root, Study& s);
   /// The task's orientation key (after the vertices): per-vertex angles (planar) or "hold" (spatial).
   void parse_task_orientation(const toml::table& t, Study& s);
+  /// task_waypoints.cpp: [task] waypoints = [[t, x, y(, z)], ...] and spline = "natural" | "clamped"
+  /// (a cubic spline through timed waypoints). False when the waypoints are unusable (reported).
+  bool parse_task_waypoints(const toml::table& t, Study& s);
   /// The path's vertices against the robot's reach (chains); the task's equations against its joints.
   void check_task_fits_robot(const toml::table* task, Study& s);
 
@@ -202,8 +206,8 @@ class Parser : public ParserCore {
   /// Check a stored numeric value's domain (expects file units for messages). Empty when fine.
   std::string domain_problem(const ParamDef& info, double file_value);
   /// Why dt [s] cannot sample the task's path in every run ("" when it can): fewer than
-  /// kMinSamplesPerSegment samples on a segment.
-  std::string sampling_problem(const std::vector<double>& durations, double dt) const;
+  /// kMinSamplesPerSegment samples on a segment (a spline: on the whole path; StudyTask::sampled_spans).
+  std::string sampling_problem(const StudyTask& task, double dt) const;
   /// Why a generated value `v` (file units) of the axis `what` cannot be the parameter's ("" when it can).
   std::string value_problem(const ParamDef& info, const std::string& what, double v);
   /// A count >= 1 and at most max_runs, and from <= to (random and linspace axes); false after reporting.

@@ -18,7 +18,7 @@
 #include "model/chain_plane.hpp"
 #include "optimize/optimize.hpp"
 #include "space/space.hpp"
-#include "task/quintic_path.hpp"
+#include "task/task_path.hpp"
 
 namespace ks {
 
@@ -72,17 +72,30 @@ struct HistoryPolicy {
   static bool parse(const std::string& s, HistoryPolicy& p);
 };
 
+/// The task's path: vertices and segment durations joined by rest-to-rest quintics ([task] vertices,
+/// durations), or timed waypoints joined by a cubic spline ([task] waypoints, spline): then `vertices`
+/// are the waypoints and `durations` the differences of their times.
 struct StudyTask {
   std::vector<Eigen::Vector2d> vertices;  ///< x, y [m]
   std::vector<double> z;                  ///< vertex heights [m] (spatial robots; empty: planar, z = 0)
   std::vector<double> durations;          ///< [s], vertices.size() - 1 values
+  PathShape shape = PathShape::quintic;   ///< how the path joins the vertices
   double dt = 1e-3;                       ///< [s]
   Integrator integrator = Integrator::semi_implicit_euler;
   /// The tip orientation along the path: planar robots, one angle per vertex [rad] (a quintic between
   /// them); empty with hold_orientation false: a position task.
   std::vector<double> orientation;
   bool hold_orientation = false;          ///< spatial robots: the start's tip orientation held along the path
-  Path2 path() const { return Path2(vertices, durations); }
+  Path2 path() const { return Path2(vertices, durations, shape); }
+  /// The spans [s] the sampling rule (samples_path: at least kMinSamplesPerSegment samples on each)
+  /// applies to: every segment of a quintic path (each a motion from rest to rest); the whole path of a
+  /// spline (one motion through its waypoints, whatever their spacing).
+  std::vector<double> sampled_spans() const {
+    if (shape == PathShape::quintic) return durations;
+    double total = 0.0;
+    for (double d : durations) total += d;
+    return {total};
+  }
   Eigen::Vector3d vertex(std::size_t i) const {
     return {vertices[i].x(), vertices[i].y(), i < z.size() ? z[i] : 0.0};
   }

@@ -85,12 +85,24 @@ void Parser::parse_task(const toml::table& root, Study& s) {
     error(*n, "'task' is " + type_name(*n) + "; expected a [task] table");
     return;
   }
-  check_keys(*t, {"vertices", "durations", "dt", "integrator", "orientation"}, "[task]");
+  check_keys(*t, {"vertices", "durations", "waypoints", "spline", "dt", "integrator", "orientation"}, "[task]");
   const bool spatial = s.chain && !s.chain->planar();
   const std::size_t dims = spatial ? 3 : 2;
   const std::string point = spatial ? "[x, y, z]" : "[x, y] (plane coordinates) or [x, y, z] (base frame, on the plane)";
   bool vertices_ok = true;
-  if (const toml::node* vn = t->get("vertices")) {
+  // the path: timed waypoints joined by a spline, or vertices and durations joined by quintics
+  const toml::node* wn = t->get("waypoints");
+  if (wn) {
+    for (const char* key : {"vertices", "durations"})
+      if (const toml::node* k = t->get(key))
+        error(*k, std::string(key) + " given with waypoints; expected either waypoints = [[t, x, y], ...] (a spline "
+                                     "through timed waypoints) or vertices and durations (quintics), not both");
+    vertices_ok = parse_task_waypoints(*t, s);
+  } else if (const toml::node* sn = t->get("spline")) {
+    error(*sn, "spline given without waypoints; expected [task] waypoints = [[t, x, y], ...] with it (a spline "
+               "joins timed waypoints; vertices and durations are joined by rest-to-rest quintics)");
+  }
+  if (const toml::node* vn = wn ? nullptr : t->get("vertices")) {
     const auto* a = vn->as_array();
     if (!a || a->size() < 2) {
       error(*vn, "vertices is " + (a ? "an array of " + std::to_string(a->size()) : type_name(*vn)) +
@@ -129,7 +141,7 @@ void Parser::parse_task(const toml::table& root, Study& s) {
       }
     }
   }
-  if (const toml::node* dn = t->get("durations")) {
+  if (const toml::node* dn = wn ? nullptr : t->get("durations")) {
     const auto* a = dn->as_array();
     if (!a) error(*dn, "durations is " + type_name(*dn) + "; expected an array of segment durations [s]");
     else {
@@ -154,7 +166,10 @@ void Parser::parse_task(const toml::table& root, Study& s) {
     path_duration_ = 0;
     for (double d : s.task.durations) path_duration_ += d;
   }
-  path_pos_ = pos_of((t->get("durations") ? t->get("durations") : static_cast<const toml::node*>(t))->source());
+  path_pos_ = pos_of((wn                    ? wn
+                      : t->get("durations") ? t->get("durations")
+                                            : static_cast<const toml::node*>(t))
+                         ->source());
   if (t->get("dt")) task_dt_pos_ = pos_of(t->get("dt")->source());
   if (auto v = get_number(*t, "dt", "dt")) {
     if (auto p = domain_problem(*find_param(block_params(BlockKind::trajectory), "dt"), *v); !p.empty()) error(*t->get("dt"), p + " [s]");
@@ -185,7 +200,8 @@ void Parser::parse_task_orientation(const toml::table& t, Study& s) {
   const auto* a = n->as_array();
   if (!a || a->size() != s.task.vertices.size()) {
     error(*n, "orientation is " + (a ? "an array of " + std::to_string(a->size()) : type_name(*n)) + "; expected " +
-                  std::to_string(s.task.vertices.size()) + " tip angles [deg], one per vertex");
+                  std::to_string(s.task.vertices.size()) + " tip angles [deg], one per " +
+                  (s.task.shape == PathShape::quintic ? "vertex" : "waypoint"));
     return;
   }
   std::vector<double> o;
@@ -253,7 +269,9 @@ void Parser::check_task_fits_robot(const toml::table* task, Study& s) {
                                  ? " plus the prismatic travels"
                                  : "");
   const std::string from = reach.in_plane ? "the first joint's axis" : "the first joint";
-  const toml::node* vn = task ? task->get("vertices") : nullptr;
+  const bool waypoints = task && task->get("waypoints");
+  const toml::node* vn = task ? task->get(waypoints ? "waypoints" : "vertices") : nullptr;
+  const std::string word = waypoints ? "waypoint " : "vertex ";
   for (std::size_t i = 0; i < s.task.vertices.size(); ++i) {
     Eigen::Vector3d v = s.task.vertex(i) - reach.centre;
     if (reach.in_plane) v.z() = 0.0;
@@ -263,7 +281,7 @@ void Parser::check_task_fits_robot(const toml::table* task, Study& s) {
       const std::string hole = fmt(reach.inner) + " m: twice the longest link, " + fmt(reach.longest) +
                                " m, minus the sum of the links, " + fmt(reach.bound) + " m, in the plane of motion";
       error(at ? pos_of(at->source()) : vn ? pos_of(vn->source()) : task ? pos_of(task->source()) : Pos{1, 1},
-            "vertex " + std::to_string(i + 1) + (at ? "" : " of the default path (the seed's square)") + " is " + fmt(d) +
+            word + std::to_string(i + 1) + (at ? "" : " of the default path (the seed's square)") + " is " + fmt(d) +
                 " m from " + from + ", inside the disc the robot cannot reach (no tip position closer than " + hole +
                 "); expected [task] vertices at least " + fmt(reach.inner) + " m from " + from);
       if (!at) return;
@@ -271,8 +289,8 @@ void Parser::check_task_fits_robot(const toml::table* task, Study& s) {
     }
     if (d <= reach.bound * (1 + 1e-12)) continue;
     if (at) {
-      error(*at, "vertex " + std::to_string(i + 1) + " is " + fmt(d) + " m from " + from +
-                     ", beyond the robot's reach (at most " + bound + "); expected a vertex within " + fmt(reach.bound) +
+      error(*at, word + std::to_string(i + 1) + " is " + fmt(d) + " m from " + from +
+                     ", beyond the robot's reach (at most " + bound + "); expected a " + word + "within " + fmt(reach.bound) +
                      " m of " + from);
     } else {
       error(vn ? pos_of(vn->source()) : task ? pos_of(task->source()) : Pos{1, 1},
