@@ -24,12 +24,13 @@ bool Parser::parse_task_waypoints(const toml::table& t, Study& s) {
   const toml::node& wn = *t.get("waypoints");
   const bool spatial = s.chain && !s.chain->planar();
   const std::size_t dims = spatial ? 3 : 2;
-  const std::string point = spatial ? "[t, x, y, z]"
-                                    : "[t, x, y] (plane coordinates) or [t, x, y, z] (base frame, on the plane)";
+  const std::string point = spatial ? "[t, x, y, z] (t in s, x, y, z in m)"
+                                    : "[t, x, y] (t in s, x, y in m, plane coordinates) or [t, x, y, z] (base frame, "
+                                      "on the plane)";
   const auto* a = wn.as_array();
   if (!a || a->size() < 2) {
     error(wn, "waypoints is " + (a ? "an array of " + std::to_string(a->size()) : type_name(wn)) +
-                  "; expected an array of at least 2 " + point + " waypoints (time [s], position [m])");
+                  "; expected an array of at least 2 waypoints " + point);
     return false;
   }
   std::vector<Eigen::Vector2d> v;
@@ -40,7 +41,7 @@ bool Parser::parse_task_waypoints(const toml::table& t, Study& s) {
     const bool base_point = !spatial && s.plane && p && p->size() == 4;  // a planar robot's waypoint, base frame
     if (!p || (p->size() != dims + 1 && !base_point)) {
       error(e, "a waypoint is " + (p ? "an array of " + std::to_string(p->size()) : type_name(e)) + "; expected " +
-                   point + " (time [s], position [m])" + (spatial ? " (the robot is spatial)" : ""));
+                   point + (spatial ? " (the robot is spatial)" : ""));
       ok = false;
       continue;
     }
