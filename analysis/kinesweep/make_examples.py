@@ -3,7 +3,8 @@
 
     python3 -m kinesweep.make_examples [--kinesweep build/kinesweep] [--work /tmp/ks_examples]
 
-Runs the small studies studies/examples_*.toml and studies/thesis_table4.toml (seconds), and the small
+Runs the small studies studies/examples_*.toml, studies/thesis_table4.toml and studies/placement_scara1.toml
+(seconds), and the small
 optimisation study below (OPTIMIZATION_STUDY, written to the work directory), then every plot script at
 800x600 (basins 1200x500), dpi 100. results/examples/report.png (a screenshot of the page of
 kinesweep.report, taken with headless Chromium) is not regenerated here: the analysis README says how
@@ -67,7 +68,8 @@ def main():
     os.makedirs(a.work, exist_ok=True)
     os.makedirs(a.out, exist_ok=True)
     h5 = {}
-    for s in ("thesis_table4", "examples_landscape", "examples_basins", "examples_convergence", "examples_lhs"):
+    for s in ("thesis_table4", "examples_landscape", "examples_basins", "examples_convergence", "examples_lhs",
+              "placement_scara1"):
         h5[s] = os.path.join(a.work, s + ".h5")
         subprocess.run([a.kinesweep, "run", os.path.join(ROOT, "studies", s + ".toml"), "-o", h5[s],
                         "--overwrite", "-q"], check=True, stdout=subprocess.DEVNULL)
@@ -96,6 +98,8 @@ def main():
         ("plot_runs", h5["examples_lhs"], "runs_slice_lambda.png",
          ["--view", "slice", "--block", "lm_lambda", "--size", "1100x450"]),
         ("plot_runs", h5["examples_lhs"], "runs_parcoords.png", ["--view", "parcoords"]),
+        ("plot_trade_off", h5["placement_scara1"], "trade_off_scara1.png",
+         ["--mark", f"{0.108 / 0.067},{5.261 / 6.451}:Santos 2007, Table 7.5 (k = 0.9)"]),
     ]
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [PACKAGE_PARENT, os.environ.get("PYTHONPATH")])))
     for command, f, out, extra in jobs:
