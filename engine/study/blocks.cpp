@@ -128,6 +128,7 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
   d.ctx.path_global = names_global_spline(d.table);
   d.ctx.placement = names_placement(d.table);
   check_robot_supports(d, s);
+  check_motion_world(d, s);
   reject_ineffective_axes(d);
   return finish_block(d, errors_before);
 }
@@ -419,6 +420,26 @@ void Parser::check_robot_supports(const BlockDraft& d, const Study& s) {
         error(a.pos, reason + " (the " + a.axis.name + " axis includes it); expected local methods only");
         return;
       }
+}
+
+void Parser::check_motion_world(const BlockDraft& d, const Study& s) {
+  if (d.kind != BlockKind::motion || s.world.has_obstacles()) return;
+  const auto positive = [](const Cell& v) {
+    const double* x = std::get_if<double>(&v);
+    return x && *x > 0.0;
+  };
+  const std::string why = "w_clearance weighs the least clearance from the [world] obstacles, and the study has none; "
+                          "expected w_clearance = 0, or [world] obstacles with link_radius";
+  for (const auto& [name, v] : d.spec.fixed)
+    if (name == "w_clearance" && positive(v)) {
+      error(d.table.get(name)->source(), why);
+      return;
+    }
+  for (const AxisDraft& a : d.drafts)
+    if (a.axis.name == "w_clearance" && std::any_of(a.axis.values.begin(), a.axis.values.end(), positive)) {
+      error(a.pos, why + " (the w_clearance axis has a positive value)");
+      return;
+    }
 }
 
 }  // namespace ks::study_parse

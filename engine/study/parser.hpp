@@ -184,6 +184,9 @@ class Parser : public ParserCore {
   std::string limit_hint() const;
   /// Checks the block's runs against the robot: redundancy left by the task, vertex_alpha's domain.
   void check_robot_supports(const BlockDraft& d, const Study& s);
+  /// Motion blocks of a study without obstacles: a positive w_clearance (fixed or an axis value) is
+  /// reported at its key (its reference, the clearance, is +inf: nothing to weigh).
+  void check_motion_world(const BlockDraft& d, const Study& s);
   /// Reads the axes against their controlling parameters; reports axes a run would ignore.
   void reject_ineffective_axes(const BlockDraft& d);
   /// Reads the draft into a Block unless a step reported since errors_before; reports a spec Block refuses.

@@ -9,8 +9,9 @@ read back with h5py.
 - every status is one of the kind's; a good run has no NaN metric but min_clearance without obstacles;
 - a sphere on the cubic's path: the cubic collides, and the solved run is never ok with a negative
   clearance (ok with min_clearance >= 0, or collision / infeasible);
-- parse errors are located: an unknown obstacle type, a link_radius of the wrong size, start_4 on a
-  3-joint robot, a motion block on the seed's closed-form 3R.
+- parse errors are located: an unknown obstacle type, a link_radius of the wrong size, a centre of 2
+  numbers, start_4 on a 3-joint robot, w_clearance without obstacles, a motion block on the seed's
+  closed-form 3R.
 
 usage: /usr/bin/python3 test_motion_runs.py KINESWEEP_BINARY ROBOTS_DIR
 """
@@ -146,6 +147,8 @@ class MotionRuns(TempDirTest):
                  'obstacles = [{ type = "box", centre = [1, 1], half = [0.1, 0.1, 0.1] }]\n\n')
         self.refused("bad_centre", study("bad_centre", [("m", "")], world), 10, ["centre is an array of 2"])
         self.refused("start4", study("start4", [("m", "start_4 = 10")]), 20, ["unknown key 'start_4'"])
+        self.refused("no_world", study("no_world", [("m", "w_clearance = 1")]), 20,
+                     ["w_clearance weighs the least clearance", "[world] obstacles with link_radius"])
         seed = '[study]\nname = "seed"\n\n[[block]]\nname = "m"\nkind = "motion"\n'
         self.refused("seed", seed, 6, ["closed-form 3R", "l = [1, 1, 1]"])
 
