@@ -101,7 +101,7 @@ std::vector<ParamDef> motion_params(const KindContext& ctx) {
   return t;
 }
 
-std::vector<MetricDef> motion_metrics(const KindContext&) {
+std::vector<MetricDef> motion_metrics(const KindContext& ctx) {
   using R = MotionResult;
   const auto f = [](std::string name, std::string unit, std::string what, auto get) {
     return metric<R>(std::move(name), CellType::f64, std::move(unit), std::move(what), true, get);
@@ -119,7 +119,8 @@ std::vector<MetricDef> motion_metrics(const KindContext&) {
         [](const R& r) { return r.peak_torque; }),
       f("jerk_sq_integral", "rad^2/s^5", "integral of the sum of squared joint jerks (exact per spline segment)",
         [](const R& r) { return r.jerk_sq; }),
-      f("min_manipulability", "", "least sqrt(det(J_p J_p^T)) over the samples (J_p: the tip's position rows)",
+      f("min_manipulability", ctx.robot.planar ? "m^2" : "m^3",
+        "least sqrt(det(J_p J_p^T)) over the samples (J_p: the tip's position rows)",
         [](const R& r) { return r.min_manipulability; }),
       f("min_clearance", "m", "least clearance of the link capsules from the [world] obstacles (NaN: no obstacles)",
         [](const R& r) { return r.min_clearance; }),
