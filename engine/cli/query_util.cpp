@@ -86,6 +86,7 @@ void v1_column_roles(std::vector<ColumnSpec>& columns) {
     if (!fresh) it->second.second += "," + kind;
   };
   for (const BlockKind k : block_kinds()) {
+    if (k == BlockKind::motion) continue;  // format v1 predates motion runs (and shares metric names with trajectory)
     const auto& ms = metrics(k);
     if (std::none_of(ms.begin(), ms.end(), [&](const MetricDef& m) { return names.count(m.name) > 0; }))
       continue;  // no block of this kind in the file

@@ -61,6 +61,9 @@ std::vector<Listed> listed() {
   spatial7.robot.joints = 7;
   spatial7.robot.planar = false;
   spatial7.first_vertex = {0.5, 0.0, 0.5};
+  KindContext arm3 = spatial7;  // a spatial arm of 3 revolute joints (motion runs: chain robots only)
+  arm3.robot.joints = 3;
+  arm3.path_global = arm3.placement = false;
   KindContext seed;  // the seed's 3R, with the columns of global_spline (present in blocks that run it)
   seed.path_global = true;
   seed.placement = true;
@@ -70,7 +73,8 @@ std::vector<Listed> listed() {
           {BlockKind::trajectory, "chain_planar", planar4},
           {BlockKind::ik, "chain_planar", planar4},
           {BlockKind::trajectory, "chain_spatial", spatial7},
-          {BlockKind::ik, "chain_spatial", spatial7}};
+          {BlockKind::ik, "chain_spatial", spatial7},
+          {BlockKind::motion, "chain_spatial", arm3}};
 }
 bool is_chain(const Listed& l) { return l.context.robot.chain; }
 
@@ -83,11 +87,17 @@ void print_schema_markdown(std::ostream& os) {
     if (kind == BlockKind::ik) os << "; where they differ, planar3r problems after the semicolon";
     os << ")";
     if (kind == BlockKind::trajectory) os << "; one `vertex_alpha_<i>` per path vertex after the first (the square: 2 .. 5)";
+    if (kind == BlockKind::motion)
+      os << "; chain robots only, one `start_<i>` and `goal_<i>` per joint (here a 3-joint arm), deg for revolute "
+            "joints, m for prismatic ones";
     os << ":\n\n| column | type | unit | domain | default | has an effect | description |\n"
           "|---|---|---|---|---|---|---|\n";
     std::vector<const Listed*> ctx;
     for (const Listed& l : all)
       if (l.kind == kind && !is_chain(l)) ctx.push_back(&l);
+    const bool chain_only = ctx.empty();  // motion runs: chain robots only (here a 3-joint spatial arm)
+    for (const Listed& l : all)
+      if (chain_only && l.kind == kind && ctx.empty()) ctx.push_back(&l);
     std::vector<std::vector<ParamDef>> tables;
     std::vector<RunSpec> defaults;
     for (const Listed* l : ctx) {
@@ -116,30 +126,32 @@ void print_schema_markdown(std::ostream& os) {
          << " |\n";
     }
     // the columns a chain robot adds (n-link planar arms, URDF robots), and those it has not
-    std::set<std::string> seed_names;
-    for (const auto& t : tables)
-      for (const ParamDef& p : t) seed_names.insert(p.name);
-    std::set<std::string> shown, chain_names;
-    os << "\nOn a chain robot (`[robot]` with n links or a URDF file; here a 4-link planar arm and a 7-joint spatial "
-          "arm) `"
-       << to_string(kind) << "` runs also have:\n\n| column | type | unit | default | has an effect | description |\n"
-       << "|---|---|---|---|---|---|\n";
-    for (const Listed& l : all) {
-      if (l.kind != kind || !is_chain(l)) continue;
-      const RunSpec d = default_run(kind, l.context);
-      for (const ParamDef& p : params(kind, l.context)) {
-        chain_names.insert(p.name);
-        if (seed_names.count(p.name) || !shown.insert(p.name).second) continue;
-        const std::string unit = p.file_unit_name() == p.unit ? (p.unit.empty() ? "-" : p.unit)
-                                                              : p.file_unit_name() + " / " + p.unit;
-        os << "| `" << p.name << "` | " << type_name(p.type) << " | " << unit << " | " << file_value(p, d) << " | "
-           << p.effect.str() << " | " << cell(p.description) << " |\n";
+    if (!chain_only) {
+      std::set<std::string> seed_names;
+      for (const auto& t : tables)
+        for (const ParamDef& p : t) seed_names.insert(p.name);
+      std::set<std::string> shown, chain_names;
+      os << "\nOn a chain robot (`[robot]` with n links or a URDF file; here a 4-link planar arm and a 7-joint spatial "
+            "arm) `"
+         << to_string(kind) << "` runs also have:\n\n| column | type | unit | default | has an effect | description |\n"
+         << "|---|---|---|---|---|---|\n";
+      for (const Listed& l : all) {
+        if (l.kind != kind || !is_chain(l)) continue;
+        const RunSpec d = default_run(kind, l.context);
+        for (const ParamDef& p : params(kind, l.context)) {
+          chain_names.insert(p.name);
+          if (seed_names.count(p.name) || !shown.insert(p.name).second) continue;
+          const std::string unit = p.file_unit_name() == p.unit ? (p.unit.empty() ? "-" : p.unit)
+                                                                : p.file_unit_name() + " / " + p.unit;
+          os << "| `" << p.name << "` | " << type_name(p.type) << " | " << unit << " | " << file_value(p, d) << " | "
+             << p.effect.str() << " | " << cell(p.description) << " |\n";
+        }
       }
+      std::string absent;
+      for (const std::string& n : seed_names)
+        if (!chain_names.count(n)) absent += (absent.empty() ? "" : ", ") + ("`" + n + "`");
+      if (!absent.empty()) os << "\nNot on chain robots: " << absent << ".\n";
     }
-    std::string absent;
-    for (const std::string& n : seed_names)
-      if (!chain_names.count(n)) absent += (absent.empty() ? "" : ", ") + ("`" + n + "`");
-    if (!absent.empty()) os << "\nNot on chain robots: " << absent << ".\n";
     os << "\nMetrics of `" << to_string(kind) << "` runs (per-joint metrics: one per joint of the robot, "
           "as many as it has):\n\n| column | type | unit | in /landscapes | description |\n"
           "|---|---|---|---|---|\n";

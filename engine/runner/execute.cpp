@@ -18,6 +18,7 @@
 #include "methods/chain/trajectory.hpp"
 #include "methods/base/trajectory.hpp"
 #include "methods/closed_form/lanes.hpp"
+#include "runner/execute_motion.hpp"
 #include "runner/placed_task.hpp"
 #include "schema/history_arrays.hpp"
 
@@ -338,6 +339,7 @@ const TrajectoryRun* lane_run(const Scenario& sc, const RunSpec& run) {
 RunOutcome execute(const Scenario& scenario, const RunSpec& run, int history_stride, RunWorkspace& workspace) {
   if (const auto* t = std::get_if<TrajectoryRun>(&run))
     return run_trajectory(scenario, *t, history_stride, workspace.impl());
+  if (const auto* m = std::get_if<MotionRun>(&run)) return run_motion(scenario, *m, history_stride);
   return run_ik(scenario, std::get<IkRun>(run), history_stride, workspace.impl());
 }
 

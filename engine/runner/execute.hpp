@@ -15,8 +15,11 @@ struct Scenario {
   const StudyTask* task = nullptr;
   const Chain* chain = nullptr;       ///< the study's chain robot; null: the closed-form 3R
   const Chain* ik_chain = nullptr;    ///< the chain of the position / pose IK problems (chain, or the 3R as one)
+  const Chain* base_chain = nullptr;  ///< the chain robot in its base frame (motion runs; null: the 3R)
+  const World* world = nullptr;       ///< the study's obstacles and link radii (motion runs; may be null)
   static Scenario of(const Study& s) {
-    return {&s.robot, &s.task, s.chain.get(), s.arm_chain ? s.arm_chain.get() : s.chain.get()};
+    return {&s.robot, &s.task, s.chain.get(), s.arm_chain ? s.arm_chain.get() : s.chain.get(),
+            s.base_chain ? s.base_chain.get() : s.chain.get(), &s.world};
   }
 };
 

@@ -126,11 +126,28 @@ Digest sha256(const std::string& bytes) {
 
 }  // namespace
 
+/// The [world] (motion runs read it): each obstacle and the link radii, listed only when given (a
+/// study without [world] keeps the context it had before [world] existed).
+void world_fields(const Study& s, std::vector<ContextField>& out) {
+  auto add = [&](std::string key, std::string value) { out.push_back({"world", "[world] " + key, std::move(value)}); };
+  for (std::size_t i = 0; i < s.world.obstacles.size(); ++i) {
+    const std::string k = "obstacle " + std::to_string(i + 1);
+    const geometry::Obstacle& o = s.world.obstacles[i];
+    if (const auto* p = std::get_if<geometry::Sphere>(&o)) add(k, "sphere centre " + vec3(p->centre) + ", radius " + num(p->radius));
+    else if (const auto* b = std::get_if<geometry::Box>(&o))
+      add(k, "box centre " + vec3(b->centre) + ", R " + mat3(b->rotation) + ", half " + vec3(b->half));
+    else if (const auto* c = std::get_if<geometry::Capsule>(&o))
+      add(k, "capsule a " + vec3(c->a) + ", b " + vec3(c->b) + ", radius " + num(c->radius));
+  }
+  if (!s.world.link_radius.empty()) add("link_radius", list(s.world.link_radius));
+}
+
 std::vector<ContextField> run_context(const Study& study, const HistoryPolicy& histories,
                                       const std::string& engine_version) {
   std::vector<ContextField> out;
   robot_fields(study, out);
   task_fields(study, out);
+  world_fields(study, out);
   out.push_back({"settings", "[study] histories", histories.str()});
   out.push_back({"settings", "kinesweep version", engine_version});
   return out;

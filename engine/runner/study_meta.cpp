@@ -39,6 +39,7 @@ std::vector<store::KindMeta> kind_meta(const Study& study) {
     std::vector<std::string> ranked{std::string(rank.objective)};
     if (!rank.tie.empty()) ranked.emplace_back(rank.tie);
     const auto arrays = kind == BlockKind::trajectory ? trajectory_history_arrays(study.robot_shape())
+                        : kind == BlockKind::motion   ? motion_history_arrays(study.robot_shape())
                                                       : ik_history_arrays(IkProblem::scara, study.robot_shape());
     std::vector<std::string> names, units;
     for (const auto& a : arrays) names.push_back(a.name), units.push_back(a.unit);
@@ -49,7 +50,7 @@ std::vector<store::KindMeta> kind_meta(const Study& study) {
                {"objectives", objective_names(block->metrics())},
                {"history_arrays", names},
                {"resume_context", strings(context_parts(kind))}};
-    if (kind == BlockKind::trajectory) k.lists.emplace_back("history_units", units);
+    if (kind != BlockKind::ik) k.lists.emplace_back("history_units", units);
     out.push_back(std::move(k));
   }
   return out;

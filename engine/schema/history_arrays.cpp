@@ -50,6 +50,16 @@ std::vector<HistoryArrayDef> trajectory_history_arrays(const RobotShape& robot) 
   };
 }
 
+std::vector<HistoryArrayDef> motion_history_arrays(const RobotShape& robot) {
+  const auto n = static_cast<std::size_t>(robot.joints);
+  return {
+      {"t", "s", 1, "time of the sample (the samples the criteria are integrated on)"},
+      {"q", joint_units(robot, "rad", "m"), n, "joint positions"},
+      {"qd", joint_units(robot, "rad/s", "m/s"), n, "joint velocities"},
+      {"tau", joint_units(robot, "Nm", "N"), n, "joint torques (forces for prismatic joints), RNEA"},
+  };
+}
+
 std::vector<HistoryArrayDef> ik_history_arrays(IkProblem problem, const RobotShape& robot) {
   // A norm's unit: its components' one unit, "problem units" when they mix units (q in rad and mm).
   std::string q_unit, f_unit = "problem units", norm_unit = "problem units", step_unit;

@@ -22,6 +22,9 @@ struct HistoryArrayDef {
 /// The history arrays of a trajectory run of `robot` (t, q, qd, qdd, tau, x, alpha), in the order
 /// the executor writes them.
 std::vector<HistoryArrayDef> trajectory_history_arrays(const RobotShape& robot);
+/// The history arrays of a motion run of `robot` (t, q, qd, tau at its samples), in the order the
+/// executor writes them.
+std::vector<HistoryArrayDef> motion_history_arrays(const RobotShape& robot);
 /// The history arrays of an ik run of `problem` on `robot` (the arm of the chain problems; the seed's
 /// problems have their own 3 joints): k, q, F, norm_F, step, lambda.
 std::vector<HistoryArrayDef> ik_history_arrays(IkProblem problem, const RobotShape& robot);

@@ -12,7 +12,8 @@
 namespace ks {
 
 namespace {
-constexpr NameTable<BlockKind, 2> kKinds{{{BlockKind::trajectory, "trajectory"}, {BlockKind::ik, "ik"}}};
+constexpr NameTable<BlockKind, 3> kKinds{
+    {{BlockKind::trajectory, "trajectory"}, {BlockKind::ik, "ik"}, {BlockKind::motion, "motion"}}};
 constexpr NameTable<InertiaForm, 2> kInertia{{{InertiaForm::physical, "physical"},
                                               {InertiaForm::thesis_m11, "thesis_m11"}}};
 constexpr NameTable<IkProblem, 5> kProblems{{{IkProblem::scara, "scara"},
@@ -21,7 +22,7 @@ constexpr NameTable<IkProblem, 5> kProblems{{{IkProblem::scara, "scara"},
                                              {IkProblem::position, "position"},
                                              {IkProblem::pose, "pose"}}};
 constexpr NameTable<ZMode, 3> kZModes{{{ZMode::unset, ""}, {ZMode::thesis, "thesis"}, {ZMode::physical, "physical"}}};
-constexpr std::array<BlockKind, 2> kKindList{BlockKind::trajectory, BlockKind::ik};
+constexpr std::array<BlockKind, 3> kKindList{BlockKind::trajectory, BlockKind::ik, BlockKind::motion};
 }  // namespace
 
 std::string_view to_string(BlockKind k) { return name_of(kKinds, k); }
@@ -35,10 +36,12 @@ bool parse(std::string_view n, ZMode& out) { return value_of(kZModes, n, out); }
 
 bool RunOutcome::good() const {
   if (const auto* t = std::get_if<TrajectoryMetrics>(&result)) return t->status == RunStatus::ok;
+  if (const auto* m = std::get_if<MotionResult>(&result)) return m->status == MotionStatus::ok;
   return std::get<IkResult>(result).status == ik::Status::converged;
 }
 std::string_view RunOutcome::status() const {
   if (const auto* t = std::get_if<TrajectoryMetrics>(&result)) return to_string(t->status);
+  if (const auto* m = std::get_if<MotionResult>(&result)) return to_string(m->status);
   return ik::to_string(std::get<IkResult>(result).status);
 }
 
@@ -71,6 +74,7 @@ ColumnSpec MetricDef::column(BlockKind kind) const {
 std::span<const BlockKind> block_kinds() { return kKindList; }
 
 std::vector<ParamDef> params(BlockKind kind, const KindContext& context) {
+  if (kind == BlockKind::motion) return motion_params(context);
   return kind == BlockKind::trajectory ? trajectory_params(context) : ik_params(context);
 }
 const ParamDef* find_param(const std::vector<ParamDef>& table, std::string_view name) {
@@ -79,20 +83,26 @@ const ParamDef* find_param(const std::vector<ParamDef>& table, std::string_view 
   return nullptr;
 }
 std::vector<MetricDef> metrics(BlockKind kind, const KindContext& context) {
+  if (kind == BlockKind::motion) return motion_metrics(context);
   return kind == BlockKind::trajectory ? trajectory_metrics(context) : ik_metrics(context);
 }
 Ranking ranking(BlockKind kind) {
   if (kind == BlockKind::trajectory) return {"E", ""};
+  if (kind == BlockKind::motion) return {"objective", ""};
   return {"iterations", "error"};
 }
 std::span<const std::string_view> key_metrics(BlockKind kind) {
-  static const std::array<std::string_view, 3> trajectory{"E", "E_M", "tau_inf"}, ik{"iterations", "error", "solution"};
+  static const std::array<std::string_view, 3> trajectory{"E", "E_M", "tau_inf"}, ik{"iterations", "error", "solution"},
+      motion{"objective", "torque_sq_integral", "power_sq_integral"};
+  if (kind == BlockKind::motion) return motion;
   return kind == BlockKind::trajectory ? trajectory : ik;
 }
 std::span<const std::string_view> context_parts(BlockKind kind) {
   static const std::array<std::string_view, 3> trajectory{"robot", "task", "settings"};
   static const std::array<std::string_view, 2> ik{"robot", "settings"};
+  static const std::array<std::string_view, 3> motion{"robot", "world", "settings"};
   if (kind == BlockKind::trajectory) return trajectory;
+  if (kind == BlockKind::motion) return motion;
   return ik;
 }
 std::vector<std::string> objective_names(const std::vector<MetricDef>& metrics) {
@@ -118,7 +128,11 @@ std::span<const std::string_view> statuses(BlockKind kind) {
       ik::to_string(Status::converged), ik::to_string(Status::stalled),  ik::to_string(Status::singular),
       ik::to_string(Status::max_iter),  ik::to_string(Status::cycle),    ik::to_string(Status::diverged),
       ik::to_string(Status::unsupported), ik::to_string(Status::no_solution), ik::to_string(Status::out_of_limits)};
+  static const std::array<std::string_view, 5> motion{
+      to_string(MotionStatus::ok), to_string(MotionStatus::infeasible), to_string(MotionStatus::collision),
+      to_string(MotionStatus::max_evaluations), to_string(MotionStatus::failure)};
   if (kind == BlockKind::trajectory) return trajectory;
+  if (kind == BlockKind::motion) return motion;
   return ik;
 }
 
@@ -131,6 +145,7 @@ bool identity_neutral(std::string_view name, const Cell& value) {
 }
 
 RunSpec default_run(BlockKind kind, const KindContext& c) {
+  if (kind == BlockKind::motion) return MotionRun::defaults(c.robot.prismatic, c.robot.joints);
   if (kind == BlockKind::ik) {
     if (c.scara) return IkRun{};
     if (c.robot.chain) return IkRun::chain_defaults(c.robot.prismatic, c.robot.joints, c.first_vertex, c.robot.limited);

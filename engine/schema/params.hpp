@@ -110,16 +110,19 @@ std::span<const BlockKind> block_kinds();
 /// The parameters of a kind, in /runs column order. Trajectory: preset, method, k, alpha1A, K_N,
 /// vertex_alpha_2 .. vertex_alpha_<path_vertices>, integrator, dt, torque_bound, inertia. IK:
 /// problem, method, lambda, q0_1 .. q0_3, target_x, target_y, target_z, target_alpha, tol, max_iter, z_mode.
+/// Motion: start_1 .. start_n, goal_1 .. goal_n, duration, vary_duration, ..., the weights w_*, normalise,
+/// solve, starts, max_evaluations, clearance_margin (schema/motion_table.cpp).
 std::vector<ParamDef> params(BlockKind kind, const KindContext& context = {});
 /// The parameter named `name` in `table`, or nullptr.
 const ParamDef* find_param(const std::vector<ParamDef>& table, std::string_view name);
 /// The metrics of a kind, in /runs column order (per-joint metrics: one per joint of context.robot).
 std::vector<MetricDef> metrics(BlockKind kind, const KindContext& context = {});
-/// The status names of a kind, in enum order (the first is the good one: ok / converged).
+/// The status names of a kind, in enum order (the first is the good one: ok / converged / ok).
 std::span<const std::string_view> statuses(BlockKind kind);
 /// How the runs of a kind are ranked ("best"): the lowest `objective` metric among the runs whose
 /// status is the kind's good one (statuses(kind).front()), ties broken by the `tie` metric (lower
-/// first; none when empty), then by run id. Trajectory: E; ik: iterations, then error. The one
+/// first; none when empty), then by run id. Trajectory: E; ik: iterations, then error; motion:
+/// objective. The one
 /// rule of the run summary and `kinesweep info`.
 struct Ranking {
   std::string_view objective;
@@ -128,13 +131,15 @@ struct Ranking {
 Ranking ranking(BlockKind kind);
 
 /// The metrics a one-line summary of a run of the kind shows (query's compact table, info's best
-/// run), in order: trajectory E, E_M, tau_inf; ik iterations, error, solution.
+/// run), in order: trajectory E, E_M, tau_inf; ik iterations, error, solution; motion objective,
+/// torque_sq_integral, power_sq_integral.
 std::span<const std::string_view> key_metrics(BlockKind kind);
 
 /// The parts of a study's run context (runner/run_identity.hpp: "robot", "task", "settings") that a
 /// run of the kind reads besides its parameters; a change of any other part keeps the run's identity,
 /// so a resume of the edited study reuses it. Trajectory: robot, task, settings. IK: robot, settings
-/// (its target is a parameter, its initial guess too; it reads no path).
+/// (its target is a parameter, its initial guess too; it reads no path). Motion: robot, world ([world]:
+/// its obstacles and link radii), settings.
 std::span<const std::string_view> context_parts(BlockKind kind);
 
 /// True when parameter `name` at value `value` leaves a run as it is without that parameter: the task

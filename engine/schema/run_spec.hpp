@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 #include <variant>
+#include <vector>
 
 #include "common/angles.hpp"
 #include "ik/solve.hpp"
@@ -20,7 +21,7 @@
 namespace ks {
 
 /// The kinds of run a study block holds.
-enum class BlockKind { trajectory, ik };
+enum class BlockKind { trajectory, ik, motion };
 std::string_view to_string(BlockKind k);
 bool parse(std::string_view name, BlockKind& out);
 std::string_view to_string(InertiaForm f);
@@ -81,7 +82,55 @@ struct IkRun {
   bool chain() const { return problem == IkProblem::position || problem == IkProblem::pose; }
 };
 
-using RunSpec = std::variant<TrajectoryRun, IkRun>;
+/// One point-to-point motion of a chain robot (seed 002 Chapter 7): rest to rest from `start` to
+/// `goal` in `duration`, each joint a clamped cubic spline through `controls` values
+/// (motion/motion_problem.hpp), the weighted criteria minimised by motion::solve_motion, or only
+/// evaluated on the initial rest-to-rest cubic when !solve.
+struct MotionRun {
+  VecN start = VecN::Zero(3);           ///< start configuration [rad or m per joint]
+  VecN goal = VecN::Zero(3);            ///< goal configuration [rad or m per joint]
+  double duration = 1.0;                ///< T [s]; the start value when vary_duration
+  bool vary_duration = false;           ///< T is a variable within [min_duration, max_duration]
+  double min_duration = 0.1, max_duration = 100.0;  ///< [s]
+  int controls = 3;                     ///< K control values per joint (0: the cubic alone)
+  int samples = 201;                    ///< at least this many samples (motion_problem.hpp's rule)
+  /// Objective weights of f5 (torque_sq), f6 (power_sq), T, peak torque, jerk, manipulability, clearance.
+  double w_torque = 1.0, w_power = 0.0, w_time = 0.0, w_peak = 0.0, w_jerk = 0.0, w_manipulability = 0.0,
+         w_clearance = 0.0;
+  bool normalise = true;                ///< each term divided by the initial cubic's value (seed 002 Eq. 7.1)
+  bool solve = true;                    ///< false: evaluate the initial cubic only
+  int starts = 1;                       ///< SLSQP starts (the cubic, then seeded perturbations)
+  int max_evaluations = 500;            ///< SLSQP evaluations per start
+  double clearance_margin = 1e-3;       ///< clearance >= this at every window [m] (with obstacles)
+  static constexpr Domain controls_rule = Domain::within(0, 30);
+  static constexpr Domain samples_rule = Domain::within(2, 100000);
+  static constexpr Domain starts_rule = Domain::within(1, 1000);
+  static constexpr Domain evaluations_rule = Domain::within(1, 100000000);
+
+  /// The defaults for a robot of `joints` joints: from 0 to 30 deg at every revolute joint (0 m at
+  /// a prismatic one) in 1 s.
+  static MotionRun defaults(const std::vector<bool>& prismatic, int joints);
+};
+
+using RunSpec = std::variant<TrajectoryRun, IkRun, MotionRun>;
+
+/// How a motion run ended: ok (converged, within every limit and clear of the obstacles),
+/// infeasible (a limit or the clearance margin violated at the end), collision (least clearance < 0),
+/// max_evaluations (the budget ran out on a feasible point), failure (NLopt failed, the problem could
+/// not be set up, or a criterion is not finite).
+enum class MotionStatus { ok, infeasible, collision, max_evaluations, failure };
+std::string_view to_string(MotionStatus s);
+
+/// What a motion run returns to the store (NaN where not measured).
+struct MotionResult {
+  MotionStatus status = MotionStatus::failure;
+  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  double duration = kNaN, torque_sq = kNaN, power_sq = kNaN, peak_torque = kNaN, jerk_sq = kNaN,
+         min_manipulability = kNaN, min_clearance = kNaN;  ///< at the end (see motion::Criterion)
+  double torque_sq_0 = kNaN, power_sq_0 = kNaN;            ///< the initial cubic's f5, f6
+  double objective = kNaN, max_constraint = kNaN;
+  int evaluations = 0;
+};
 
 /// What an IK solve returns to the store (the Summary less its history).
 struct IkResult {
@@ -94,10 +143,10 @@ struct IkResult {
 
 /// The outcome of one run: its metrics with an enum status, and its history (empty when off).
 struct RunOutcome {
-  std::variant<TrajectoryMetrics, IkResult> result;
+  std::variant<TrajectoryMetrics, IkResult, MotionResult> result;
   RunHistory history;
 
-  /// ok (trajectory) or converged (ik)
+  /// ok (trajectory, motion) or converged (ik)
   bool good() const;
   /// The status name stored in /runs.
   std::string_view status() const;

@@ -54,6 +54,9 @@ void Parser::check_block_dt(const BlockDraft& d, const Study& s) {
 
 std::optional<Cell> Parser::param_value(const ParamDef& info, const toml::node& n) {
   if (info.type == CellType::str) {
+    // a yes/no parameter (choices false, true) takes a TOML boolean as its text
+    if (const auto* b = n.as_boolean(); b && info.choices == std::vector<std::string>{"false", "true"})
+      return Cell(std::string(b->get() ? "true" : "false"));
     const auto* s = n.as_string();
     if (!s) {
       error(n, info.name + " is " + type_name(n) + "; expected a string" +

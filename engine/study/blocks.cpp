@@ -106,6 +106,13 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
 
   read_block_name(d, names);
   if (!read_block_kind(d)) return std::nullopt;
+  if (d.kind == BlockKind::motion && !s.chain) {
+    error(d.table.get("kind")->source(),
+          "kind = \"motion\" plans the motions of a chain robot, not of the seed's closed-form 3R; expected a [robot] "
+          "chain: an n-link planar arm with recursive dynamics (e.g. [robot] l = [1, 1, 1] with dynamics = \"recursive\"), "
+          "a DH table or a URDF robot");
+    return std::nullopt;
+  }
   check_block_keys(d);
   find_axes_table(d);
   read_ik_family(d);
@@ -121,6 +128,7 @@ std::optional<Block> Parser::parse_block(const toml::table& b, std::size_t index
   d.ctx.path_global = names_global_spline(d.table);
   d.ctx.placement = names_placement(d.table);
   check_robot_supports(d, s);
+  check_motion_world(d, s);
   reject_ineffective_axes(d);
   return finish_block(d, errors_before);
 }
@@ -159,17 +167,19 @@ bool Parser::read_block_kind(BlockDraft& d) {
   if (auto v = get_string(b, "kind", "block kind")) {
     kind_ok = parse(*v, kind);
     if (!kind_ok)
-      error(*b.get("kind"), "unknown block kind '" + *v + "'; expected \"trajectory\" or \"ik\"" +
-                                suggest(*v, {"trajectory", "ik"}));
+      error(*b.get("kind"), "unknown block kind '" + *v + "'; expected \"trajectory\", \"ik\" or \"motion\"" +
+                                suggest(*v, {"trajectory", "ik", "motion"}));
   } else if (!b.get("kind") && d.optimize) {
     kind = BlockKind::trajectory;  // optimisation blocks default to trajectory
     kind_ok = true;
   } else if (!b.get("kind")) {
-    error(d.pos, d.label + " has no kind; expected kind = \"trajectory\" or \"ik\"");
+    error(d.pos, d.label + " has no kind; expected kind = \"trajectory\", \"ik\" or \"motion\"");
   }
   if (!kind_ok) return false;
   d.kind = kind;
   d.spec.kind = kind;
+  // the kind whose parameters a misplaced key is looked up in (did-you-mean): ik's for a trajectory
+  // block, trajectory's for the others
   const BlockKind other_kind = kind == BlockKind::trajectory ? BlockKind::ik : BlockKind::trajectory;
   d.kname = std::string(to_string(kind));
   d.other_kname = std::string(to_string(other_kind));
@@ -410,6 +420,26 @@ void Parser::check_robot_supports(const BlockDraft& d, const Study& s) {
         error(a.pos, reason + " (the " + a.axis.name + " axis includes it); expected local methods only");
         return;
       }
+}
+
+void Parser::check_motion_world(const BlockDraft& d, const Study& s) {
+  if (d.kind != BlockKind::motion || s.world.has_obstacles()) return;
+  const auto positive = [](const Cell& v) {
+    const double* x = std::get_if<double>(&v);
+    return x && *x > 0.0;
+  };
+  const std::string why = "w_clearance weighs the least clearance from the [world] obstacles, and the study has none; "
+                          "expected w_clearance = 0, or [world] obstacles with link_radius";
+  for (const auto& [name, v] : d.spec.fixed)
+    if (name == "w_clearance" && positive(v)) {
+      error(d.table.get(name)->source(), why);
+      return;
+    }
+  for (const AxisDraft& a : d.drafts)
+    if (a.axis.name == "w_clearance" && std::any_of(a.axis.values.begin(), a.axis.values.end(), positive)) {
+      error(a.pos, why + " (the w_clearance axis has a positive value)");
+      return;
+    }
 }
 
 }  // namespace ks::study_parse

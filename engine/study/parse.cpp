@@ -64,7 +64,7 @@ Study study_parse::Parser::run() {
     });
     throw StudyError(diags_);
   };
-  check_keys(root, {"study", "robot", "task", "block", "optimize"}, "the top level");
+  check_keys(root, {"study", "robot", "task", "world", "block", "optimize"}, "the top level");
   parse_study_table(root, s);
   const std::size_t before_robot = diags_.size();
   parse_robot(root, s);
@@ -73,6 +73,7 @@ Study study_parse::Parser::run() {
   if (diags_.size() > before_robot) fail();
   place_robot_in_plane(s);
   parse_task(root, s);
+  parse_world(root, s);
   s.arm_chain = s.robot_chain();
   if (!s.robot_text.empty()) s.sha256 = sha256_hex(std::string(text) + std::string(1, '\0') + s.robot_text);  // the robot is part of the study
   if (root.get("block") || !root.get("optimize")) parse_blocks(root, s);

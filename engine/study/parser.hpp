@@ -6,6 +6,7 @@
 //   robot_table.cpp      [robot]: the seed 3R, an n-link planar arm or a URDF robot
 //   robot_dh.cpp         [robot] dh: a standard DH table (in the study or a robot file)
 //   axes.cpp             parameter values and the [block.axes] forms (values, range, linspace, random, lhs)
+//   world_table.cpp      [world]: obstacles and link radii (motion runs)
 //   blocks.cpp           [[block]] tables: name, kind, keys, IK problem family, fixed parameters
 //   block_axes.cpp       a block's axes: lhs settings, [block.axes], lhs and zip groups, axes a run would ignore
 //   optimize_tables.cpp  [[optimize]] tables and their stages
@@ -139,6 +140,12 @@ class Parser : public ParserCore {
   std::optional<std::vector<double>> get_joint_numbers(const toml::table& t, std::string_view key, std::size_t count,
                                                        std::string_view what, std::string_view unit);
 
+  // world_table.cpp
+  /// [world]: obstacles = [{ type, ... }] and link_radius = [one per joint], in the robot's base frame.
+  void parse_world(const toml::table& root, Study& s);
+  /// One obstacle inline table of [world] obstacles; nullopt after reporting.
+  std::optional<geometry::Obstacle> parse_obstacle(const toml::node& n, std::size_t index);
+
   // blocks.cpp
   void parse_blocks(const toml::table& root, Study& s);
   /// One [[block]] table, or with optimize = true the block part of an [[optimize]] table. `names`
@@ -181,6 +188,9 @@ class Parser : public ParserCore {
   std::string limit_hint() const;
   /// Checks the block's runs against the robot: redundancy left by the task, vertex_alpha's domain.
   void check_robot_supports(const BlockDraft& d, const Study& s);
+  /// Motion blocks of a study without obstacles: a positive w_clearance (fixed or an axis value) is
+  /// reported at its key (its reference, the clearance, is +inf: nothing to weigh).
+  void check_motion_world(const BlockDraft& d, const Study& s);
   /// Reads the axes against their controlling parameters; reports axes a run would ignore.
   void reject_ineffective_axes(const BlockDraft& d);
   /// Reads the draft into a Block unless a step reported since errors_before; reports a spec Block refuses.

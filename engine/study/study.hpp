@@ -14,6 +14,7 @@
 
 #include "methods/base/trajectory.hpp"
 #include "model/arm.hpp"
+#include "geometry/link_capsules.hpp"
 #include "model/chain.hpp"
 #include "model/chain_plane.hpp"
 #include "optimize/optimize.hpp"
@@ -150,6 +151,14 @@ struct OptimizeBlock {
   const Block& block() const { return base.front(); }
 };
 
+/// The study's [world]: fixed obstacles in the robot's base frame and the radii of the links'
+/// capsules (geometry/link_capsules.hpp), which motion runs keep clear of the obstacles.
+struct World {
+  std::vector<geometry::Obstacle> obstacles;  ///< spheres, oriented boxes, capsules [m]
+  std::vector<double> link_radius;            ///< one per joint's link [m] (empty without obstacles)
+  bool has_obstacles() const { return !obstacles.empty(); }
+};
+
 struct Study {
   std::string file;         ///< the path or name it was parsed from
   std::string name;
@@ -177,6 +186,7 @@ struct Study {
   std::string robot_file;   ///< the URDF or DH robot file as the study names it ("" when none)
   std::string robot_text;   ///< its text, verbatim (kept with the results)
   StudyTask task;
+  World world;              ///< [world] (motion runs); empty when the study has none
   std::string text;         ///< the study file's text, verbatim
   std::string sha256;       ///< lower-case hex SHA-256 of text
   std::vector<Block> blocks;  ///< file order; global run ids concatenate them
