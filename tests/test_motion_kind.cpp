@@ -38,8 +38,7 @@ MotionSpec puma_spec(const Study& s) {
   MotionSpec spec;
   spec.chain = *s.base_chain;
   spec.q_start = VecN::Zero(3);
-  spec.q_goal = VecN(3);
-  spec.q_goal << kPi / 2, kPi / 4, -kPi / 6;
+  spec.q_goal = (VecN(3) << kPi / 2, kPi / 4, -kPi / 6).finished();
   spec.controls = 1;
   spec.duration = 9.0;
   spec.samples = 201;
