@@ -10,8 +10,10 @@
 #include "runner/execute.hpp"
 #include "runner/optimize_blocks.hpp"
 #include "study/study.hpp"
+#include "study_errors.hpp"
 
 using namespace ks;
+using ks::study_test::expect_error_at;
 
 namespace {
 
@@ -58,18 +60,6 @@ double named(const std::vector<std::pair<std::string, double>>& v, const std::st
   return NAN;
 }
 
-void expect_error(const std::string& text, int line, int col, const std::string& part) {
-  try {
-    parse_study(text, "bad.toml");
-    ADD_FAILURE() << "no error for:\n" << text;
-  } catch (const StudyError& e) {
-    ASSERT_FALSE(e.diagnostics().empty());
-    const auto& d = e.diagnostics().front();
-    EXPECT_EQ(d.line, line) << e.what();
-    EXPECT_EQ(d.column, col) << e.what();
-    EXPECT_NE(d.message.find(part), std::string::npos) << e.what();
-  }
-}
 
 }  // namespace
 
@@ -142,10 +132,10 @@ TEST(NormalisedObjective, AReferenceThatFailsIsAClearError) {
 
 TEST(NormalisedObjective, ErrorsAreLocated) {
   const std::string head = "[[optimize]]\nname = \"x\"\nvariables = { k = [0, 1] }\n";
-  expect_error(head + "objective = { E = 1 }\nreference = \"strat\"\n", 5, 13, "did you mean 'start'?");
-  expect_error(head + "objective = { E = 1 }\nreference = { alpha1A = 0 }\n", 5, 15, "not a variable");
-  expect_error(head + "objective = { E = 1 }\ntrade_off = [0.5]\n", 5, 13, "the objective has 1");
-  expect_error(head + "objective = { E = 1, tau_inf = 1 }\ntrade_off = [0.5, 1.5]\n", 5, 13, "expected 0 <= k <= 1");
-  expect_error(head + "objective = { \"1/failure_rate\" = 1 }\n", 4, 15, "divides by a rate");
-  expect_error(head + "objective = { \"1/EE\" = 1 }\n", 4, 15, "did you mean 'E'?");
+  expect_error_at(head + "objective = { E = 1 }\nreference = \"strat\"\n", 5, 13, "did you mean 'start'?");
+  expect_error_at(head + "objective = { E = 1 }\nreference = { alpha1A = 0 }\n", 5, 15, "not a variable");
+  expect_error_at(head + "objective = { E = 1 }\ntrade_off = [0.5]\n", 5, 13, "the objective has 1");
+  expect_error_at(head + "objective = { E = 1, tau_inf = 1 }\ntrade_off = [0.5, 1.5]\n", 5, 13, "expected 0 <= k <= 1");
+  expect_error_at(head + "objective = { \"1/failure_rate\" = 1 }\n", 4, 15, "divides by a rate");
+  expect_error_at(head + "objective = { \"1/EE\" = 1 }\n", 4, 15, "did you mean 'E'?");
 }

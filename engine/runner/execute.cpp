@@ -44,15 +44,6 @@ std::vector<HistoryArray> trajectory_arrays(const std::vector<HistoryArrayDef>& 
   return out;
 }
 
-/// The shape of a chain robot, as the tables see it.
-RobotShape shape_of(const Chain& chain) {
-  RobotShape r;
-  r.joints = chain.dof();
-  for (const ChainJoint& j : chain.joints) r.prismatic.push_back(j.type == JointType::prismatic);
-  r.chain = true;
-  r.planar = chain.planar();
-  return r;
-}
 
 /// The history arrays of an IK run, `defs` declaring k, q, F, norm_F, step, lambda: every
 /// stride-th iterate of `h` and the last.
@@ -180,7 +171,7 @@ RunOutcome run_chain_trajectory(const Scenario& sc, const TrajectoryRun& run, co
   }
   RunOutcome out;
   out.result = simulate(chain, task, start_guess(chain, run.q0), o, h);
-  if (h && h->size > 0) out.history.arrays = trajectory_arrays(trajectory_history_arrays(shape_of(chain)), *h);
+  if (h && h->size > 0) out.history.arrays = trajectory_arrays(trajectory_history_arrays(RobotShape::of(chain)), *h);
   return out;
 }
 
@@ -291,7 +282,7 @@ RunOutcome run_chain_ik(const Scenario& sc, const IkRun& run, const ik::Options&
   ik::solve_chain(chain, task, run.q0, o, r, ws.chain_ik);
   RunOutcome out;
   out.result = IkResult{r.status, r.iterations, r.rejected, -1, r.error, r.min_rcond, r.q, r.restarts_used};
-  if (stride > 0 && r.history.size() > 0) out.history.arrays = ik_arrays(ik_history_arrays(run.problem, shape_of(chain)), r.history, stride);
+  if (stride > 0 && r.history.size() > 0) out.history.arrays = ik_arrays(ik_history_arrays(run.problem, RobotShape::of(chain)), r.history, stride);
   return out;
 }
 

@@ -62,15 +62,6 @@ std::vector<HistoryArray> motion_arrays(const motion::MotionProblem& problem, co
   return a;
 }
 
-/// The shape of the chain for the history arrays' units.
-RobotShape motion_shape(const Chain& chain) {
-  RobotShape r;
-  r.joints = chain.dof();
-  for (const ChainJoint& j : chain.joints) r.prismatic.push_back(j.type == JointType::prismatic);
-  r.chain = true;
-  r.planar = chain.planar();
-  return r;
-}
 
 }  // namespace
 
@@ -144,7 +135,7 @@ RunOutcome run_motion(const Scenario& sc, const MotionRun& run, int stride) {
     res.objective = objective;
     res.max_constraint = worst;
     out.result = res;
-    if (stride > 0 && !x.empty()) out.history.arrays = motion_arrays(problem, x, motion_shape(*chain), stride);
+    if (stride > 0 && !x.empty()) out.history.arrays = motion_arrays(problem, x, RobotShape::of(*chain), stride);
   } catch (const std::exception&) {  // a problem that cannot be set up (e.g. a zero reference to normalise by)
     res = MotionResult{};
     res.status = MotionStatus::failure;

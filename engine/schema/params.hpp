@@ -35,6 +35,18 @@ struct RobotShape {
   bool vertex_alpha() const { return planar && joints == 3 && !pose_task; }
   /// global_spline is defined (a position path: the seed's arm, planar or spatial chains).
   bool path_global() const { return !pose_task; }
+  /// The shape of a chain robot (pose_task false: the task is not the chain's).
+  static RobotShape of(const Chain& chain) {
+    RobotShape r;
+    r.chain = true;
+    r.joints = chain.dof();
+    r.planar = chain.planar();
+    for (const ChainJoint& j : chain.joints) {
+      r.prismatic.push_back(j.type == JointType::prismatic);
+      r.limited = r.limited || j.limited();
+    }
+    return r;
+  }
 };
 
 /// What a block's tables depend on: its path and the study-wide defaults of [task] and [robot].

@@ -17,17 +17,8 @@
 namespace ks {
 
 RobotShape Study::robot_shape() const {
-  RobotShape r;
+  RobotShape r = chain ? RobotShape::of(*chain) : RobotShape{};
   r.pose_task = task.pose();
-  if (!chain) return r;
-  r.chain = true;
-  r.joints = chain->dof();
-  r.planar = chain->planar();
-  r.prismatic.clear();
-  for (const ChainJoint& j : chain->joints) {
-    r.prismatic.push_back(j.type == JointType::prismatic);
-    r.limited = r.limited || j.limited();
-  }
   return r;
 }
 
