@@ -15,6 +15,7 @@ import math
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -47,9 +48,9 @@ failures = []
 
 
 def check(cond, msg):
+    """Records a failure; printed at the end, since a concurrent read that saw a commit drops its own."""
     if not cond:
         failures.append(msg)
-        print("FAIL:", msg)
 
 
 def expected_row(i):
@@ -273,19 +274,35 @@ def check_column_specs(runs):
     check(sorted(runs) == sorted([c[0] for c in COLUMNS] + ["done"]), f"/runs datasets {sorted(runs)}")
 
 
-def concurrent_read(helper, path, n):
-    # commits every ~0.25 s (a real sweep: every 64 runs or 10 s), so that slow h5py reads fit between
+def stopped(proc):
+    """True while the writer has stopped itself (SIGSTOP after a flush, --stop-after-runs)."""
+    try:
+        with open(f"/proc/{proc.pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] == "T"
+    except (FileNotFoundError, IndexError):
+        return False
+
+
+def concurrent_read(helper, path, n, pauses=(250, 500, 750, 1000, 1250)):
+    """Reads the file many times while the helper writes it. The helper commits every ~0.25 s (a real
+    sweep: every 64 runs or 10 s) and also stops itself after each of `pauses` runs, just after a
+    commit, until a read has been made: so that reads in the middle of the sweep happen however loaded
+    the machine is, besides the ones racing the writer."""
     proc = subprocess.Popen([helper, path, str(n), "--delay-us", "1000", "--flush-every", "100000",
-                             "--flush-seconds", "0.25"],
+                             "--flush-seconds", "0.25", "--stop-after-runs", ",".join(map(str, pauses))],
                             stdout=subprocess.DEVNULL)
-    snapshots, mid, errors, stale, stale_bad, seen = 0, 0, 0, 0, 0, []
+    snapshots, mid, paused, errors, stale, stale_bad, seen = 0, 0, 0, 0, 0, 0, []
     try:
         while proc.poll() is None:
             time.sleep(0.02)
             if not os.path.exists(path):
                 continue
+            was_stopped = stopped(proc)
             before = stamp(path)
             if before is None:
+                if was_stopped:  # stopped after its flush, so no commit can be under way
+                    check(False, "a commit seemed under way while the writer was stopped")
+                    os.kill(proc.pid, signal.SIGCONT)
                 continue
             mark = len(failures)
             try:
@@ -294,27 +311,40 @@ def concurrent_read(helper, path, n):
                     ids = np.nonzero(f["runs/done"][()])[0]
                     for i in list(ids[::9]) + list(ids[-5:]):
                         check_history(f, int(i))
+                raised = None
             except (OSError, KeyError, RuntimeError) as e:  # metadata changed under this read
+                raised = e
+            after = stamp(path)
+            if was_stopped:
+                os.kill(proc.pid, signal.SIGCONT)
+            if raised is not None:
                 del failures[mark:]
+                check(not was_stopped, f"a read while the writer was stopped raised: {raised}")
                 errors += 1
                 if os.environ.get("KS_DEBUG"):
-                    print("raised:", e, "stamp unchanged:", stamp(path) == before)
+                    print("raised:", raised, "stamp unchanged:", after == before)
                 continue
-            if stamp(path) != before:  # a commit happened during the read: not one snapshot, discard
+            if after != before:  # a commit happened during the read: not one snapshot, discard
                 stale += 1
                 stale_bad += len(failures) > mark
                 del failures[mark:]
+                check(not was_stopped, "the stamp moved while the writer was stopped")
                 continue
             snapshots += 1
+            paused += was_stopped
             seen.append(done)
             if 0 < done < n:
                 mid += 1
     finally:
+        if proc.poll() is None:
+            os.kill(proc.pid, signal.SIGCONT)
         rc = proc.wait(timeout=120)
     check(rc == 0, f"writer exited with {rc}")
-    print(f"concurrent reads: {snapshots} consistent snapshots ({mid} mid-sweep); discarded: {errors} raised, "
-          f"{stale} saw a commit ({stale_bad} of them with odd newest runs); done counts: {seen[:3]} ... {seen[-3:]}")
-    check(mid >= 3, f"only {mid} consistent reads happened while the sweep was running")
+    print(f"concurrent reads: {snapshots} consistent snapshots ({mid} mid-sweep, {paused} with the writer stopped "
+          f"after a commit); discarded: {errors} raised, {stale} saw a commit ({stale_bad} of them with odd newest "
+          f"runs); done counts: {seen[:3]} ... {seen[-3:]}")
+    check(paused >= len(pauses), f"{paused} reads with the writer stopped, not {len(pauses)}")
+    check(mid >= len(pauses), f"only {mid} consistent reads happened while the sweep was running")
     check(all(b >= a for a, b in zip(seen, seen[1:])), "done count went backwards between snapshots")
     check_complete_table(path, n)
 
@@ -323,7 +353,6 @@ def killed_writer_file(helper, work, iterations=8):
     """kill -9 the writer at random moments; h5py must open the file as the writer left it (no
     recovery step) and every run marked done must be right."""
     import random
-    import signal
 
     rng = random.Random(4)
     opened, pending = 0, 0
@@ -374,6 +403,8 @@ def main():
     concurrent_read(helper, os.path.join(work, "growing.h5"), 1500)
     killed_writer_file(helper, work)
     if failures:
+        for msg in failures:
+            print("FAIL:", msg)
         print(f"{len(failures)} failures")
         return 1
     shutil.rmtree(work, ignore_errors=True)
