@@ -78,8 +78,8 @@ TEST(MotionKind, CubicRunEqualsTheMotionProblemEvaluation) {
   EXPECT_EQ(r.duration, 9.0);
   EXPECT_EQ(r.evaluations, 0);
   EXPECT_LE(r.max_constraint, 0.0);
-  // the history: t, q, qd, tau at every sample
-  ASSERT_EQ(out.history.arrays.size(), 4u);
+  // the history: t, q, qd, tau, points at every sample
+  ASSERT_EQ(out.history.arrays.size(), 5u);
   EXPECT_EQ(out.history.arrays[0].name, "t");
   EXPECT_EQ(out.history.arrays[3].name, "tau");
   EXPECT_EQ(out.history.arrays[3].rows, static_cast<std::size_t>(P.samples()));

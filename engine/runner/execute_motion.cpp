@@ -9,6 +9,7 @@
 #include <limits>
 #include <optional>
 
+#include "model/chain_kinematics.hpp"
 #include "motion/solve_motion.hpp"
 #include "schema/history_arrays.hpp"
 
@@ -35,7 +36,8 @@ MotionStatus status_of(const motion::Criteria& c, double worst, double tolerance
 }
 
 /// The history arrays of `robot`'s motion at x: every stride-th sample of `problem` and the last
-/// (t [s], q [rad or m], qd [rad/s or m/s], tau [Nm or N]). Evaluates the problem at x (no gradients).
+/// (t [s], q [rad or m], qd [rad/s or m/s], tau [Nm or N], points: the joint origins and the tip [m]).
+/// Evaluates the problem at x (no gradients).
 std::vector<HistoryArray> motion_arrays(const motion::MotionProblem& problem, const std::vector<double>& x,
                                         const RobotShape& robot, int stride) {
   motion::MotionEvaluation ev;
@@ -51,6 +53,8 @@ std::vector<HistoryArray> motion_arrays(const motion::MotionProblem& problem, co
   for (const HistoryArrayDef& d : defs) a.push_back({d.name, d.unit, rows.size(), d.columns, {}});
   for (auto& h : a) h.data.reserve(rows.size() * h.cols);
   VecN q(n), qd(n), qdd(n), jerk(n);
+  const Chain& chain = problem.spec().chain;
+  ChainData data;
   for (int s : rows) {
     const double t = problem.sample_time(s, spline.duration());
     spline.evaluate(t, q, qd, qdd, jerk);
@@ -58,10 +62,47 @@ std::vector<HistoryArray> motion_arrays(const motion::MotionProblem& problem, co
     for (int j = 0; j < n; ++j) a[1].data.push_back(q[j]);
     for (int j = 0; j < n; ++j) a[2].data.push_back(qd[j]);
     for (int j = 0; j < n; ++j) a[3].data.push_back(tau[static_cast<std::size_t>(s)][j]);
+    forward_kinematics(chain, data, q);
+    for (int k = 0; k <= n; ++k) {
+      const Vec3& p = k < n ? data.joint[static_cast<std::size_t>(k)].p : data.tip.p;
+      for (int c = 0; c < 3; ++c) a[4].data.push_back(p[c]);
+    }
   }
   return a;
 }
 
+
+/// Re-evaluates the end x of `problem` at factor times as many samples (the same spline, windows,
+/// limits and obstacles) into res's check_* fields; `c` the criteria at the problem's own samples.
+/// False when a dense value is NaN (the run is then a failure).
+bool dense_check(const motion::MotionProblem& problem, const std::vector<double>& x, int factor,
+                 const motion::Criteria& c, MotionResult& res) {
+  motion::MotionSpec spec = problem.spec();
+  spec.samples = factor * (problem.samples() - 1) + 1;
+  spec.normalise = false;  // the objective is not used; its reference may be 0
+  const motion::MotionProblem dense(std::move(spec));
+  motion::MotionEvaluation ev;
+  dense.evaluate(x, false, ev);
+  res.check_samples = dense.samples();
+  const double clear = motion::at(ev.criteria, Criterion::min_clearance);
+  res.check_min_clearance = std::isinf(clear) ? MotionResult::kNaN : clear;  // +inf: no obstacles
+  bool nan = std::isnan(clear), limited = false;
+  double worst = -std::numeric_limits<double>::infinity();  // the largest ratio - 1
+  for (std::size_t i = 0; i < ev.constraints.size(); ++i) {
+    if (dense.constraint_list()[i].kind == motion::MotionConstraint::Kind::clearance) continue;
+    nan = nan || std::isnan(ev.constraints[i]);
+    limited = true;
+    worst = std::max(worst, ev.constraints[i] + dense.spec().limit_margin);
+  }
+  res.check_max_limit = limited && !nan ? worst : MotionResult::kNaN;
+  const auto change = [&](Criterion k) {
+    return (motion::at(ev.criteria, k) - motion::at(c, k)) / std::abs(motion::at(c, k));
+  };
+  res.check_torque_sq_change = change(Criterion::torque_sq);
+  res.check_power_sq_change = change(Criterion::power_sq);
+  return !nan && !std::isnan(motion::at(ev.criteria, Criterion::torque_sq)) &&
+         !std::isnan(motion::at(ev.criteria, Criterion::power_sq));
+}
 
 }  // namespace
 
@@ -77,7 +118,8 @@ RunOutcome run_motion(const Scenario& sc, const MotionRun& run, int stride) {
   spec.q_goal = run.goal;
   spec.controls = run.controls;
   spec.duration = run.duration;
-  spec.vary_duration = run.vary_duration && run.solve;
+  // Without a solve, T is a variable that is never moved when there are no controls to vary.
+  spec.vary_duration = run.solve ? run.vary_duration : run.controls == 0;
   spec.min_duration = run.min_duration;
   spec.max_duration = run.max_duration;
   spec.samples = run.samples;
@@ -94,6 +136,7 @@ RunOutcome run_motion(const Scenario& sc, const MotionRun& run, int stride) {
     spec.radii = sc.world->link_radius;
     spec.clearance_margin = run.clearance_margin;
   }
+  spec.limit_margin = run.limit_margin;
   motion::MotionSolveOptions options;
   options.max_evaluations = run.max_evaluations;
   options.starts = run.starts;
@@ -121,6 +164,14 @@ RunOutcome run_motion(const Scenario& sc, const MotionRun& run, int stride) {
         worst = std::numeric_limits<double>::quiet_NaN();
     }
     res.status = status_of(c, worst, options.constraint_tolerance, term);
+    // ok and max_evaluations hold only if the dense check agrees: no collision, no limit exceeded
+    // between the samples either.
+    const bool dense_ok = dense_check(problem, x, run.check_factor, c, res);
+    if (res.status == MotionStatus::ok || res.status == MotionStatus::max_evaluations) {
+      if (!dense_ok) res.status = MotionStatus::failure;
+      else if (res.check_min_clearance < 0.0) res.status = MotionStatus::collision;
+      else if (res.check_max_limit > options.constraint_tolerance) res.status = MotionStatus::infeasible;
+    }
     if (!std::isfinite(objective) && res.status != MotionStatus::failure) res.status = MotionStatus::failure;
     res.duration = motion::at(c, Criterion::duration);
     res.torque_sq = motion::at(c, Criterion::torque_sq);

@@ -57,6 +57,8 @@ std::vector<HistoryArrayDef> motion_history_arrays(const RobotShape& robot) {
       {"q", joint_units(robot, "rad", "m"), n, "joint positions"},
       {"qd", joint_units(robot, "rad/s", "m/s"), n, "joint velocities"},
       {"tau", joint_units(robot, "Nm", "N"), n, "joint torques (forces for prismatic joints), RNEA"},
+      {"points", "m", 3 * (n + 1),
+       "base-frame positions (x, y, z) of joint 1 .. n's origins and of the tip: the link capsules' ends"},
   };
 }
 

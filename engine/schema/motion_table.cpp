@@ -98,6 +98,13 @@ std::vector<ParamDef> motion_params(const KindContext& ctx) {
   t.push_back(real<Run>("clearance_margin", FileUnit::none, "m", Domain::nonnegative(),
                         "the links keep at least this clearance from the obstacles (a constraint; with obstacles)",
                         [](auto& r) -> auto& { return r.clearance_margin; }));
+  t.push_back(real<Run>("limit_margin", FileUnit::none, "", Domain::within(0.0, 0.99),
+                        "each limited ratio (position from mid-range over half the range, |velocity|, |torque| "
+                        "over its limit) is kept <= 1 - limit_margin at the samples (room for the dense check)",
+                        [](auto& r) -> auto& { return r.limit_margin; }));
+  t.push_back(integer<Run>("check_factor", "", MotionRun::check_factor_rule,
+                           "the end is checked at check_factor times as many samples (limits, clearance, f5, f6)",
+                           [](auto& r) -> auto& { return r.check_factor; }));
   return t;
 }
 
@@ -133,6 +140,16 @@ std::vector<MetricDef> motion_metrics(const KindContext& ctx) {
                 [](const R& r) { return std::int64_t(r.evaluations); }),
       f("max_constraint", "", "largest constraint value at the end (<= 0: every limit and margin kept)",
         [](const R& r) { return r.max_constraint; }),
+      metric<R>("check_samples", CellType::i64, "", "samples of the dense check of the end (check_factor times denser)",
+                true, [](const R& r) { return std::int64_t(r.check_samples); }),
+      f("check_min_clearance", "m", "least clearance at the dense check samples (NaN: no obstacles; < 0: collision)",
+        [](const R& r) { return r.check_min_clearance; }),
+      f("check_max_limit", "", "largest limited ratio minus 1 at the dense check samples (<= 0: every limit kept)",
+        [](const R& r) { return r.check_max_limit; }),
+      f("check_torque_sq_change", "", "relative change of f5 from the samples to the dense check samples",
+        [](const R& r) { return r.check_torque_sq_change; }),
+      f("check_power_sq_change", "", "relative change of f6 from the samples to the dense check samples",
+        [](const R& r) { return r.check_power_sq_change; }),
   };
 }
 

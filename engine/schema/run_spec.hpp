@@ -102,10 +102,13 @@ struct MotionRun {
   int starts = 1;                       ///< SLSQP starts (the cubic, then seeded perturbations)
   int max_evaluations = 500;            ///< SLSQP evaluations per start
   double clearance_margin = 1e-3;       ///< clearance >= this at every window [m] (with obstacles)
+  double limit_margin = 0.0;            ///< each limited ratio (|q - mid| / half range, |qd| / v, |tau| / effort) <= 1 - this
+  int check_factor = 8;                 ///< the end is re-evaluated at check_factor times as dense samples
   static constexpr Domain controls_rule = Domain::within(0, 30);
   static constexpr Domain samples_rule = Domain::within(2, 100000);
   static constexpr Domain starts_rule = Domain::within(1, 1000);
   static constexpr Domain evaluations_rule = Domain::within(1, 100000000);
+  static constexpr Domain check_factor_rule = Domain::within(2, 256);
 
   /// The defaults for a robot of `joints` joints: from 0 to 30 deg at every revolute joint (0 m at
   /// a prismatic one) in 1 s.
@@ -114,8 +117,10 @@ struct MotionRun {
 
 using RunSpec = std::variant<TrajectoryRun, IkRun, MotionRun>;
 
-/// How a motion run ended: ok (converged, within every limit and clear of the obstacles),
-/// infeasible (a limit or the clearance margin violated at the end), collision (least clearance < 0),
+/// How a motion run ended: ok (converged, within every limit and clear of the obstacles at the
+/// samples and at the check_factor times denser check samples between them), infeasible (a limit or
+/// the clearance margin violated at the samples, or a limit exceeded between them), collision (least
+/// clearance < 0 at the samples or between them),
 /// max_evaluations (the budget ran out on a feasible point), failure (NLopt failed, the problem could
 /// not be set up, or a criterion is not finite).
 enum class MotionStatus { ok, infeasible, collision, max_evaluations, failure };
@@ -130,6 +135,12 @@ struct MotionResult {
   double torque_sq_0 = kNaN, power_sq_0 = kNaN;            ///< the initial cubic's f5, f6
   double objective = kNaN, max_constraint = kNaN;
   int evaluations = 0;
+  /// The end re-evaluated at the dense check samples: their count, the least clearance (NaN: no
+  /// obstacles), the largest limit constraint (<= 0: every limit kept between the samples too) and the
+  /// relative change of f5 and f6 from the samples' trapezoidal rule to the dense one's.
+  int check_samples = 0;
+  double check_min_clearance = kNaN, check_max_limit = kNaN, check_torque_sq_change = kNaN,
+         check_power_sq_change = kNaN;
 };
 
 /// What an IK solve returns to the store (the Summary less its history).
