@@ -14,14 +14,15 @@ Submodules (each importable alone):
     compare     `kinesweep compare`'s verdict table (compare) and the /verification table (verification)
     pareto      Pareto fronts of 2 or 3 metrics (pareto_front, as `kinesweep query --pareto`) and hypervolume
     plotting    shared matplotlib helpers of the plot commands
+    motion_view a motion run's picture: link poses, [world] obstacles, the view plane, clearance
 Commands (`python3 -m kinesweep.NAME --help`; in a source tree with analysis/ on PYTHONPATH):
     plot_landscape, plot_histories, plot_cases, plot_basins, plot_convergence, plot_runs, plot_pareto,
-    plot_trade_off, compare_landscapes, importance, report, make_examples
+    plot_trade_off, plot_motion, compare_landscapes, importance, report, make_examples
 `python3 -m kinesweep` lists them. Old scripts that import the former flat names (ksread, kswhere,
 kshistory, kslive, kstypes, kssolutions, ksplot, plot_landscape, ...) run after `import kinesweep.compat`.
 """
 COMMANDS = ("plot_landscape", "plot_histories", "plot_cases", "plot_basins", "plot_convergence", "plot_runs",
-            "plot_pareto", "plot_trade_off", "compare_landscapes", "importance", "report", "make_examples")
+            "plot_pareto", "plot_trade_off", "plot_motion", "compare_landscapes", "importance", "report", "make_examples")
 _READ_API = ("open_results", "read_runs", "read_history", "read_landscape", "read_optimization", "Results",
              "FormatVersionError", "THESIS_TABLE4")
 

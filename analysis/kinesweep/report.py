@@ -30,6 +30,7 @@ from kinesweep import read as ksread  # noqa: E402
 from kinesweep.report_basins import basins_figure  # noqa: E402
 from kinesweep.report_grids import landscape_figure  # noqa: E402
 from kinesweep.report_page import esc, figure, page  # noqa: E402
+from kinesweep.report_motion import motion_figure  # noqa: E402
 from kinesweep.report_pareto import pareto_section  # noqa: E402
 from kinesweep.report_samples import sampled_section  # noqa: E402
 from kinesweep.report_tables import (RunsView, best_section, metadata_section, status_section,  # noqa: E402
@@ -195,6 +196,9 @@ def histories_section(view):
         if out is None:
             continue
         parts.append(figure(f"history-{n}", out[0], out[1], title=f"Block {b} ({view.kind(b)})"))
+        sweep = motion_figure(view.res, int(row))
+        if sweep is not None:
+            parts.append(figure(f"motion-{n}", sweep[0], sweep[1], title=f"Block {b}: the arm's motion"))
         n += 1
     return "".join(parts)
 

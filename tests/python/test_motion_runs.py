@@ -9,12 +9,18 @@ read back with h5py.
 - every status is one of the kind's; a good run has no NaN metric but min_clearance without obstacles;
 - a sphere on the cubic's path: the cubic collides, and the solved run is never ok with a negative
   clearance (ok with min_clearance >= 0, or collision / infeasible);
+- the dense check: a small sphere that the cubic's tip crosses between two of its 3 samples is missed
+  by them (min_clearance > 0) and found by the check at 8 times as many (check_samples = 17,
+  check_min_clearance < 0): the run is `collision`, never `ok`; the clearance recomputed here from the
+  stored link points (kinesweep.motion_view, point distances) agrees with the engine's at every sample;
+- kinesweep.plot_motion draws the run's sweep: its closest sample is the least of those clearances;
 - parse errors are located: an unknown obstacle type, a link_radius of the wrong size, a centre of 2
   numbers, start_4 on a 3-joint robot, w_clearance without obstacles, a motion block on the seed's
   closed-form 3R.
 
 usage: /usr/bin/python3 test_motion_runs.py KINESWEEP_BINARY ROBOTS_DIR
 """
+import json
 import math
 import os
 import re
@@ -25,7 +31,10 @@ import unittest
 import h5py
 import numpy as np
 
-from e2e_common import TempDirTest, history
+from e2e_common import ANALYSIS_ENV, TempDirTest, analysis_command, history
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
+from kinesweep import motion_view  # noqa: E402
 
 KS = None
 ROBOTS = None
@@ -96,7 +105,8 @@ class MotionRuns(TempDirTest):
                 self.assertAlmostEqual(i5 / f5[run], 1.0, delta=1e-9)
                 self.assertAlmostEqual(i6 / f6[run], 1.0, delta=1e-9)
                 for k, v in c.items():
-                    if k != "min_clearance" and np.issubdtype(v.dtype, np.floating):
+                    if k not in ("min_clearance", "check_min_clearance", "check_max_limit") and \
+                            np.issubdtype(v.dtype, np.floating):  # NaN: no obstacles, no limits
                         self.assertFalse(math.isnan(v[run]), f"run {run} {k}")
             self.assertEqual((f5[0], f6[0]), (f50[0], f60[0]))
             self.assertEqual(c["evaluations"][0], 0)
@@ -124,6 +134,40 @@ class MotionRuns(TempDirTest):
             if c["min_clearance"][1] < 0.0:
                 self.assertEqual(st[1], "collision")
             print(f"sphere: cubic {st[0]} ({c['min_clearance'][0]:.4g} m), solved {st[1]} ({c['min_clearance'][1]:.4g} m)")
+
+    def test_dense_check_finds_a_collision_between_samples(self):
+        dense = self.run_study("dense", study("dense", [("cubic", "solve = false\nsamples = 201")]))
+        with h5py.File(dense, "r") as f:
+            pts = history(f, 0)["points"]
+        self.assertEqual(pts.shape, (201, 12))  # joint origins of 3 joints and the tip, x y z each
+        tip = pts[50, 9:12]  # t = T / 4: between the samples 0, T / 2, T of a 3-sample run
+        world = ('[world]\nlink_radius = [0.0, 0.0, 0.0]\n'
+                 f'obstacles = [{{ type = "sphere", centre = [{tip[0]!r}, {tip[1]!r}, {tip[2]!r}], radius = 0.02 }}]\n\n')
+        out = self.run_study("between", study("between", [("coarse", "solve = false\nsamples = 3"),
+                                                          ("fine", "solve = false\nsamples = 201")], world))
+        obstacles, radii = motion_view.world_of(world)
+        with h5py.File(out, "r") as f:
+            st, c = self.rows(f)
+            self.assertGreater(c["min_clearance"][0], 0.02)        # its 3 samples miss the sphere
+            self.assertEqual(int(c["check_samples"][0]), 17)
+            self.assertLess(c["check_min_clearance"][0], 0.0)      # the check does not
+            self.assertEqual(st[0], "collision")
+            self.assertEqual(st[1], "collision")
+            self.assertLess(c["min_clearance"][1], 0.0)
+            self.assertTrue(np.isnan(c["check_max_limit"]).all())  # the arm has no limits
+            fine = history(f, 1)["points"]
+            here = np.array([motion_view.clearance(row, radii, obstacles) for row in fine])
+        self.assertAlmostEqual(here.min(), c["min_clearance"][1], delta=1e-12)
+        self.assertLessEqual(c["check_min_clearance"][1], here.min() + 1e-12)
+        png = os.path.join(self.dir, "between.png")
+        r = subprocess.run(analysis_command("plot_motion", out, "--runs", "1", "-o", png, "--print-data"),
+                           capture_output=True, text=True, timeout=300, env=ANALYSIS_ENV)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        data = json.loads(r.stdout)
+        self.assertTrue(os.path.getsize(png) > 0)
+        self.assertEqual(data["rows"][0]["closest_sample"], int(np.argmin(here)))
+        self.assertEqual(data["rows"][0]["frames"][0], 0)
+        self.assertEqual(data["rows"][0]["frames"][-1], 200)
 
     def refused(self, name, body, line, words):
         path = self.write(name + ".toml", body)
