@@ -69,7 +69,7 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     h5 = {}
     for s in ("thesis_table4", "examples_landscape", "examples_basins", "examples_convergence", "examples_lhs",
-              "placement_scara1"):
+              "placement_scara1", "motion_elbow"):
         h5[s] = os.path.join(a.work, s + ".h5")
         subprocess.run([a.kinesweep, "run", os.path.join(ROOT, "studies", s + ".toml"), "-o", h5[s],
                         "--overwrite", "-q"], check=True, stdout=subprocess.DEVNULL)
@@ -100,6 +100,8 @@ def main():
         ("plot_runs", h5["examples_lhs"], "runs_parcoords.png", ["--view", "parcoords"]),
         ("plot_trade_off", h5["placement_scara1"], "trade_off_scara1.png",
          ["--mark", f"{0.108 / 0.067},{5.261 / 6.451}:Santos 2007, Table 7.5 (k = 0.9)"]),
+        ("plot_motion", h5["motion_elbow"], "motion_elbow.png",
+         ["--runs", "0,4", "--title", "Seed 002 7.4: the cubic through the cube (run 0), K = 4 past it (run 4)"]),
     ]
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [PACKAGE_PARENT, os.environ.get("PYTHONPATH")])))
     for command, f, out, extra in jobs:
