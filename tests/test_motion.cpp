@@ -335,7 +335,7 @@ std::vector<double> generic_point(const MotionProblem& P, double T, unsigned see
 
 TEST(MotionGradients, PumaAndPlanar2rAgainstCentralDifferences) {
   for (int robot = 0; robot < 2; ++robot)
-    for (bool obstacle : {false, true}) {
+    for (int obstacle : {0, 1, 2}) {  // none, a fixed sphere, a moving one (its share in T)
       MotionSpec spec = robot == 0 ? puma_spec() : planar2r_spec();
       if (robot == 1) spec.q_start[1] = 0.4, spec.q_goal[1] = 0.9;  // off the stretched (singular) arm: manipulability > 0
       spec.controls = 2;
@@ -356,12 +356,14 @@ TEST(MotionGradients, PumaAndPlanar2rAgainstCentralDifferences) {
         const Eigen::Vector3d elbow = d.joint[std::min(2, spec.chain.dof() - 1)].p;
         spec.obstacles.emplace_back(geometry::Sphere{elbow + Eigen::Vector3d(0.25, 0.2, robot == 0 ? 0.1 : 0.0), 0.1});
         spec.radii.assign(spec.chain.dof(), 0.05);
+        if (obstacle == 2) spec.obstacle_velocities = {Eigen::Vector3d(0.04, -0.06, robot == 0 ? 0.02 : 0.0)};
       } else {
         at(spec.weights, Criterion::min_clearance) = 0.0;
       }
       spec.windows = 4;
       const MotionProblem P(spec);
-      const std::string label = std::string(robot == 0 ? "puma560_arm" : "planar2r") + (obstacle ? " + sphere" : "");
+      const std::string label = std::string(robot == 0 ? "puma560_arm" : "planar2r") +
+                                (obstacle == 2 ? " + moving sphere" : obstacle ? " + sphere" : "");
       EXPECT_EQ(P.constraints(), 4 * (3 * spec.chain.dof() + (obstacle ? 1 : 0))) << label;
       EXPECT_LT(check_gradients(P, generic_point(P, 3.0, 11 + robot), label.c_str()), 1e-6);
     }

@@ -13,7 +13,8 @@ AXES = "xyz"
 def world_of(study_text):
     """(obstacles, link radii) of a study's [world] table: obstacles as dicts of numpy arrays
     ({type, centre, radius} spheres; {type, centre, half, R} boxes, R from rpy [deg]; {type, a, b,
-    radius} capsules), radii a list (empty without [world])."""
+    radius} capsules; each with its velocity [m/s], zero when fixed), radii a list (empty without
+    [world])."""
     try:
         world = tomllib.loads(study_text).get("world", {})
     except tomllib.TOMLDecodeError:
@@ -21,15 +22,16 @@ def world_of(study_text):
     out = []
     for o in world.get("obstacles", []):
         t = o.get("type")
+        v = np.array(o.get("velocity", [0.0, 0.0, 0.0]), float)
         if t == "sphere":
-            out.append({"type": t, "centre": np.array(o["centre"], float), "radius": float(o["radius"])})
+            out.append({"type": t, "centre": np.array(o["centre"], float), "radius": float(o["radius"]), "velocity": v})
         elif t == "box":
             r, p, y = np.radians(np.array(o.get("rpy", [0, 0, 0]), float))
             out.append({"type": t, "centre": np.array(o["centre"], float), "half": np.array(o["half"], float),
-                        "R": rot_z(y) @ rot_y(p) @ rot_x(r)})
+                        "R": rot_z(y) @ rot_y(p) @ rot_x(r), "velocity": v})
         elif t == "capsule":
             out.append({"type": t, "a": np.array(o["a"], float), "b": np.array(o["b"], float),
-                        "radius": float(o["radius"])})
+                        "radius": float(o["radius"]), "velocity": v})
     return out, [float(r) for r in world.get("link_radius", [])]
 
 
@@ -46,6 +48,20 @@ def rot_y(a):
 def rot_z(a):
     c, s = np.cos(a), np.sin(a)
     return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def at_time(o, t):
+    """The obstacle where it is at time t [s] (moved by t times its velocity)."""
+    d = t * o.get("velocity", np.zeros(3))
+    m = dict(o)
+    for key in ("centre", "a", "b"):
+        if key in m:
+            m[key] = m[key] + d
+    return m
+
+
+def moving(obstacles):
+    return any(np.any(o.get("velocity", np.zeros(3)) != 0) for o in obstacles)
 
 
 def surface_points(o, n=48):
@@ -121,15 +137,17 @@ def segment_points_distance(a, b, c):
     return float(np.linalg.norm(a + t[:, None] * ab - c, axis=1).min())
 
 
-def clearance(points_row, radii, obstacles):
+def clearance(points_row, radii, obstacles, t=0.0):
     """The least clearance of the links (capsules between consecutive points, radii per link) from
-    the obstacles at one history row [m]; +inf without obstacles. Sphere and capsule distances via
-    point-segment distances on a dense subdivision, boxes as segment_box_distance."""
+    the obstacles at one history row of time t [s] (moving obstacles where they are then) [m]; +inf
+    without obstacles. Sphere and capsule distances via point-segment distances on a dense
+    subdivision, boxes as segment_box_distance."""
     p = links_of(points_row)
     best = np.inf
+    now = [at_time(o, t) for o in obstacles]
     for k in range(len(p) - 1):
         a, b = p[k], p[k + 1]
-        for o in obstacles:
+        for o in now:
             if o["type"] == "sphere":
                 d = segment_points_distance(a, b, o["centre"]) - o["radius"]
             elif o["type"] == "box":

@@ -69,9 +69,10 @@ def sweep_panel(ax, pts, t, obstacles, radii, plane, count):
     """Draws one run's sweep in `plane` (two axis indices); returns what was drawn (for --print-data)."""
     i, j = plane
     shown = mv.frames(len(pts), count)
-    for o in obstacles:
-        h = mv.hull(mv.surface_points(o)[:, [i, j]])
-        ax.fill(h[:, 0], h[:, 1], color="#7f7f7f", alpha=0.45, lw=1, ec="#404040")
+    for o in obstacles:  # a moving one: where it starts (light) and ends (dark)
+        for when, alpha in ((0.0, 0.2), (t[-1], 0.45)) if mv.moving([o]) else ((0.0, 0.45),):
+            h = mv.hull(mv.surface_points(mv.at_time(o, when))[:, [i, j]])
+            ax.fill(h[:, 0], h[:, 1], color="#7f7f7f", alpha=alpha, lw=1, ec="#404040")
     for rank, s in enumerate(shown):
         p = mv.links_of(pts[s])
         shade = 0.25 + 0.75 * rank / max(1, len(shown) - 1)
@@ -80,7 +81,7 @@ def sweep_panel(ax, pts, t, obstacles, radii, plane, count):
     ax.plot(tips[:, i], tips[:, j], "--", color="#d62728", lw=1, label="tip path")
     closest = None
     if obstacles and radii:
-        c = np.array([mv.clearance(row, radii, obstacles) for row in pts])
+        c = np.array([mv.clearance(row, radii, obstacles, ts) for row, ts in zip(pts, t)])
         closest = int(np.argmin(c))
         p = mv.links_of(pts[closest])
         for k in range(len(p) - 1):

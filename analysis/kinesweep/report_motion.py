@@ -18,7 +18,7 @@ def motion_figure(res, run_id):
     obstacles, radii = mv.world_of(res.study_text or "")
     i, j = mv.view_plane(pts, obstacles)
     data = []
-    for o in obstacles:
+    for o in obstacles:  # where it is at the start (a moving one moves on)
         hull = mv.hull(mv.surface_points(o)[:, [i, j]])
         data.append({"type": "scatter", "mode": "lines", "x": hull[:, 0], "y": hull[:, 1], "fill": "toself",
                      "fillcolor": "rgba(127,127,127,0.45)", "line": {"color": "#404040", "width": 1},
@@ -35,7 +35,7 @@ def motion_figure(res, run_id):
                  "line": {"color": "#d62728", "dash": "dash", "width": 1}})
     note = ""
     if obstacles and len(radii) == pts.shape[1] // 3 - 1:
-        c = np.array([mv.clearance(row, radii, obstacles) for row in pts])
+        c = np.array([mv.clearance(row, radii, obstacles, ts) for row, ts in zip(pts, t)])
         k = int(np.argmin(c))
         note = f" Least clearance of the stored samples {fmt(c[k], 4)} m at t = {fmt(t[k], 4)} s."
     layout = {"height": 420, "margin": {"l": 60, "r": 20, "t": 30, "b": 50},

@@ -28,6 +28,17 @@ ClosestPoints capsule_obstacle(const Capsule& link, const Obstacle& obstacle) {
   return capsule_capsule(link, std::get<Capsule>(obstacle));
 }
 
+Obstacle translated(const Obstacle& obstacle, const Vec3& by) {
+  if (const auto* s = std::get_if<Sphere>(&obstacle)) return Sphere{s->centre + by, s->radius};
+  if (const auto* b = std::get_if<Box>(&obstacle)) {
+    Box m = *b;
+    m.centre += by;
+    return m;
+  }
+  const auto& c = std::get<Capsule>(obstacle);
+  return Capsule{c.a + by, c.b + by, c.radius};
+}
+
 void link_capsules(const Chain& chain, const ChainData& data, std::span<const double> radii,
                    std::array<Capsule, kMaxJoints>& links) {
   const int n = chain.dof();
@@ -74,6 +85,7 @@ Clearance min_clearance(const Chain& chain, const VecN& q, std::span<const doubl
   // k and k + 1; joint i moves frame m's origin when i <= m (and i < n).
   const int k = out.link;
   const EndpointGradient g = first_segment_gradient(out.closest);
+  out.obstacle_gradient = -(g.d_a + g.d_b);
   const Vec3& a = ws.links[k].a;
   const Vec3& b = ws.links[k].b;
   for (int i = 0; i <= k + 1 && i < n; ++i) {

@@ -24,6 +24,8 @@ using Obstacle = std::variant<Sphere, Box, Capsule>;
 /// The surface distance from a capsule (first) to an obstacle (second): capsule_sphere,
 /// capsule_box or capsule_capsule (geometry/distance.hpp, its conventions).
 ClosestPoints capsule_obstacle(const Capsule& link, const Obstacle& obstacle);
+/// The obstacle moved by `by` [m] (a sphere's or box's centre, both ends of a capsule).
+Obstacle translated(const Obstacle& obstacle, const Vec3& by);
 
 /// Fixed-size per-call workspace of min_clearance: no allocation.
 struct ClearanceWorkspace {
@@ -43,6 +45,9 @@ struct Clearance {
   /// first_segment_gradient); at a switch of the least pair it is the current pair's. (Translating
   /// the obstacle by dx changes the distance by closest.normal . dx: a moving obstacle's share.)
   VecN gradient;
+  /// d distance / d(translation of the least pair's obstacle) [m/m]: -(d_a + d_b), moving the
+  /// obstacle by dx being moving the link by -dx (zero without an obstacle).
+  Vec3 obstacle_gradient = Vec3::Zero();
 };
 
 /// The link capsules of `chain` at the frames of the last forward_kinematics(chain, data, q).

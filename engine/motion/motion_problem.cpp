@@ -63,6 +63,10 @@ bool MotionSpec::IsValid(std::string* why) const {
     return fail(why, "obstacles need one link radius per joint");
   for (double r : radii)
     if (!(r >= 0.0) || !std::isfinite(r)) return fail(why, "link radii must be finite and >= 0");
+  if (!obstacle_velocities.empty() && obstacle_velocities.size() != obstacles.size())
+    return fail(why, "obstacle_velocities needs one velocity per obstacle (or none: all fixed)");
+  for (const geometry::Vec3& v : obstacle_velocities)
+    if (!v.allFinite()) return fail(why, "obstacle velocities must be finite");
   if (!std::isfinite(clearance_margin)) return fail(why, "clearance_margin must be finite");
   if (!(limit_margin >= 0.0 && limit_margin < 1.0)) return fail(why, "limit_margin must be in [0, 1)");
   if (windows < 0) return fail(why, "windows must be >= 0");
@@ -118,6 +122,8 @@ MotionProblem::MotionProblem(MotionSpec spec) : spec_(std::move(spec)), basis_(s
   q_.assign(N, VecN::Zero(n_)), qd_ = q_, qdd_ = q_, tau_ = q_, clear_grad_ = q_;
   dtau_dq_.assign(N, MatN::Zero(n_, n_)), dtau_dqd_ = dtau_dq_, M_ = dtau_dq_;
   clear_.assign(N, kInf);
+  clear_dT_.assign(N, 0.0);
+  moved_ = spec_.obstacles;
   nodes_.resize(n_, K_ + 2);
   nodes_.col(0) = spec_.q_start;
   nodes_.col(K_ + 1) = spec_.q_goal;
@@ -270,9 +276,16 @@ void MotionProblem::evaluate(std::span<const double> x, bool gradients, MotionEv
       if (std::abs(tau[i]) > peak) peak = std::abs(tau[i]), peak_s = s, peak_i = i;
     if (const double m = manipulability(q); m < wmin) wmin = m, wmin_s = s;
     if (!spec_.obstacles.empty()) {
-      const geometry::Clearance c = geometry::min_clearance(chain, q, spec_.radii, spec_.obstacles, clear_ws_);
+      const bool moving = !spec_.obstacle_velocities.empty();
+      if (moving)
+        for (std::size_t j = 0; j < moved_.size(); ++j)
+          moved_[j] = geometry::translated(spec_.obstacles[j], (u_[s] * T) * spec_.obstacle_velocities[j]);
+      const geometry::Clearance c = geometry::min_clearance(chain, q, spec_.radii, moving ? moved_ : spec_.obstacles, clear_ws_);
       clear_[s] = c.distance;
       clear_grad_[s] = c.gradient;
+      clear_dT_[s] = moving && c.obstacle >= 0
+                         ? u_[s] * c.obstacle_gradient.dot(spec_.obstacle_velocities[static_cast<std::size_t>(c.obstacle)])
+                         : 0.0;
       if (c.distance < dmin) dmin = c.distance, dmin_s = s;
     }
     // the window's constraints: the largest value so far and its sample
@@ -343,8 +356,10 @@ void MotionProblem::evaluate(std::span<const double> x, bool gradients, MotionEv
     }
     project(wmin_s, a_q, zero, zero, 1.0, G[static_cast<int>(Criterion::min_manipulability)].data());
   }
-  if (!spec_.obstacles.empty())
+  if (!spec_.obstacles.empty()) {
     project(dmin_s, clear_grad_[dmin_s], zero, zero, 1.0, G[static_cast<int>(Criterion::min_clearance)].data());
+    if (spec_.vary_duration) G[static_cast<int>(Criterion::min_clearance)][nv - 1] += clear_dT_[dmin_s];
+  }
   for (int c = 0; c < kCriteria; ++c) {
     const double k = spec_.weights[c] * sense(static_cast<Criterion>(c)) / scale_[c];
     if (k != 0.0)
@@ -365,6 +380,8 @@ void MotionProblem::evaluate(std::span<const double> x, bool gradients, MotionEv
       case MotionConstraint::Kind::clearance: a_q = -clear_grad_[s]; break;
     }
     project(s, a_q, a_qd, a_qdd, 1.0, out.constraint_jacobian.data() + static_cast<std::size_t>(r) * nv);
+    if (k.kind == MotionConstraint::Kind::clearance && spec_.vary_duration)
+      out.constraint_jacobian[static_cast<std::size_t>(r) * nv + nv - 1] -= clear_dT_[s];
   }
 }
 

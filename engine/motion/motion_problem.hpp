@@ -14,7 +14,8 @@
 // differences of the RNEA, exact to rounding since τ is quadratic in q̇ (a central difference of a
 // quadratic has no truncation error); ∂τ/∂q by central differences of the RNEA with step
 // 6e-6 max(1, |q_j|) (truncation and rounding errors near 1e-10 relative). Manipulability: central
-// differences in q at its minimising sample; clearance: geometry::min_clearance's exact gradient.
+// differences in q at its minimising sample; clearance: geometry::min_clearance's exact gradient,
+// and for moving obstacles its share in T: u_s (d clearance / d translation) . v_j at fixed u.
 #include <array>
 #include <span>
 #include <string>
@@ -65,14 +66,18 @@ struct MotionSpec {
   double limit_margin = 0.0;   ///< a limited ratio must stay <= 1 - limit_margin
   int windows = 0;             ///< constraint windows (0: one per spline segment, K + 1; at most the samples)
 
-  std::vector<geometry::Obstacle> obstacles;  ///< in the base frame (none: no clearance constraint)
+  std::vector<geometry::Obstacle> obstacles;  ///< in the base frame at t = 0 (none: no clearance constraint)
+  /// One velocity per obstacle [m/s] (empty: all fixed): obstacle j at time t is obstacles[j]
+  /// translated by t obstacle_velocities[j], so the clearance at a sample depends on T too.
+  std::vector<geometry::Vec3> obstacle_velocities;
   std::vector<double> radii;   ///< one per link [m] (needed with obstacles)
   double clearance_margin = 0.0;  ///< clearance >= this [m], per window
 
   /// False (with the reason in *why) when the chain is invalid, sizes disagree, K or the samples are
   /// out of range, a duration bound is not 0 < min <= duration <= max, a weight is negative or not
   /// finite, no variable is free, the clearance weight is set without obstacles, radii are missing or
-  /// negative, or a margin is out of range (limit_margin in [0, 1), clearance_margin finite).
+  /// negative, obstacle_velocities is neither empty nor one finite velocity per obstacle, or a
+  /// margin is out of range (limit_margin in [0, 1), clearance_margin finite).
   bool IsValid(std::string* why = nullptr) const;
 };
 
@@ -159,6 +164,8 @@ class MotionProblem {
   mutable std::vector<MatN> dtau_dq_, dtau_dqd_, M_;
   mutable std::vector<VecN> clear_grad_;
   mutable std::vector<double> clear_;
+  mutable std::vector<double> clear_dT_;              // d clearance / dT at each sample (moving obstacles)
+  mutable std::vector<geometry::Obstacle> moved_;     // the obstacles at a sample's time
   mutable std::vector<int> top_sample_;              // each constraint's largest sample
 };
 

@@ -133,6 +133,7 @@ RunOutcome run_motion(const Scenario& sc, const MotionRun& run, int stride) {
   spec.normalise = run.normalise;
   if (sc.world && sc.world->has_obstacles()) {
     spec.obstacles = sc.world->obstacles;
+    spec.obstacle_velocities = sc.world->velocities;
     spec.radii = sc.world->link_radius;
     spec.clearance_margin = run.clearance_margin;
   }

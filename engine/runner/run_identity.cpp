@@ -138,6 +138,8 @@ void world_fields(const Study& s, std::vector<ContextField>& out) {
       add(k, "box centre " + vec3(b->centre) + ", R " + mat3(b->rotation) + ", half " + vec3(b->half));
     else if (const auto* c = std::get_if<geometry::Capsule>(&o))
       add(k, "capsule a " + vec3(c->a) + ", b " + vec3(c->b) + ", radius " + num(c->radius));
+    if (!s.world.velocities.empty() && s.world.velocities[i] != Vec3::Zero())  // fixed ones keep their field
+      add(k + " velocity", vec3(s.world.velocities[i]));
   }
   if (!s.world.link_radius.empty()) add("link_radius", list(s.world.link_radius));
 }

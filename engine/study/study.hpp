@@ -154,7 +154,8 @@ struct OptimizeBlock {
 /// The study's [world]: fixed obstacles in the robot's base frame and the radii of the links'
 /// capsules (geometry/link_capsules.hpp), which motion runs keep clear of the obstacles.
 struct World {
-  std::vector<geometry::Obstacle> obstacles;  ///< spheres, oriented boxes, capsules [m]
+  std::vector<geometry::Obstacle> obstacles;  ///< spheres, oriented boxes, capsules [m] (at t = 0)
+  std::vector<Vec3> velocities;               ///< one per obstacle [m/s] when any moves, else empty
   std::vector<double> link_radius;            ///< one per joint's link [m] (empty without obstacles)
   bool has_obstacles() const { return !obstacles.empty(); }
 };

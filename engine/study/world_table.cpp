@@ -6,6 +6,7 @@
 //     { type = "sphere", centre = [0.5, 0.2, 0.3], radius = 0.1 },
 //     { type = "box", centre = [x, y, z], half = [hx, hy, hz], rpy = [r, p, y] },   # rpy [deg], optional
 //     { type = "capsule", a = [x, y, z], b = [x, y, z], radius = r },
+//     { type = "sphere", centre = [1, 0, 0], radius = 0.1, velocity = [0, 0.1, 0] },  # m/s: moving
 //   ]
 //
 // Everything in metres in the robot's base frame (a URDF file's base link; a DH table's frame 0).
@@ -64,14 +65,14 @@ std::optional<geometry::Obstacle> Parser::parse_obstacle(const toml::node& n, st
     return r;
   };
   if (*type == "sphere") {
-    check_keys(*t, {"type", "centre", "radius"}, what + " (sphere)");
+    check_keys(*t, {"type", "centre", "radius", "velocity"}, what + " (sphere)");
     auto c = point("centre");
     auto r = radius();
     if (!c || !r) return std::nullopt;
     return geometry::Obstacle(geometry::Sphere{*c, *r});
   }
   if (*type == "capsule") {
-    check_keys(*t, {"type", "a", "b", "radius"}, what + " (capsule)");
+    check_keys(*t, {"type", "a", "b", "radius", "velocity"}, what + " (capsule)");
     auto a = point("a");
     auto b = point("b");
     auto r = radius();
@@ -79,7 +80,7 @@ std::optional<geometry::Obstacle> Parser::parse_obstacle(const toml::node& n, st
     return geometry::Obstacle(geometry::Capsule{*a, *b, *r});
   }
   if (*type == "box") {
-    check_keys(*t, {"type", "centre", "half", "rpy"}, what + " (box)");
+    check_keys(*t, {"type", "centre", "half", "rpy", "velocity"}, what + " (box)");
     auto c = point("centre");
     auto h = point("half");
     if (h && !(h->array() >= 0.0).all()) {
@@ -115,8 +116,27 @@ void Parser::parse_world(const toml::table& root, Study& s) {
     if (!a) {
       error(*on, "[world] obstacles is " + type_name(*on) + "; expected an array of obstacle tables");
     } else {
-      for (std::size_t i = 0; i < a->size(); ++i)
-        if (auto o = parse_obstacle(*a->get(i), i)) s.world.obstacles.push_back(*o);
+      std::vector<Vec3> velocities;
+      bool moving = false;
+      for (std::size_t i = 0; i < a->size(); ++i) {
+        auto o = parse_obstacle(*a->get(i), i);
+        if (!o) continue;
+        s.world.obstacles.push_back(*o);
+        Vec3 v = Vec3::Zero();
+        const toml::table* t = a->get(i)->as_table();
+        if (t && t->get("velocity")) {
+          const std::string what = "[world] obstacles[" + std::to_string(i) + "] velocity";
+          auto n = get_numbers(*t, "velocity", 3, 3, what, "3 numbers [vx, vy, vz] [m/s]");
+          if (n && std::isfinite((*n)[0]) && std::isfinite((*n)[1]) && std::isfinite((*n)[2])) {
+            v = Vec3((*n)[0], (*n)[1], (*n)[2]);
+            moving = true;
+          } else if (n) {
+            error(*t->get("velocity"), what + " is not finite; expected 3 finite numbers [m/s]");
+          }
+        }
+        velocities.push_back(v);
+      }
+      if (moving) s.world.velocities = velocities;
     }
   }
   if (const toml::node* rn = w->get("link_radius")) {

@@ -190,6 +190,10 @@ class MotionRuns(TempDirTest):
         world = ('[world]\nlink_radius = [0.05, 0.05, 0.05]\n'
                  'obstacles = [{ type = "box", centre = [1, 1], half = [0.1, 0.1, 0.1] }]\n\n')
         self.refused("bad_centre", study("bad_centre", [("m", "")], world), 10, ["centre is an array of 2"])
+        world = ('[world]\nlink_radius = [0.05, 0.05, 0.05]\n'
+                 'obstacles = [{ type = "sphere", centre = [1, 1, 1], radius = 0.1, velocity = [1, 2] }]\n\n')
+        self.refused("bad_velocity", study("bad_velocity", [("m", "")], world), 10,
+                     ["velocity is an array of 2", "[vx, vy, vz] [m/s]"])
         self.refused("start4", study("start4", [("m", "start_4 = 10")]), 20, ["unknown key 'start_4'"])
         self.refused("no_world", study("no_world", [("m", "w_clearance = 1")]), 20,
                      ["w_clearance weighs the least clearance", "[world] obstacles with link_radius"])

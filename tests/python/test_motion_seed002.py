@@ -11,6 +11,9 @@ back with h5py; the comparisons studies/README.md states are these files' number
   check, and the clearance recomputed here from the stored link points against the box (point
   distances, kinesweep.motion_view) agrees with the engine's at every stored sample; each K lowers
   both T and f6 below the cubic's, and T is at most Table 7.15's for K = 1, 2, 3.
+- 7.5 (motion_moving_2r): three obstacles moving in straight lines; the cubic collides near t = 3 s,
+  the optimum is ok with f6 below the cubic's, and the clearance recomputed here with each obstacle
+  where it is at each sample's time equals the engine's.
 - studies/README.md's tables of these experiments are these files' numbers; the report of the Elbow
   file has the arm's motion figure.
 
@@ -51,7 +54,7 @@ class MotionSeed002(unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
         cls.h5 = {}
-        for s in ("motion_puma", "motion_planar2r", "motion_elbow"):
+        for s in ("motion_puma", "motion_planar2r", "motion_elbow", "motion_moving_2r"):
             cls.h5[s] = os.path.join(cls.tmp.name, s + ".h5")
             r = subprocess.run([KS, "run", os.path.join(SOURCE, "studies", s + ".toml"), "-o", cls.h5[s], "-q"],
                                capture_output=True, text=True)
@@ -110,6 +113,25 @@ class MotionSeed002(unittest.TestCase):
                 K = int(c["controls"][i])
                 if K <= 3:
                     self.assertLessEqual(c["final_duration"][i], TABLE_7_15_T[K])
+
+    def test_planar2r_passes_three_moving_obstacles(self):
+        c = self.c["motion_moving_2r"]
+        with open(os.path.join(SOURCE, "studies", "motion_moving_2r.toml"), encoding="utf-8") as fh:
+            obstacles, radii = motion_view.world_of(fh.read())
+        self.assertTrue(motion_view.moving(obstacles))
+        with h5py.File(self.h5["motion_moving_2r"], "r") as f:
+            for run in (0, 1):
+                h = history(f, run)
+                t = h["t"][:, 0]
+                here = np.array([motion_view.clearance(row, radii, obstacles, ts) for row, ts in zip(h["points"], t)])
+                # spheres: exact point-segment distances, each obstacle where it is at the sample's time
+                self.assertAlmostEqual(here.min(), c["min_clearance"][run], delta=1e-12)
+                if run == 0:  # the cubic runs into an obstacle near t = 3 s (the seed: t = 3 s and 5 s)
+                    hit = t[here < 0]
+                    self.assertTrue(len(hit) > 0 and 2.5 < hit.min() and hit.max() < 3.5, hit)
+        self.assertEqual(c["status"].tolist(), ["collision", "ok"])
+        self.assertGreaterEqual(c["check_min_clearance"][1], 0.0)
+        self.assertLess(c["power_sq_integral"][1], c["power_sq_integral_0"][1])
 
     def test_readme_tables_are_these_files(self):
         c = self.c["motion_elbow"]
