@@ -101,7 +101,8 @@ def main(argv=None):
     try:
         res = ksread.open_results(args.file)
     except (OSError, ksread.FormatVersionError) as e:
-        fail(f"{args.file}: {e}", 1)
+        why = "no such file" if isinstance(e, FileNotFoundError) else (getattr(e, "strerror", None) or str(e))
+        fail(f"{args.file}: cannot read it as a results file: {why}", 1)
     ids = choose_runs(res, args)[:MAX_ROWS]
     obstacles, radii = mv.world_of(res.study_text or "")
     hist = {r: res.history(r, degrees=not args.radians) for r in ids}
