@@ -29,6 +29,8 @@ namespace ks {
 inline double select(bool m, double a, double b) { return m ? a : b; }
 inline bool any(bool m) { return m; }
 inline bool all(bool m) { return m; }
+/// Both masks (a lane holds in both): a && b for one lane, a & b for vectors' masks.
+inline bool both(bool a, bool b) { return a && b; }
 inline double vabs(double x) { return std::abs(x); }
 inline double vsqrt(double x) { return std::sqrt(x); }
 /// std::min(a, b) and std::max(a, b) per lane: b < a ? b : a and a < b ? b : a.
@@ -57,6 +59,7 @@ struct M64x4 {
   __m256d m;  // all ones or all zeros per lane
 };
 inline M64x4 operator&(M64x4 a, M64x4 b) { return {_mm256_and_pd(a.m, b.m)}; }
+inline M64x4 both(M64x4 a, M64x4 b) { return a & b; }
 inline M64x4 operator|(M64x4 a, M64x4 b) { return {_mm256_or_pd(a.m, b.m)}; }
 inline M64x4 operator!(M64x4 a) { return {_mm256_xor_pd(a.m, _mm256_castsi256_pd(_mm256_set1_epi64x(-1)))}; }
 inline bool any(M64x4 a) { return _mm256_movemask_pd(a.m) != 0; }
@@ -112,6 +115,7 @@ struct M64x8 {
   __mmask8 m;
 };
 inline M64x8 operator&(M64x8 a, M64x8 b) { return {static_cast<__mmask8>(a.m & b.m)}; }
+inline M64x8 both(M64x8 a, M64x8 b) { return a & b; }
 inline M64x8 operator|(M64x8 a, M64x8 b) { return {static_cast<__mmask8>(a.m | b.m)}; }
 inline M64x8 operator!(M64x8 a) { return {static_cast<__mmask8>(~a.m)}; }
 inline bool any(M64x8 a) { return a.m != 0; }

@@ -94,7 +94,7 @@ inline void sample_3r(const PlanarArm3& arm, const DynamicsCoefficients& dyn, co
   if (solve_elbow) {
     const T c2_raw = (d - (l1 * l1 + l2 * l2)) * (1.0 / (2.0 * l1 * l2));
     const L raw = value_of(c2_raw);
-    s.reachable = (value_of(d) > L(0.0)) & (vabs(raw) <= L(1.0));
+    s.reachable = both(value_of(d) > L(0.0), vabs(raw) <= L(1.0));
     c2 = select(raw > L(clamp), T(clamp), select(raw < L(-clamp), T(-clamp), c2_raw));
     s2 = static_cast<double>(elbow) * sqrt_of(1.0 - c2 * c2);
   } else {
