@@ -104,6 +104,38 @@ TEST(MotionKind, SolvedRunEqualsSolveMotion) {
   EXPECT_TRUE(out.history.arrays.empty());
 }
 
+// The dense check (check_factor times the samples) is the motion problem at those samples evaluated
+// at the run's end: a problem that skips its reference's evaluation gives the same criteria bit for
+// bit as one that evaluates it, and says its reference is not there.
+TEST(MotionKind, DenseCheckIsTheProblemAtDenseSamples) {
+  const Study s = parse_study(puma_study("solve = false\ncheck_factor = 4\n"), "motion.toml");
+  RunWorkspace ws;
+  const RunOutcome out = execute(Scenario::of(s), s.blocks[0].run(0), 0, ws);
+  const MotionResult& r = result_of(out);
+  MotionSpec spec = puma_spec(s);
+  const MotionProblem P(spec);
+  spec.samples = 4 * (P.samples() - 1) + 1;
+  spec.normalise = false;
+  const MotionProblem with_reference(spec);
+  spec.evaluate_reference = false;
+  const MotionProblem without(spec);
+  EXPECT_TRUE(std::isnan(at(without.reference(), Criterion::torque_sq)));
+  EXPECT_FALSE(std::isnan(at(with_reference.reference(), Criterion::torque_sq)));
+  MotionEvaluation a, b;
+  with_reference.evaluate(P.initial_point(), false, a);
+  without.evaluate(P.initial_point(), false, b);
+  for (int c = 0; c < kCriteria; ++c) EXPECT_EQ(a.criteria[c], b.criteria[c]) << c;
+  EXPECT_EQ(a.constraints, b.constraints);
+  EXPECT_EQ(r.check_samples, without.samples());
+  EXPECT_EQ(r.check_min_clearance, at(b.criteria, Criterion::min_clearance));
+  EXPECT_EQ(r.check_torque_sq_change, (at(b.criteria, Criterion::torque_sq) - r.torque_sq) / std::abs(r.torque_sq));
+  // a problem without its reference cannot normalise
+  spec.normalise = true;
+  std::string why;
+  EXPECT_FALSE(spec.IsValid(&why));
+  EXPECT_NE(why.find("evaluate_reference"), std::string::npos) << why;
+}
+
 TEST(MotionKind, Tables) {
   KindContext ctx;
   ctx.robot.chain = true;

@@ -68,9 +68,16 @@ bool MotionSpec::IsValid(std::string* why) const {
   for (const geometry::Vec3& v : obstacle_velocities)
     if (!v.allFinite()) return fail(why, "obstacle velocities must be finite");
   if (!std::isfinite(clearance_margin)) return fail(why, "clearance_margin must be finite");
+  if (normalise && !evaluate_reference) return fail(why, "normalise needs the reference (evaluate_reference)");
   if (!(limit_margin >= 0.0 && limit_margin < 1.0)) return fail(why, "limit_margin must be in [0, 1)");
   if (windows < 0) return fail(why, "windows must be >= 0");
   return true;
+}
+
+int motion_sample_count(int samples, int controls) {
+  const int seg = controls + 1;
+  const int per = std::max(1, (samples - 1 + seg - 1) / seg);
+  return per * seg + 1;
 }
 
 MotionProblem::MotionProblem(MotionSpec spec) : spec_(std::move(spec)), basis_(std::clamp(spec_.controls, 0, kMaxControls)) {
@@ -83,10 +90,8 @@ MotionProblem::MotionProblem(MotionSpec spec) : spec_(std::move(spec)), basis_(s
   if (!spec_.vary_controls && spec_.fixed_controls.empty())
     spec_.fixed_controls = JointSpline(spec_.q_start, spec_.q_goal, K_, spec_.duration).cubic_controls();
 
-  // samples: the least N >= spec.samples with N - 1 a multiple of K + 1 (every node a sample)
   const int seg = K_ + 1;
-  const int per = std::max(1, (spec_.samples - 1 + seg - 1) / seg);
-  const int N = per * seg + 1;
+  const int N = motion_sample_count(spec_.samples, K_);
   u_.resize(N);
   c_.resize(N);
   w_.resize(N);
@@ -129,6 +134,8 @@ MotionProblem::MotionProblem(MotionSpec spec) : spec_(std::move(spec)), basis_(s
   nodes_.col(K_ + 1) = spec_.q_goal;
 
   scale_.fill(1.0);
+  reference_.fill(std::numeric_limits<double>::quiet_NaN());
+  if (!spec_.evaluate_reference) return;
   MotionEvaluation e;
   evaluate(initial_point(), false, e);
   reference_ = e.criteria;

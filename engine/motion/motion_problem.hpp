@@ -61,6 +61,9 @@ struct MotionSpec {
 
   Criteria weights{};          ///< the objective's weight of each criterion (>= 0)
   bool normalise = false;      ///< divide each term by its reference value (reference(): the initial cubic's)
+  /// Evaluate the initial point as the reference (reference()); false leaves the reference NaN (a
+  /// problem only evaluated at given points, such as a dense check; normalise needs it).
+  bool evaluate_reference = true;
 
   bool position_limits = true, velocity_limits = true, effort_limits = true;  ///< the chain's finite limits as constraints
   double limit_margin = 0.0;   ///< a limited ratio must stay <= 1 - limit_margin
@@ -99,11 +102,15 @@ struct MotionConstraint {
   int window = 0;
 };
 
+/// The samples of a motion of `controls` control values per joint asked for at least `samples`: the
+/// least N >= samples with N - 1 a multiple of controls + 1 (every spline node a sample).
+int motion_sample_count(int samples, int controls);
+
 /// The motion problem. The variables x: the control values (n K, joint-major) when vary_controls,
 /// then T when vary_duration. evaluate() uses the problem's own workspace: one thread at a time.
 class MotionProblem {
  public:
-  /// Samples the motion and evaluates the initial point (reference()). Throws std::invalid_argument
+  /// Samples the motion and evaluates the initial point (reference(), when spec.evaluate_reference). Throws std::invalid_argument
   /// when !spec.IsValid(), or when spec.normalise meets a weighted criterion whose reference value is
   /// 0 or not finite (e.g. the manipulability of a motion that starts at a singularity).
   explicit MotionProblem(MotionSpec spec);

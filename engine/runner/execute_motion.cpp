@@ -80,6 +80,7 @@ bool dense_check(const motion::MotionProblem& problem, const std::vector<double>
   motion::MotionSpec spec = problem.spec();
   spec.samples = factor * (problem.samples() - 1) + 1;
   spec.normalise = false;  // the objective is not used; its reference may be 0
+  spec.evaluate_reference = false;
   const motion::MotionProblem dense(std::move(spec));
   motion::MotionEvaluation ev;
   dense.evaluate(x, false, ev);
