@@ -12,6 +12,7 @@
 #include <optional>
 #include <ostream>
 
+#include "motion/motion_problem.hpp"
 #include "runner/execute.hpp"
 #include "schema/params.hpp"
 
@@ -42,8 +43,9 @@ std::vector<BestRunRef> best_runs_to_verify(const Study& study, const store::Res
   const std::size_t status_col = column_of(columns, "status"), method_col = column_of(columns, "method");
   for (std::size_t b = 0; b < study.blocks.size(); ++b) {
     const Block& block = study.blocks[b];
-    if (block.kind() != BlockKind::trajectory || block.run_count() == 0) continue;
-    if (status_col >= columns.size() || method_col >= columns.size()) continue;
+    const bool motion = block.kind() == BlockKind::motion;
+    if ((block.kind() != BlockKind::trajectory && !motion) || block.run_count() == 0) continue;
+    if (status_col >= columns.size() || (!motion && method_col >= columns.size())) continue;
     // the metrics ranked by (the kind's objective first, with its tie metric), as columns
     const Ranking rank = ranking(block.kind());
     std::vector<std::string> by{std::string(rank.objective)};
@@ -85,8 +87,8 @@ std::vector<BestRunRef> best_runs_to_verify(const Study& study, const store::Res
         BestRunRef ref;
         ref.run = first + at + i;
         ref.block = b;
-        ref.method = text_of(cells[method_col]);
-        ref.group = "method=" + ref.method;
+        ref.method = motion ? "" : text_of(cells[method_col]);
+        ref.group = motion ? "block=" + block.name() : "method=" + ref.method;
         for (const Condition& c : conditions) {
           const bool applies =
               c.controller >= columns.size() ? c.effect->always() : c.effect->applies(text_of(cells[c.controller]));
@@ -127,16 +129,36 @@ std::vector<BestRunRef> best_runs_to_verify(const Study& study, const store::Res
 }
 
 namespace {
-/// One refined computation: a run's spec with dt or knots changed.
+/// What a refinement changes: a trajectory run's dt or knots, a motion run's samples or controls.
+enum class Refinement { dt, knots, samples, controls };
+constexpr const char* kRefinementNames[] = {"dt", "knots", "samples", "controls"};
+
+/// One refined computation: a run's spec with one refinement applied.
 struct Task {
   std::size_t ref = 0;      // index into the runs verified
-  bool knots = false;       // refinement "knots" (else "dt")
+  Refinement refinement = Refinement::dt;
   int grid = 0;             // 0 (finest) or 1
   bool runnable = true;     // false: beyond the parameter's domain, not run
-  TrajectoryRun run;
+  RunSpec run;
   RunOutcome outcome;
   bool done = false;
 };
+
+/// The refinements of a run: dt (and knots for global_spline's cubic splines), or a motion's samples
+/// (and controls when it solves with controls).
+std::vector<Refinement> refinements_of(const RunSpec& spec) {
+  if (const auto* traj = std::get_if<TrajectoryRun>(&spec)) {
+    const TrajectoryOptions& o = traj->options;
+    if (o.method == TrajectoryMethod::global_spline && o.global.spline == AlphaSpline::cubic)
+      return {Refinement::dt, Refinement::knots};
+    return {Refinement::dt};
+  }
+  if (const auto* m = std::get_if<MotionRun>(&spec)) {
+    if (m->solve && m->controls > 0) return {Refinement::samples, Refinement::controls};
+    return {Refinement::samples};
+  }
+  return {};
+}
 
 /// The value of metric `name` of `metrics` in outcome `o` (NaN when absent or not numeric).
 double metric_value(const std::vector<MetricDef>& metrics, const std::string& name, const RunOutcome& o) {
@@ -152,32 +174,38 @@ store::VerificationTable verify_best_runs(const Study& study, const store::Resul
   table.safety_factor = options.gci.safety_factor;
   // The refined specs: grid 0 is the finest (dt/4 or 4K), grid 1 the middle one (dt/2 or 2K).
   std::vector<Task> tasks;
-  std::vector<bool> has_knots(runs.size(), false);
   double duration = 0.0;  // of the study's path [s]
   for (const double d : study.task.durations) duration += d;
   auto affordable = [&](double dt) { return duration / dt + 1.0 <= options.max_samples; };
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const Block& block = study.blocks[runs[i].block];
     const RunSpec spec = block.run(runs[i].run - study.first_run(runs[i].block));
-    const auto* traj = std::get_if<TrajectoryRun>(&spec);
-    if (!traj) continue;
-    const TrajectoryOptions& o = traj->options;
-    has_knots[i] = o.method == TrajectoryMethod::global_spline && o.global.spline == AlphaSpline::cubic;
-    for (int grid = 0; grid < 2; ++grid) {
-      const double factor = grid == 0 ? kGridRatio * kGridRatio : kGridRatio;
-      Task t;
-      t.ref = i, t.grid = grid, t.run = *traj;
-      t.run.options.dt = o.dt / factor;
-      t.runnable = affordable(t.run.options.dt);
-      tasks.push_back(t);
-      if (!has_knots[i]) continue;
-      const double knots = static_cast<double>(o.global.knots) * factor;
-      t.knots = true;
-      t.run = *traj;
-      t.run.options.global.knots = static_cast<std::int64_t>(knots);
-      t.runnable = PathGlobalOptions::knots_rule.holds(knots) && affordable(o.dt);
-      tasks.push_back(std::move(t));
-    }
+    for (const Refinement refinement : refinements_of(spec))
+      for (int grid = 0; grid < 2; ++grid) {
+        const int factor = grid == 0 ? 4 : 2;  // kGridRatio^2, kGridRatio
+        Task t;
+        t.ref = i, t.grid = grid, t.refinement = refinement, t.run = spec;
+        if (auto* traj = std::get_if<TrajectoryRun>(&t.run)) {
+          TrajectoryOptions& o = traj->options;
+          if (refinement == Refinement::dt) {
+            o.dt /= factor;
+            t.runnable = affordable(o.dt);
+          } else {
+            const double knots = static_cast<double>(o.global.knots) * factor;
+            o.global.knots = static_cast<std::int64_t>(knots);
+            t.runnable = PathGlobalOptions::knots_rule.holds(knots) && affordable(o.dt);
+          }
+        } else if (auto* m = std::get_if<MotionRun>(&t.run)) {
+          if (refinement == Refinement::samples) {  // the sample intervals divided by the factor
+            m->samples = factor * (motion::motion_sample_count(m->samples, m->controls) - 1) + 1;
+            t.runnable = MotionRun::samples_rule.holds(m->samples);
+          } else {
+            m->controls *= factor;
+            t.runnable = MotionRun::controls_rule.holds(m->controls);
+          }
+        }
+        tasks.push_back(std::move(t));
+      }
   }
   const Scenario scenario = Scenario::of(study);
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
@@ -186,7 +214,7 @@ store::VerificationTable verify_best_runs(const Study& study, const store::Resul
       Task& t = tasks[i];
       if (!t.runnable || (options.stop && options.stop->load())) return;
       RunWorkspace workspace;
-      t.outcome = execute(scenario, RunSpec(t.run), 0, workspace);
+      t.outcome = execute(scenario, t.run, 0, workspace);
       t.done = true;
     });
   });
@@ -197,23 +225,26 @@ store::VerificationTable verify_best_runs(const Study& study, const store::Resul
     const Block& block = study.blocks[ref.block];
     const RunSpec spec = block.run(ref.run - study.first_run(ref.block));
     const auto* traj = std::get_if<TrajectoryRun>(&spec);
-    if (!traj) continue;
+    const auto* motion_run = std::get_if<MotionRun>(&spec);
+    if (!traj && !motion_run) continue;
     const Record stored = file.read_record(static_cast<std::int64_t>(ref.run));
     auto stored_cell = [&](const std::string& name) -> const Cell* {
       const std::size_t c = column_of(columns, name);
       return c < columns.size() ? &stored.cells[c] : nullptr;
     };
     const Cell* stored_status = stored_cell("status");
-    for (const bool knots : {false, true}) {
-      if (knots && !has_knots[i]) continue;
+    const std::string good(statuses(block.kind()).front());
+    const Cell* stored_duration = motion_run ? stored_cell("final_duration") : nullptr;
+    const double motion_T = stored_duration ? cell_number(*stored_duration) : kNaN;  // [s]
+    for (const Refinement refinement : refinements_of(spec)) {
       const Task* grid[2] = {nullptr, nullptr};
       for (const Task& t : tasks)
-        if (t.ref == i && t.knots == knots) grid[t.grid] = &t;
-      for (const std::string& q : options.quantities) {
+        if (t.ref == i && t.refinement == refinement) grid[t.grid] = &t;
+      for (const std::string& q : traj ? options.quantities : options.motion_quantities) {
         const MetricDef* def = nullptr;
         for (const MetricDef& m : block.metrics())
           if (m.name == q && m.type == CellType::f64) def = &m;
-        if (!def || (q == "opt_objective" && traj->options.method != TrajectoryMethod::global_spline)) continue;
+        if (!def || (traj && q == "opt_objective" && traj->options.method != TrajectoryMethod::global_spline)) continue;
         const Cell* stored_value = stored_cell(q);
         if (!stored_value) continue;
         store::VerificationRow row;
@@ -223,15 +254,26 @@ store::VerificationTable verify_best_runs(const Study& study, const store::Resul
         row.group = ref.group;
         row.quantity = q;
         row.unit = def->unit;
-        row.refinement = knots ? "knots" : "dt";
+        row.refinement = kRefinementNames[static_cast<int>(refinement)];
         row.ratio = kGridRatio;
-        const std::string good(statuses(BlockKind::trajectory).front());
         bool all_good = stored_status && text_of(*stored_status) == good;
         for (int g = 0; g < 3; ++g) {
-          const double factor = std::pow(kGridRatio, 2 - g);  // grid 0: r^2, grid 1: r, grid 2 (3): 1
-          const double k = has_knots[i] ? static_cast<double>(traj->options.global.knots) : kNaN;
-          row.dt[g] = knots ? traj->options.dt : traj->options.dt / factor;
-          row.knots[g] = knots ? k * factor : k;
+          const int factor = g == 0 ? 4 : g == 1 ? 2 : 1;  // grid 0: r^2, grid 1: r, grid 2 (3): 1
+          if (traj) {
+            const bool knots = refinement == Refinement::knots;
+            const double k = traj->options.method == TrajectoryMethod::global_spline &&
+                                     traj->options.global.spline == AlphaSpline::cubic
+                                 ? static_cast<double>(traj->options.global.knots)
+                                 : kNaN;
+            row.dt[g] = knots ? traj->options.dt : traj->options.dt / factor;
+            row.knots[g] = knots ? k * factor : k;
+          } else {  // dt: the sample step at the stored duration; knots: the controls per joint
+            const bool controls = refinement == Refinement::controls;
+            const int K = motion_run->controls * (controls ? factor : 1);
+            const int N = motion::motion_sample_count(motion_run->samples, K);
+            row.dt[g] = motion_T / (controls ? N - 1 : factor * (N - 1));
+            row.knots[g] = static_cast<double>(K);
+          }
           if (g == 2) {
             row.value[g] = cell_number(*stored_value);
             row.status[g] = stored_status ? text_of(*stored_status) : "";
@@ -283,11 +325,13 @@ std::string with_unit(double v, const std::string& unit) { return unit.empty() ?
 std::string verification_phrase(const store::VerificationRow& r) {
   Convergence c = Convergence::not_enough;
   parse(r.convergence, c);
-  const bool knots = r.refinement == "knots";
+  // the grids as knots or controls per joint, else as the step [s]
+  const bool knots = r.refinement == "knots" || r.refinement == "controls";
+  const std::string grid_unit = r.refinement == "knots" ? " knots" : r.refinement == "controls" ? " controls" : " s";
   auto grids = [&] {
     std::string s;
     for (int g = 2; g >= 0; --g) s += (g == 2 ? "" : ", ") + num(knots ? r.knots[g] : r.dt[g]);
-    return s + (knots ? " knots" : " s");
+    return s + grid_unit;
   };
   auto values = [&] {
     std::string s;
@@ -310,20 +354,22 @@ std::string verification_phrase(const store::VerificationRow& r) {
   std::string why;
   for (int g = 1; g >= 0; --g)
     if (r.status[g] != "ok") why += (why.empty() ? "" : ", ") + r.status[g] + " at " + num(knots ? r.knots[g] : r.dt[g]) +
-                                    (knots ? " knots" : " s");
+                                    grid_unit;
   if (r.status[2] != "ok") why += (why.empty() ? "" : ", ") + r.status[2] + " as stored";
   return r.quantity + ": not verified (" + (why.empty() ? "a value is not finite" : why) + ")";
 }
 
 void print_verification(std::ostream& out, const store::VerificationTable& table) {
   if (table.rows.empty()) return;
-  out << "best runs against the grid (dt, dt/2, dt/4; global_spline also K, 2K, 4K knots; GCI of the run as stored, "
-         "Fs = " << num(table.safety_factor) << "):\n";
+  out << "best runs against the grid (dt, dt/2, dt/4; global_spline also K, 2K, 4K knots; motions 2 and 4 times "
+         "the sample intervals, 2K and 4K controls; GCI of the run as stored, Fs = " << num(table.safety_factor) << "):\n";
   const auto& rows = table.rows;
   for (std::size_t i = 0; i < rows.size();) {
     if (i == 0 || rows[i - 1].run != rows[i].run)
       out << "  run " << rows[i].run << " (block " << rows[i].block << ", " << rows[i].group << ")\n";
-    out << "    " << (rows[i].refinement == "knots" ? "knots: " : "dt:    ") << verification_phrase(rows[i]);
+    std::string label = rows[i].refinement + ":";
+    label.resize(std::max<std::size_t>(label.size() + 1, 7), ' ');
+    out << "    " << label << verification_phrase(rows[i]);
     std::size_t j = i + 1;
     for (; j < rows.size() && rows[j].run == rows[i].run && rows[j].refinement == rows[i].refinement; ++j)
       out << "; " << verification_phrase(rows[j]);

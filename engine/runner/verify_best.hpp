@@ -28,10 +28,11 @@ inline const std::vector<std::string> kVerifiedRankings{"torque_sq_integral"};
 
 /// The runs to verify in a results file of `study` (`file`, its done runs): per trajectory block, per
 /// method and, where they have an effect on the run, per end_state (a run ending at rest and one
-/// free to move are not the same problem) and per inertia form (not the same robot model), the best
-/// good run under the kind's ranking (schema/params.hpp `ranking`: lowest objective, then tie, then
-/// run id) and the one of lowest value of each metric of `rank_by` (then lowest run id); each run
-/// once. In block order, then by group. Throws store::StoreError when the file cannot be read.
+/// free to move are not the same problem) and per inertia form (not the same robot model), and per
+/// motion block, the best good run under the kind's ranking (schema/params.hpp `ranking`: lowest
+/// objective, then tie, then run id) and the one of lowest value of each metric of `rank_by` (then
+/// lowest run id); each run once. In block order, then by group ("block=NAME" for a motion block).
+/// Throws store::StoreError when the file cannot be read.
 std::vector<BestRunRef> best_runs_to_verify(const Study& study, const store::ResultsReader& file,
                                             const std::vector<std::string>& rank_by = kVerifiedRankings);
 
@@ -42,6 +43,8 @@ struct BestRunVerifyOptions {
   /// The /runs metrics verified (each that the block has): E, the peak torque, the integral of tau^T
   /// tau, and global_spline's objective.
   std::vector<std::string> quantities{"E", "tau_inf", "torque_sq_integral", "opt_objective"};
+  /// The /runs metrics verified of a motion run: its objective, final duration, f5 and f6.
+  std::vector<std::string> motion_quantities{"objective", "final_duration", "torque_sq_integral", "power_sq_integral"};
   const std::atomic<bool>* stop = nullptr;  ///< set: the runs not begun are skipped (their rows not_enough)
   /// The most samples a refined run may take (the path's duration / its dt, + 1): a longer one is not
   /// run (status not_run; its rows not_enough), as its sampled path alone would take memory in
@@ -50,11 +53,14 @@ struct BestRunVerifyOptions {
 };
 inline constexpr double kGridRatio = 2.0;  ///< the refinement ratio r of the verification grids
 
-/// The grid studies of `runs` (from best_runs_to_verify): each run's spec computed at dt/2 and dt/4
-/// (refinement "dt"), and for global_spline with cubic splines at 2K and 4K knots ("knots", skipped
-/// when 4K is beyond the knots' domain), in parallel (a refined run of more than max_samples samples
-/// is not run); grid 3 is the stored row of `file`. One row per
-/// (run, refinement, quantity). The same whatever the thread count (each run is a pure function of
+/// The grid studies of `runs` (from best_runs_to_verify): each trajectory run's spec computed at dt/2
+/// and dt/4 (refinement "dt"), and for global_spline with cubic splines at 2K and 4K knots ("knots",
+/// skipped when 4K is beyond the knots' domain); each motion run's with 2 and 4 times as many sample
+/// intervals ("samples") and, when it solves with K > 0 controls, with 2K and 4K controls
+/// ("controls", skipped beyond the controls' domain); in parallel (a refined trajectory run of more
+/// than max_samples samples is not run); grid 3 is the stored row of `file`. One row per (run,
+/// refinement, quantity); a motion row's dt is its sample step at the stored duration [s] and its
+/// knots its controls per joint. The same whatever the thread count (each run is a pure function of
 /// its spec).
 store::VerificationTable verify_best_runs(const Study& study, const store::ResultsReader& file,
                                           const std::vector<BestRunRef>& runs, const BestRunVerifyOptions& options);

@@ -14,8 +14,9 @@ back with h5py; the comparisons studies/README.md states are these files' number
 - 7.5 (motion_moving_2r): three obstacles moving in straight lines; the cubic collides near t = 3 s,
   the optimum is ok with f6 below the cubic's, and the clearance recomputed here with each obstacle
   where it is at each sample's time equals the engine's.
-- studies/README.md's tables of these experiments are these files' numbers; the report of the Elbow
-  file has the arm's motion figure.
+- studies/README.md's tables of these experiments are these files' numbers, and so is its statement of
+  the Elbow optimum against the grid (/verification); the report of the Elbow file has the arm's
+  motion figure.
 
 usage: /usr/bin/python3 test_motion_seed002.py KINESWEEP_BINARY SOURCE_DIR
 """
@@ -152,6 +153,25 @@ class MotionSeed002(unittest.TestCase):
             self.assertEqual(m.group(1), f"{c['torque_sq_integral'][at][0]:.1f}")
             self.assertEqual(m.group(2), f"{c['power_sq_integral'][at][0]:.2f}")
             self.assertEqual(m.group(3), f"{c['objective'][at][0]:.3f}")
+
+    def test_readme_grid_statement_is_this_file(self):
+        """The Elbow's "Against the grid" paragraph: K = 4's optimum against 2 and 4 times the sample
+        intervals and 2K, 4K controls, as /verification holds them."""
+        with h5py.File(self.h5["motion_elbow"], "r") as f:
+            g = f["verification"]
+            rows = {(g["refinement"].asstr()[i], g["quantity"].asstr()[i]): (g["value"][i], g["gci_coarse"][i],
+                                                                              g["extrapolated"][i])
+                    for i in range(len(g["run"])) if g["group"].asstr()[i].startswith("lowest objective")}
+        para = self.readme[self.readme.index("**Against the grid**"):]
+        para = " ".join(para[:para.index("\n\n")].split())
+        e = lambda x: f"{100 * x:.1e}".replace("e-0", "e-")  # noqa: E731
+        T, T_gci, _ = rows[("samples", "final_duration")]
+        self.assertIn(f"T = {T[2]:.3f} s, GCI {e(T_gci)} %", para)
+        self.assertIn(f"f6 GCI {e(rows[('samples', 'power_sq_integral')][1])} %", para)
+        _, gci, rich = rows[("controls", "final_duration")]
+        self.assertIn(f"T GCI {100 * gci:.1f} %, Richardson value {rich:.2f} s", para)
+        _, gci, rich = rows[("controls", "power_sq_integral")]
+        self.assertIn(f"f6 GCI {100 * gci:.1f} %, {rich:.0f} W²s", para)
 
     def test_report_draws_the_arm(self):
         out = os.path.join(self.tmp.name, "elbow.html")
