@@ -60,6 +60,8 @@ extension = "joints"
 knots = 10
 K_N = 20
 K_L = 8
+q0_3 = 60    # deg: the start within the URDF's limits (studies/path_global_arm7.toml's global block)
+q0_4 = -90
 """
 
 
