@@ -118,7 +118,7 @@ void JointExtensionProblem::sample(std::size_t i, const double (*z)[3], ChainGlo
   // rates: J_S qd_S = xd - J_C zd; accelerations: J_S qdd_S = xdd - J_C zdd - (Jdot qd)
   const Eigen::PartialPivLU<SquareM>& lu = same_q ? accepted_lu_ : current_lu_;
   const JacobianC& JC = same_q ? accepted_JC_ : current_JC_;
-  TaskV zd(r), zdd(r);
+  CoordinateV zd(r), zdd(r);
   for (int k = 0; k < r; ++k) zd[k] = z[k][1], zdd[k] = z[k][2];
   if (same_qd) {
     s.qd = accepted_qd_;

@@ -44,6 +44,7 @@ class JointExtensionProblem final : public ChainGlobalProblem {
  private:
   using SquareM = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
   using TaskV = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
+  using CoordinateV = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJoints, 1>;  // the r coordinates' rates
   using JacobianC = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, kMaxJoints>;
 
   std::vector<int> solved_, coordinate_joints_;
