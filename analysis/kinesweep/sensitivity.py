@@ -1,12 +1,13 @@
 """First-order and total Sobol' indices of the blocks a study ran as a Saltelli design (/designs,
-FORMAT.md), as `kinesweep sensitivity` computes them: Saltelli 2010's first-order estimator (centred
-on the mean over A and B) and Jansen's total one, over the sample rows whose runs all have the
-kind's good status; percentile bootstrap intervals (numpy's resampling: the same method as the
-command, other draws, so intervals agree to their sampling noise and point estimates exactly).
+FORMAT.md), as `kinesweep run` stored them in /sensitivity: the engine's one estimator
+(sensitivity/design_indices.cpp; Saltelli 2010's first-order estimator centred on the mean over A
+and B, Jansen's total one, over the sample rows whose runs all have the kind's good status;
+percentile bootstrap intervals at the group's bootstrap, confidence and seed). `kinesweep
+sensitivity FILE` prints the same numbers, or others for other bootstrap settings.
 
     from kinesweep.read import open_results
     for r in open_results("results/sensitivity_seed.h5").sensitivity(metric="E"):
-        print(r["at"], [(f["name"], f["first"], f["total"]) for f in r["factors"]])
+        print(r["at"], list(zip(r["factors"], r["first"], r["total"])))
 
 Run with Debian's /usr/bin/python3.
 """
@@ -68,52 +69,48 @@ def check_design(f, block, d):
                              f"{first}, {runs} rows) does not cover its block's rows")
 
 
-def indices(a, b, ab, bootstrap=1000, confidence=0.95, seed=1):
-    """The indices of the factors from the outputs of the sample rows (a: f(A), b: f(B), ab: d x N
-    f(AB_i)); rows with a non-finite value are left out. Returns a dict: first, total (arrays of d),
-    first_lo/first_hi/total_lo/total_hi, variance, samples, dropped."""
-    a, b, ab = np.asarray(a, float), np.asarray(b, float), np.atleast_2d(np.asarray(ab, float))
-    keep = np.isfinite(a) & np.isfinite(b) & np.all(np.isfinite(ab), axis=0)
-    a, b, ab = a[keep], b[keep], ab[:, keep]
-    d, n = ab.shape[0], a.size
-    out = {"samples": int(n), "dropped": int(keep.size - n)}
-
-    def estimate(rows):
-        ra, rb, rab = a[rows], b[rows], ab[:, rows]
-        y = np.concatenate([ra, rb])
-        v = y.var(ddof=1)
-        if not v > 0:
-            return np.full(d, np.nan), np.full(d, np.nan), v
-        return np.mean((rb - y.mean()) * (rab - ra), axis=1) / v, np.mean((ra - rab) ** 2, axis=1) / 2 / v, v
-
-    nan = np.full(d, np.nan)
-    if n < 2:
-        out.update(first=nan, total=nan, variance=np.nan, first_lo=nan, first_hi=nan, total_lo=nan, total_hi=nan)
-        return out
-    out["first"], out["total"], out["variance"] = estimate(np.arange(n))
-    q = (1 - confidence) / 2
-    if bootstrap:
-        rng = np.random.default_rng(seed)
-        s1, st = np.empty((bootstrap, d)), np.empty((bootstrap, d))
-        for r in range(bootstrap):
-            s1[r], st[r], _ = estimate(rng.integers(0, n, n))
-        out["first_lo"], out["first_hi"] = np.nanquantile(s1, q, axis=0), np.nanquantile(s1, 1 - q, axis=0)
-        out["total_lo"], out["total_hi"] = np.nanquantile(st, q, axis=0), np.nanquantile(st, 1 - q, axis=0)
-    else:
-        out.update(first_lo=nan, first_hi=nan, total_lo=nan, total_hi=nan)
-    return out
+def stored_indices(f):
+    """/sensitivity of an open h5py file as {(block, metric, combination): {first, first_lo, first_hi,
+    total, total_lo, total_hi (arrays in the design's factor order), variance, samples, dropped}} and
+    its attributes (bootstrap, confidence, seed). Raises ValueError when the file has none (written
+    before the engine stored it: `kinesweep run STUDY --resume -o FILE` adds it)."""
+    if "sensitivity" not in f:
+        raise ValueError(f"{f.filename}: no /sensitivity (written by an engine before it stored the indices); "
+                         "`kinesweep run STUDY --resume -o FILE` adds it, `kinesweep sensitivity FILE` prints them")
+    g = f["sensitivity"]
+    block, metric = text_values(g["block"]), text_values(g["metric"])
+    combination, index = g["combination"][()], g["factor_index"][()]
+    cols = {k: g[k][()] for k in ("first", "first_lo", "first_hi", "total", "total_lo", "total_hi", "variance",
+                                   "samples", "dropped")}
+    out = {}
+    for i in range(len(block)):
+        key = (str(block[i]), str(metric[i]), int(combination[i]))
+        e = out.setdefault(key, {"rows": []})
+        e["rows"].append((int(index[i]), i))
+    for e in out.values():
+        rows = [i for _, i in sorted(e.pop("rows"))]
+        for k in ("first", "first_lo", "first_hi", "total", "total_lo", "total_hi"):
+            e[k] = cols[k][rows].astype(float)
+        e["variance"] = float(cols["variance"][rows[0]])
+        e["samples"], e["dropped"] = int(cols["samples"][rows[0]]), int(cols["dropped"][rows[0]])
+    attrs = {k: g.attrs[k].item() for k in ("bootstrap", "confidence", "seed") if k in g.attrs}
+    return out, attrs
 
 
-def sensitivity(res, block=None, metric=None, bootstrap=1000, confidence=0.95, seed=1):
+def sensitivity(res, block=None, metric=None):
     """Indices of every block with a design (or `block`) for `metric` (default: the kind's ranking
     objective), one dict per combination of the block's other dimensions: block, kind, metric, unit,
     at ({axis: value} of the other dimensions), base_samples, factors (names), failed_runs ({status:
     count}), not_done, not_done_samples (sample rows with a run not done), failed_samples (the other
-    sample rows with a failed run: the indices are conditional on success, good_status), and
-    indices()'s entries."""
+    sample rows with a failed run: the indices are conditional on success, good_status), the stored
+    indices (first, total and their intervals first_lo, first_hi, total_lo, total_hi, in the order of
+    factors; variance, samples, dropped) and the intervals' bootstrap, confidence and seed. Raises
+    ValueError when the file has no /sensitivity or `metric` is not one of its metrics."""
     f = res.f
     out = []
-    for name, d in designs(f).items():
+    found = designs(f)
+    stored, attrs = stored_indices(f) if found else ({}, {})
+    for name, d in found.items():
         if block is not None and name != block:
             continue
         meaning = res.kind_meaning(d["kind"])
@@ -123,15 +120,13 @@ def sensitivity(res, block=None, metric=None, bootstrap=1000, confidence=0.95, s
         ids = slice(d["first_run"], d["first_run"] + int(np.prod(sizes)))
         done = f["runs"]["done"][ids].astype(bool).reshape(sizes)
         status = text_values(f["runs"]["status"])[ids].reshape(sizes)
-        y = np.array(f["runs"][m][ids], dtype=float).reshape(sizes)
         others = [j for j in range(len(sizes)) if j != dim]
-        for combo in np.ndindex(*[sizes[j] for j in others]):
+        for combination, combo in enumerate(np.ndindex(*[sizes[j] for j in others])):
             index = [slice(None)] * len(sizes)
             for j, c in zip(others, combo):
                 index[j] = c
-            yy, st, dn = y[tuple(index)], status[tuple(index)], done[tuple(index)]
+            st, dn = status[tuple(index)], done[tuple(index)]
             failed = dn & (st != good)
-            values = np.where(dn & ~failed, yy, np.nan)
             at = {}
             full = [0] * len(sizes)  # the combination's first run: design point 0
             for j, c in zip(others, combo):
@@ -149,7 +144,13 @@ def sensitivity(res, block=None, metric=None, bootstrap=1000, confidence=0.95, s
             rows_not_done = (~dn).reshape(k + 2, n).any(axis=0)  # points A, B, AB_0.. of each sample row
             r["not_done_samples"] = int(rows_not_done.sum())
             r["failed_samples"] = int((failed.reshape(k + 2, n).any(axis=0) & ~rows_not_done).sum())
-            r.update(indices(values[:n], values[n:2 * n], values[2 * n:].reshape(k, n), bootstrap, confidence, seed))
+            key = (name, m, combination)  # the engine's order of the combinations: run order
+            if key not in stored:
+                metrics = sorted({key[1] for key in stored if key[0] == name})
+                raise ValueError(f"{f.filename}: /sensitivity holds no indices of {m!r} for block {name!r}; "
+                                 f"expected one of {', '.join(metrics)}")
+            r.update(stored[key])
+            r.update(attrs)
             out.append(r)
     return out
 

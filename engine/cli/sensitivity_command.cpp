@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -9,29 +10,17 @@
 #include "cli/kind_meaning.hpp"
 #include "cli/query_util.hpp"
 #include "schema/params.hpp"
-#include "sensitivity/sobol_indices.hpp"
+#include "sensitivity/design_indices.hpp"
 #include "store/store.hpp"
 
 namespace ks::cli {
 
 namespace {
 
-/// One table: a block's design, one metric, one combination of the block's other axes.
-struct Result {
-  const store::DesignMeta* design = nullptr;
-  std::string metric, unit, at;  ///< at: "method=local_weighted" (the other axes' values), "" when none
-  std::map<std::string, std::uint64_t> failed;  ///< status -> runs of the design (not the good status)
-  std::uint64_t not_done = 0;
-  std::string good;                   ///< the kind's good status: the indices are conditional on it
-  std::uint64_t failed_samples = 0;   ///< sample rows left out because a run of theirs failed (all done)
-  std::uint64_t not_done_samples = 0; ///< sample rows left out because a run of theirs is not done
-  SobolIndices s;
-};
-
-std::string cell_text(const Cell& c) {
-  if (const double* d = std::get_if<double>(&c)) return format_double(*d);
-  if (const std::int64_t* i = std::get_if<std::int64_t>(&c)) return std::to_string(*i);
-  return std::get<std::string>(c);
+const store::DesignMeta& design_of(const std::vector<store::DesignMeta>& designs, const std::string& block) {
+  for (const auto& d : designs)
+    if (d.block == block) return d;
+  throw std::logic_error("no design of block " + block);
 }
 
 /// The meaning of a design's run kind, as the file declares it (cli/kind_meaning.hpp).
@@ -42,88 +31,10 @@ KindMeaning meaning_of(const store::ResultsReader& reader, const std::string& na
   return km;
 }
 
-/// Runs of the design with a status other than the good one.
-std::uint64_t failed_runs(const Result& r) {
-  std::uint64_t n = 0;
-  for (const auto& [status, k] : r.failed) n += k;
-  return n;
-}
-
-/// `count` values of the numeric /runs column `c` from row `first`, as doubles (an i64 column converted).
-std::vector<double> read_numbers(store::ResultsReader& reader, const ColumnSpec& c, std::int64_t first,
-                                 std::int64_t count) {
-  if (c.type == CellType::f64) return reader.read_f64(c.name, first, count);
-  const std::vector<std::int64_t> v = reader.read_i64(c.name, first, count);
-  return std::vector<double>(v.begin(), v.end());
-}
-
-/// The indices of every metric for every combination of the design block's other dimensions.
-void analyse(store::ResultsReader& reader, const store::DesignMeta& d, const std::vector<std::string>& metrics,
-             const SobolOptions& opt, std::vector<Result>& out) {
-  const auto& cols = reader.columns();
-  std::int64_t runs = 1;
-  for (std::int64_t s : d.sizes) runs *= s;
-  const auto done = reader.done_mask(d.first_run, runs);
-  const auto status = reader.read_str("status", d.first_run, runs);
-  const std::string good = meaning_of(reader, d.kind).good();
-  // strides of the mixed-radix local index (last dimension fastest)
-  const std::size_t nd = d.sizes.size(), dim = static_cast<std::size_t>(d.dim);
-  std::vector<std::int64_t> stride(nd, 1);
-  for (std::size_t k = nd - 1; k-- > 0;) stride[k] = stride[k + 1] * d.sizes[k + 1];
-  std::int64_t combos = runs / d.sizes[dim];
-  const std::int64_t n = d.base_samples, f = static_cast<std::int64_t>(d.factors.size());
-  for (const std::string& metric : metrics) {
-    const auto it = std::find_if(cols.begin(), cols.end(), [&](const ColumnSpec& c) { return c.name == metric; });
-    const std::vector<double> y = read_numbers(reader, *it, d.first_run, runs);
-    for (std::int64_t c = 0; c < combos; ++c) {
-      // the local index of point 0 of the design at combination c of the other dimensions
-      std::int64_t base = 0, rest = c;
-      for (std::size_t k = nd; k-- > 0;) {
-        if (k == dim) continue;
-        base += (rest % d.sizes[k]) * stride[k];
-        rest /= d.sizes[k];
-      }
-      Result r;
-      r.design = &d;
-      r.good = good;
-      r.metric = metric;
-      r.unit = it->unit;
-      const Record row = nd > 1 ? reader.read_record(d.first_run + base) : Record{};  // the other axes' values
-      for (std::size_t k = 0; k < nd; ++k) {
-        if (k == dim) continue;
-        std::istringstream names(d.dims[k]);
-        for (std::string a; std::getline(names, a, '+');) {
-          const auto col = std::find_if(cols.begin(), cols.end(), [&](const ColumnSpec& s) { return s.name == a; });
-          if (col != cols.end()) r.at += (r.at.empty() ? "" : ", ") + a + "=" + cell_text(row.cells[col - cols.begin()]);
-        }
-      }
-      auto value = [&](std::int64_t point) {
-        const std::int64_t local = base + point * stride[dim];
-        if (!done[local]) return ++r.not_done, std::nan("");
-        if (status[local] != good) return ++r.failed[status[local]], std::nan("");
-        return y[local];
-      };
-      std::vector<double> a(n), b(n);
-      std::vector<std::vector<double>> ab(f, std::vector<double>(n));
-      for (std::int64_t j = 0; j < n; ++j) {
-        const std::uint64_t not_done = r.not_done, failed = failed_runs(r);
-        a[j] = value(j);
-        b[j] = value(n + j);
-        for (std::int64_t m = 0; m < f; ++m) ab[m][j] = value((2 + m) * n + j);
-        if (r.not_done != not_done) ++r.not_done_samples;
-        else if (failed_runs(r) != failed) ++r.failed_samples;
-      }
-      std::vector<std::span<const double>> spans(ab.begin(), ab.end());
-      r.s = sobol_indices(a, b, spans, opt);
-      out.push_back(std::move(r));
-    }
-  }
-}
-
-void print_table(const std::vector<Result>& results, double confidence, std::ostream& os) {
+void print_table(const std::vector<DesignIndices>& results, const std::vector<store::DesignMeta>& designs, double confidence, std::ostream& os) {
   char line[256];
-  for (const Result& r : results) {
-    const store::DesignMeta& d = *r.design;
+  for (const DesignIndices& r : results) {
+    const store::DesignMeta& d = design_of(designs, r.block);
     os << "block " << d.block << " (" << d.kind << "), Saltelli design: " << d.base_samples << " samples x ("
        << d.factors.size() << " factors + 2) = " << d.base_samples * static_cast<std::int64_t>(d.factors.size() + 2)
        << " runs" << (r.at.empty() ? "" : " at " + r.at) << "\n";
@@ -155,13 +66,18 @@ void print_table(const std::vector<Result>& results, double confidence, std::ost
   }
 }
 
-void print_json(const std::string& file, const std::vector<Result>& results, const SobolOptions& opt, std::ostream& os) {
-  auto num = [](double v) { return std::isfinite(v) ? format_double(v) : std::string("null"); };
+void print_json(const std::string& file, const std::vector<DesignIndices>& results, const std::vector<store::DesignMeta>& designs, const SobolOptions& opt, std::ostream& os) {
+  auto num = [](double v) {  // round-trip precision: the stored /sensitivity values, digit for digit
+    if (!std::isfinite(v)) return std::string("null");
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return std::string(buf);
+  };
   os << "{\"file\": " << json_string(file) << ", \"confidence\": " << num(opt.confidence)
      << ", \"bootstrap\": " << opt.bootstrap << ", \"results\": [";
   for (std::size_t k = 0; k < results.size(); ++k) {
-    const Result& r = results[k];
-    const store::DesignMeta& d = *r.design;
+    const DesignIndices& r = results[k];
+    const store::DesignMeta& d = design_of(designs, r.block);
     os << (k ? "," : "") << "\n {\"block\": " << json_string(d.block) << ", \"kind\": " << json_string(d.kind)
        << ", \"metric\": " << json_string(r.metric) << ", \"unit\": " << json_string(r.unit)
        << ", \"at\": " << json_string(r.at) << ", \"base_samples\": " << d.base_samples
@@ -211,25 +127,23 @@ int run_sensitivity(const SensitivityArgs& args) {
               << join(names, ", ") << suggest(args.block, names) << '\n';
     return 2;
   }
-  std::vector<Result> results;
+  std::vector<DesignIndices> results;
   for (const auto& d : designs) {
     if (!args.block.empty() && d.block != args.block) continue;
     std::vector<std::string> metrics = args.metrics;
     if (metrics.empty()) metrics.emplace_back(meaning_of(reader, d.kind).objective());
-    std::vector<std::string> numeric;
-    for (const ColumnSpec& c : reader.columns())
-      if (c.role == Role::metric && c.type != CellType::str && ("," + c.kinds + ",").find("," + d.kind + ",") != std::string::npos)
-        numeric.push_back(c.name);
+    const std::vector<std::string> numeric = design_metrics(reader, d.kind);
     for (const std::string& m : metrics)
       if (std::find(numeric.begin(), numeric.end(), m) == numeric.end()) {
         std::cerr << "kinesweep sensitivity: error: --metric " << m << ": not a numeric metric of " << d.kind
                   << " runs; expected one of " << join(numeric, ", ") << suggest(m, numeric) << '\n';
         return 2;
       }
-    analyse(reader, d, metrics, opt, results);
+    for (DesignIndices& r : design_indices(reader, d, metrics, meaning_of(reader, d.kind).good(), opt))
+      results.push_back(std::move(r));
   }
-  if (args.format == "json") print_json(args.file, results, opt, std::cout);
-  else print_table(results, opt.confidence, std::cout);
+  if (args.format == "json") print_json(args.file, results, designs, opt, std::cout);
+  else print_table(results, designs, opt.confidence, std::cout);
   return 0;
 }
 

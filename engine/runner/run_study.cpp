@@ -14,12 +14,16 @@
 #include <ostream>
 #include <stdexcept>
 
+#include <tbb/task_arena.h>
+
 #include "common/shell_word.hpp"
 #include "runner/optimize_blocks.hpp"
 #include "runner/resume_edited.hpp"
 #include "runner/dry_run.hpp"
 #include "runner/sweep_backend.hpp"
 #include "runner/verify_best.hpp"
+#include "schema/params.hpp"
+#include "sensitivity/design_indices.hpp"
 
 namespace ks {
 
@@ -136,6 +140,23 @@ class LocalBackend final : public SweepBackend {
   std::unique_ptr<store::ResultsWriter> writer_;
 };
 
+/// /sensitivity of the file the sweep wrote: every numeric metric of each Saltelli design's block, at
+/// the estimator's default bootstrap, on `threads` threads (an empty table when the study has no design).
+store::SensitivityTable design_sensitivity(const Study& study, const store::ResultsReader& file, int threads) {
+  std::vector<DesignIndices> all;
+  const SobolOptions options;
+  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+  for (const store::DesignMeta& d : file.designs())
+    for (const Block& block : study.blocks) {
+      if (block.name() != d.block) continue;
+      const std::string good(statuses(block.kind()).front());
+      std::vector<DesignIndices> indices;
+      arena.execute([&] { indices = design_indices(file, d, design_metrics(file, d.kind), good, options); });
+      for (DesignIndices& r : indices) all.push_back(std::move(r));
+    }
+  return sensitivity_table(all, options);
+}
+
 /// The leader after the sweep: optimisation blocks into the same file, the report, the exit code.
 int conclude(const Study& study, const RunRequest& r, SweepBackend& backend, SweepResult& res, std::ostream& out) {
   const SweepReport& report = res.report;
@@ -186,6 +207,11 @@ int conclude(const Study& study, const RunRequest& r, SweepBackend& backend, Swe
     }
     if (!table.rows.empty()) res.writer->write_verification(table);
     print_verification(out, table);
+  }
+  {
+    res.writer->flush();
+    const store::SensitivityTable indices = design_sensitivity(study, store::ResultsReader(res.writer->path()), backend.threads(r));
+    if (!indices.rows.empty()) res.writer->write_sensitivity(indices);
   }
   res.writer->close();
   backend.publish(r);

@@ -271,6 +271,27 @@ struct VerificationTable {
   std::vector<VerificationRow> rows;
 };
 
+/// One row of /sensitivity (FORMAT.md): one factor's first-order and total Sobol' indices for one
+/// metric at one combination of a Saltelli design block's other dimensions (sensitivity/design_indices.hpp).
+struct SensitivityRow {
+  std::string block;             ///< the design's block
+  std::string metric;            ///< the /runs metric
+  std::int64_t combination = 0;  ///< the combination of the block's other dimensions, in run order
+  std::string factor;            ///< the factor's axis
+  std::int64_t factor_index = 0; ///< its position in the design (/designs/<block>@factors)
+  double first = 0.0, first_lo = 0.0, first_hi = 0.0;  ///< S_i and its bootstrap interval (NaN: none)
+  double total = 0.0, total_lo = 0.0, total_hi = 0.0;  ///< S_Ti and its bootstrap interval
+  double variance = 0.0;         ///< the metric's variance over A and B [unit²]
+  std::int64_t samples = 0;      ///< sample rows used
+  std::int64_t dropped = 0;      ///< sample rows left out (a run failed or not done)
+};
+struct SensitivityTable {
+  std::int64_t bootstrap = 1000;  ///< resamples behind the intervals
+  double confidence = 0.95;       ///< the intervals' level
+  std::int64_t seed = 1;          ///< of the resampling
+  std::vector<SensitivityRow> rows;
+};
+
 class ResultsReader;
 
 class ResultsWriter {
@@ -346,6 +367,8 @@ class ResultsWriter {
   void write_optimization(const OptimizationRecord& record);
   /// Write /verification (replacing an existing one) and flush (verification.cpp).
   void write_verification(const VerificationTable& table);
+  /// Write /sensitivity (replacing an existing one) and flush (sensitivity.cpp).
+  void write_sensitivity(const SensitivityTable& table);
   /// Flush and close; further calls throw.
   void close();
 
@@ -440,6 +463,8 @@ class ResultsReader {
   OptimizationRecord read_optimization(const std::string& name) const;
   /// The /verification table (verification.cpp); no rows when the file has none.
   VerificationTable read_verification() const;
+  /// The /sensitivity table (sensitivity.cpp); no rows when the file has none.
+  SensitivityTable read_sensitivity() const;
 
  private:
   friend class ResultsWriter;                ///< copy_runs reads a source's chunks as stored

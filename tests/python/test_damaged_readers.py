@@ -142,7 +142,7 @@ class DamagedFiles(TempDirTest):
         r = run("sensitivity", self.good, "--bootstrap", "10")
         self.assertEqual(r.returncode, 0, r.stderr)
         with python_package()(self.good) as res:
-            self.assertEqual(len(res.sensitivity(bootstrap=10)), 1)
+            self.assertEqual(len(res.sensitivity()), 1)
 
     def test_design_rows_off_runs_or_off_its_block(self):
         runs = 16 * 4  # base samples x (2 factors + 2)
@@ -156,7 +156,7 @@ class DamagedFiles(TempDirTest):
                 self.refused(out, ["sensitivity", out, "--bootstrap", "10"], "/designs/local")
                 with python_package()(out) as res:
                     with self.assertRaisesRegex(ValueError, "/designs/local"):
-                        res.sensitivity(bootstrap=10)
+                        res.sensitivity()
         # the report (which lists the designs) refuses the file as well: exit 1, the object named
         out = os.path.join(self.dir, f"fr{self.first_run + 1}.h5")
         r = subprocess.run([sys.executable, "-m", "kinesweep.report", out, "-o", os.path.join(self.dir, "r.html")],
@@ -177,7 +177,7 @@ class DamagedFiles(TempDirTest):
                 self.refused(out, ["sensitivity", out, "--bootstrap", "10"], "/designs/local")
                 with python_package()(out) as res:
                     with self.assertRaisesRegex(ValueError, "/designs/local"):
-                        res.sensitivity(bootstrap=10)
+                        res.sensitivity()
 
     def test_landscape_grid_of_another_shape(self):
         def edit(f):
@@ -264,7 +264,7 @@ class IntegerMetrics(TempDirTest):
         self.assertIn(f"failed samples {failed_samples} of {n}", r.stdout)
         self.assertIn("conditional on success", r.stdout)
         with python_package()(out) as res:  # kinesweep.read: the same counts for the integer metric
-            py = res.sensitivity(metric="iterations", bootstrap=0)
+            py = res.sensitivity(metric="iterations")
         self.assertEqual([(p["failed_samples"], p["not_done_samples"], p["good_status"]) for p in py],
                          [(failed_samples, 0, good)])
         cli_first = got[metrics.index("iterations")]["factors"][0]["first"]

@@ -3,7 +3,8 @@ order, centred) and Jansen (total) estimators computed here with numpy from the 
 reads (the design's matrices found from /designs); runs with a failed status counted by status;
 its errors (no design, an unknown metric) and the study parser's (two designs in a block, second
 order asked for, an axis of a design the block lacks). kinesweep.read's sensitivity() gives the
-command's point estimates. The report and plot_landscape draw no grid over a design's sampled
+command's numbers at its default bootstrap, digit for digit (the indices `kinesweep run` stored in
+/sensitivity). The report and plot_landscape draw no grid over a design's sampled
 points (examples_lhs and the Saltelli study). And the shipped studies/sensitivity_seed.toml:
 its indices of E and tau_inf contain those of a brute-force variance decomposition of the same
 function on a 40^3 grid of cell midpoints over the same ranges.
@@ -102,19 +103,43 @@ class Sensitivity(TempDirTest):
                     self.assertAlmostEqual(fac["total"], total[i], delta=1e-5 * max(1, abs(total[i])))
                     self.assertLessEqual(fac["first_lo"], fac["first_hi"])
                     self.assertLessEqual(fac["total_lo"], fac["total_hi"])
-        # kinesweep.read: the same point estimates, samples and failed runs per combination
+        # kinesweep.read: the indices `kinesweep run` stored in /sensitivity are the command's at its
+        # default bootstrap, digit for digit, for every numeric metric, with the same counts
+        full = run("sensitivity", out, "--metric", "E", "tau2_inf", "--format", "json")
+        self.assertEqual(full.returncode, 0, full.stderr)
+        cli = json.loads(full.stdout)["results"]  # metric by metric, combinations in run order, as py
         sys.path.insert(0, os.path.join(SOURCE, "analysis"))
         from kinesweep.read import open_results
         with open_results(out) as res:
-            py = res.sensitivity(metric="E", bootstrap=50) + res.sensitivity(metric="tau2_inf", bootstrap=50)
-        cli = got  # metric by metric, combinations in run order, as py
+            py = res.sensitivity(metric="E") + res.sensitivity(metric="tau2_inf")
         self.assertEqual([f"method={p['at']['method']}" for p in py], [c["at"] for c in cli])
         for p, c in zip(py, cli):
-            self.assertEqual((p["metric"], p["samples"], p["dropped"], p["failed_runs"]),
-                             (c["metric"], c["samples"], c["dropped"], c["failed_runs"]))
+            self.assertEqual((p["metric"], p["samples"], p["dropped"], p["failed_runs"], p["bootstrap"]),
+                             (c["metric"], c["samples"], c["dropped"], c["failed_runs"], 1000))
+            self.assertEqual(p["variance"], c["variance"])
             for i, fac in enumerate(c["factors"]):
-                self.assertAlmostEqual(p["first"][i], fac["first"], delta=1e-5 * max(1, abs(fac["first"])))
-                self.assertAlmostEqual(p["total"][i], fac["total"], delta=1e-5 * max(1, abs(fac["total"])))
+                self.assertEqual(p["factors"][i], fac["name"])
+                for key in ("first", "first_lo", "first_hi", "total", "total_lo", "total_hi"):
+                    self.assertEqual(p[key][i], fac[key], f"{p['metric']} {fac['name']} {key}")
+        with h5py.File(out, "r") as f:  # every numeric trajectory metric is stored, 3 factors x 2 methods each
+            stored = runs_column(f["sensitivity"]["metric"])
+            self.assertEqual(len(stored), 3 * 2 * len(set(stored)))
+            for name in ("E", "tau_inf", "torque_sq_integral", "min_manipulability", "iterations"):
+                self.assertEqual(name in set(stored), name != "iterations", name)
+        with self.assertRaisesRegex(ValueError, "no indices of 'status'"):
+            with open_results(out) as res:
+                res.sensitivity(metric="status")
+        # a file written before /sensitivity was stored: the reader says how to add it; a resume adds it
+        with h5py.File(out, "r+") as f:
+            del f["sensitivity"]
+        with self.assertRaisesRegex(ValueError, "no /sensitivity.*--resume"):
+            with open_results(out) as res:
+                res.sensitivity()
+        r = run("run", study, "-o", out, "--resume", "-q")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open_results(out) as res:
+            again = res.sensitivity(metric="E")
+        self.assertEqual([list(p["first"]) for p in again], [list(p["first"]) for p in py[:2]])
         table = run("sensitivity", out, "--block", "local")
         self.assertEqual(table.returncode, 0, table.stderr)
         self.assertIn("at method=local_weighted", table.stdout)

@@ -1,0 +1,55 @@
+#pragma once
+// A group of column datasets that form one table (/verification, /sensitivity): each column a 1-D
+// dataset of the table's rows (or rows x cols for per-grid figures) with unit and description
+// attributes. TableOut writes them into a group the writer has just created; TableIn reads them
+// back, checking each column's size against the row count.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "store/h5util.hpp"
+#include "store/writer_impl.hpp"
+
+namespace ks::store::detail {
+
+/// Group `name` at the file's root, created empty: an existing one is deleted first (its space
+/// marked freed). Fails the writer (m.fail) when HDF5 refuses.
+Hid replace_group(ResultsWriter::Impl& m, const char* name);
+
+/// Writes the columns of table group `g` (named `group`, as "/verification", in error messages).
+struct TableOut {
+  ResultsWriter::Impl& m;
+  hid_t g;
+  std::string group;
+  /// `v`: rows (cols == 0) or rows x cols values, row by row.
+  void f64(const char* name, const std::vector<double>& v, std::size_t cols, const std::string& unit,
+           const std::string& desc);
+  void i64(const char* name, const std::vector<std::int64_t>& v, const std::string& desc);
+  void str(const char* name, const std::vector<std::string>& v, const std::string& desc);
+  /// A scalar attribute of the group.
+  void attr_f64(const char* name, double v);
+  void attr_i64(const char* name, std::int64_t v);
+};
+
+/// Reads the columns of table group `g` of file `path`; the row count is the length of the column
+/// named when it is built. Throws StoreError for a missing column or one of another size.
+struct TableIn {
+  TableIn(hid_t g, const std::string& path, const std::string& group, const char* count_column);
+  std::size_t rows() const { return n; }
+  std::vector<double> f64(const char* name, std::size_t cols = 1) const;
+  std::vector<std::int64_t> i64(const char* name) const;
+  std::vector<std::string> str(const char* name) const;
+  /// A scalar attribute of the group, or `fallback` when it has none.
+  double attr_f64(const char* name, double fallback) const;
+  std::int64_t attr_i64(const char* name, std::int64_t fallback) const;
+
+  hid_t g;
+  const std::string& path;
+  std::string group;
+  std::size_t n = 0;
+
+ private:
+  Hid open(const char* name, std::size_t cols) const;
+};
+
+}  // namespace ks::store::detail
