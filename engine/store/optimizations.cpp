@@ -2,83 +2,12 @@
 #include <algorithm>
 #include <set>
 
-#include "store/h5util.hpp"
 #include "store/store.hpp"
-#include "store/writer_impl.hpp"
+#include "store/table_group.hpp"
 
 namespace ks::store {
 using namespace detail;
 
-namespace {
-struct Out {
-  ResultsWriter::Impl& m;
-  std::string where;
-
-  void f64_attr(hid_t obj, const char* name, const std::vector<double>& v) {
-    hsize_t n = v.size();
-    Hid space(n ? H5Screate_simple(1, &n, nullptr) : H5Screate(H5S_NULL));
-    if (H5Aexists(obj, name) > 0) H5Adelete(obj, name);
-    Hid a(H5Acreate2(obj, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT));
-    if (!a.ok() || (n && H5Awrite(a, H5T_NATIVE_DOUBLE, v.data()) < 0)) m.fail("cannot write attribute " + where + "/" + name);
-  }
-  void f64_attr(hid_t obj, const char* name, double v) {
-    Hid space(H5Screate(H5S_SCALAR));
-    if (H5Aexists(obj, name) > 0) H5Adelete(obj, name);
-    Hid a(H5Acreate2(obj, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT));
-    if (!a.ok() || H5Awrite(a, H5T_NATIVE_DOUBLE, &v) < 0) m.fail("cannot write attribute " + where + "/" + name);
-  }
-  /// rows x cols f64 dataset (cols 0: 1-D), deflated when large.
-  void f64(hid_t g, const std::string& name, const std::vector<double>& v, std::size_t cols, const std::string& unit,
-           const std::string& desc) {
-    const std::size_t rows = cols ? (v.empty() ? 0 : v.size() / cols) : v.size();
-    hsize_t dims[2] = {rows, cols};
-    Hid space(H5Screate_simple(cols ? 2 : 1, dims, nullptr));
-    Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
-    if (v.size() >= 4096) {
-      hsize_t chunk[2] = {std::min<hsize_t>(rows, 65536), cols};
-      H5Pset_chunk(dcpl, cols ? 2 : 1, chunk);
-      H5Pset_shuffle(dcpl);
-      H5Pset_deflate(dcpl, 1);
-    }
-    Hid d(H5Dcreate2(g, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT));
-    if (!d.ok() || (!v.empty() && H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0))
-      m.fail("cannot write " + where + "/" + name);
-    write_str_attr(d, "unit", unit);
-    write_cf_units(d, unit, cols);
-    write_str_attr(d, "description", desc);
-  }
-  void i64(hid_t g, const std::string& name, const std::vector<std::int64_t>& v, const std::string& desc) {
-    hsize_t n = v.size();
-    Hid space(H5Screate_simple(1, &n, nullptr));
-    Hid d(H5Dcreate2(g, name.c_str(), H5T_STD_I64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-    if (!d.ok() || (n && H5Dwrite(d, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0))
-      m.fail("cannot write " + where + "/" + name);
-    write_str_attr(d, "unit", "");
-    write_str_attr(d, "description", desc);
-  }
-  void str(hid_t g, const std::string& name, const std::vector<std::string>& v, const std::string& desc) {
-    hsize_t n = v.size();
-    Hid space(H5Screate_simple(1, &n, nullptr));
-    Hid t(utf8_vlen_type());
-    Hid d(H5Dcreate2(g, name.c_str(), t, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-    std::vector<const char*> p;
-    for (const auto& s : v) p.push_back(s.c_str());
-    if (!d.ok() || (n && H5Dwrite(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, p.data()) < 0))
-      m.fail("cannot write " + where + "/" + name);
-    write_str_attr(d, "unit", "");
-    write_str_attr(d, "description", desc);
-  }
-  /// netCDF dimensions of the datasets of `g` (name_netcdf_dimensions).
-  void dimensions(hid_t g, const std::string& rows, const std::string& columns = "") {
-    if (!name_netcdf_dimensions(g, rows, columns)) m.fail("cannot name the dimensions of " + where);
-  }
-  Hid group(hid_t parent, const std::string& name) {
-    Hid g(H5Gcreate2(parent, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
-    if (!g.ok()) m.fail("cannot create " + where + "/" + name);
-    return g;
-  }
-};
-}  // namespace
 
 void ResultsWriter::write_optimization(const OptimizationRecord& r) {
   QuietHdf5 quiet;
@@ -107,7 +36,7 @@ void ResultsWriter::write_optimization(const OptimizationRecord& r) {
     if (H5Ldelete(root, r.name.c_str(), H5P_DEFAULT) < 0) m.fail("cannot replace /optimizations/" + r.name);
     m.freed_space = true;
   }
-  Out o{m, "/optimizations/" + r.name};
+  TableOut o{m, "/optimizations/" + r.name};
   Hid g = o.group(root, r.name);
   write_str_attr(g, "kind", r.kind);
   write_str_attr(g, "preset", r.preset);

@@ -22,10 +22,10 @@ void ResultsWriter::write_sensitivity(const SensitivityTable& t) {
                  "one metric at one combination of its block's other dimensions (Saltelli 2010's centred "
                  "first-order estimator, Jansen's total one, over the sample rows whose runs all have the kind's "
                  "good status; percentile bootstrap intervals)");
-  TableOut o{m, g, "/sensitivity"};
-  o.attr_i64("bootstrap", t.bootstrap);
-  o.attr_f64("confidence", t.confidence);
-  o.attr_i64("seed", t.seed);
+  TableOut o{m, "/sensitivity"};
+  write_i64_attr(g, "bootstrap", t.bootstrap);
+  o.f64_attr(g, "confidence", t.confidence);
+  write_i64_attr(g, "seed", t.seed);
   const auto& rows = t.rows;
   auto strings = [&](auto field) {
     std::vector<std::string> v;
@@ -42,25 +42,25 @@ void ResultsWriter::write_sensitivity(const SensitivityTable& t) {
     for (const auto& r : rows) v.push_back(field(r));
     return v;
   };
-  o.str("block", strings([](auto& r) { return r.block; }), "the design's block");
-  o.str("metric", strings([](auto& r) { return r.metric; }), "the /runs metric");
-  o.i64("combination", integers([](auto& r) { return r.combination; }),
+  o.str(g, "block", strings([](auto& r) { return r.block; }), "the design's block");
+  o.str(g, "metric", strings([](auto& r) { return r.metric; }), "the /runs metric");
+  o.i64(g, "combination", integers([](auto& r) { return r.combination; }),
         "the combination of the block's other dimensions, in run order (0 when it has none)");
-  o.str("factor", strings([](auto& r) { return r.factor; }), "the factor (an axis of the design)");
-  o.i64("factor_index", integers([](auto& r) { return r.factor_index; }),
+  o.str(g, "factor", strings([](auto& r) { return r.factor; }), "the factor (an axis of the design)");
+  o.i64(g, "factor_index", integers([](auto& r) { return r.factor_index; }),
         "its position in /designs/<block>@factors");
-  o.f64("first", numbers([](auto& r) { return r.first; }), 0, "", "first-order index S_i");
-  o.f64("first_lo", numbers([](auto& r) { return r.first_lo; }), 0, "", "S_i's bootstrap interval, lower end");
-  o.f64("first_hi", numbers([](auto& r) { return r.first_hi; }), 0, "", "S_i's bootstrap interval, upper end");
-  o.f64("total", numbers([](auto& r) { return r.total; }), 0, "", "total index S_Ti");
-  o.f64("total_lo", numbers([](auto& r) { return r.total_lo; }), 0, "", "S_Ti's bootstrap interval, lower end");
-  o.f64("total_hi", numbers([](auto& r) { return r.total_hi; }), 0, "", "S_Ti's bootstrap interval, upper end");
-  o.f64("variance", numbers([](auto& r) { return r.variance; }), 0, "",
+  o.f64(g, "first", numbers([](auto& r) { return r.first; }), 0, "", "first-order index S_i");
+  o.f64(g, "first_lo", numbers([](auto& r) { return r.first_lo; }), 0, "", "S_i's bootstrap interval, lower end");
+  o.f64(g, "first_hi", numbers([](auto& r) { return r.first_hi; }), 0, "", "S_i's bootstrap interval, upper end");
+  o.f64(g, "total", numbers([](auto& r) { return r.total; }), 0, "", "total index S_Ti");
+  o.f64(g, "total_lo", numbers([](auto& r) { return r.total_lo; }), 0, "", "S_Ti's bootstrap interval, lower end");
+  o.f64(g, "total_hi", numbers([](auto& r) { return r.total_hi; }), 0, "", "S_Ti's bootstrap interval, upper end");
+  o.f64(g, "variance", numbers([](auto& r) { return r.variance; }), 0, "",
         "the metric's variance over the sample rows A and B (the metric's unit squared)");
-  o.i64("samples", integers([](auto& r) { return r.samples; }), "sample rows used");
-  o.i64("dropped", integers([](auto& r) { return r.dropped; }),
+  o.i64(g, "samples", integers([](auto& r) { return r.samples; }), "sample rows used");
+  o.i64(g, "dropped", integers([](auto& r) { return r.dropped; }),
         "sample rows left out: a run of the row failed or is not done");
-  if (!name_netcdf_dimensions(g, "sensitivity_row")) m.fail("cannot name the dimensions of /sensitivity");
+  o.dimensions(g, "sensitivity_row");
   m.do_flush();
 }
 

@@ -15,48 +15,73 @@ Hid replace_group(ResultsWriter::Impl& m, const char* name) {
   return g;
 }
 
-void TableOut::f64(const char* name, const std::vector<double>& v, std::size_t cols, const std::string& unit,
-                   const std::string& desc) {
-  const hsize_t dims[2] = {cols ? v.size() / cols : v.size(), cols};
+void TableOut::f64_attr(hid_t obj, const char* name, const std::vector<double>& v) {
+  hsize_t n = v.size();
+  Hid space(n ? H5Screate_simple(1, &n, nullptr) : H5Screate(H5S_NULL));
+  if (H5Aexists(obj, name) > 0) H5Adelete(obj, name);
+  Hid a(H5Acreate2(obj, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT));
+  if (!a.ok() || (n && H5Awrite(a, H5T_NATIVE_DOUBLE, v.data()) < 0)) m.fail("cannot write attribute " + where + "/" + name);
+}
+
+void TableOut::f64_attr(hid_t obj, const char* name, double v) {
+  Hid space(H5Screate(H5S_SCALAR));
+  if (H5Aexists(obj, name) > 0) H5Adelete(obj, name);
+  Hid a(H5Acreate2(obj, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT));
+  if (!a.ok() || H5Awrite(a, H5T_NATIVE_DOUBLE, &v) < 0) m.fail("cannot write attribute " + where + "/" + name);
+}
+
+void TableOut::f64(hid_t g, const std::string& name, const std::vector<double>& v, std::size_t cols,
+                   const std::string& unit, const std::string& desc) {
+  const std::size_t rows = cols ? (v.empty() ? 0 : v.size() / cols) : v.size();
+  hsize_t dims[2] = {rows, cols};
   Hid space(H5Screate_simple(cols ? 2 : 1, dims, nullptr));
-  Hid d(H5Dcreate2(g, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  Hid dcpl(H5Pcreate(H5P_DATASET_CREATE));
+  if (v.size() >= 4096) {
+    hsize_t chunk[2] = {std::min<hsize_t>(rows, 65536), cols};
+    H5Pset_chunk(dcpl, cols ? 2 : 1, chunk);
+    H5Pset_shuffle(dcpl);
+    H5Pset_deflate(dcpl, 1);
+  }
+  Hid d(H5Dcreate2(g, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, dcpl, H5P_DEFAULT));
   if (!d.ok() || (!v.empty() && H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0))
-    m.fail("cannot write " + group + "/" + name);
+    m.fail("cannot write " + where + "/" + name);
   write_str_attr(d, "unit", unit);
-  write_cf_units(d, unit);
+  write_cf_units(d, unit, cols);
   write_str_attr(d, "description", desc);
 }
 
-void TableOut::i64(const char* name, const std::vector<std::int64_t>& v, const std::string& desc) {
-  const hsize_t n = v.size();
+void TableOut::i64(hid_t g, const std::string& name, const std::vector<std::int64_t>& v, const std::string& desc) {
+  hsize_t n = v.size();
   Hid space(H5Screate_simple(1, &n, nullptr));
-  Hid d(H5Dcreate2(g, name, H5T_STD_I64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  Hid d(H5Dcreate2(g, name.c_str(), H5T_STD_I64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
   if (!d.ok() || (n && H5Dwrite(d, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0))
-    m.fail("cannot write " + group + "/" + name);
+    m.fail("cannot write " + where + "/" + name);
   write_str_attr(d, "unit", "");
   write_str_attr(d, "description", desc);
 }
 
-void TableOut::str(const char* name, const std::vector<std::string>& v, const std::string& desc) {
-  const hsize_t n = v.size();
+void TableOut::str(hid_t g, const std::string& name, const std::vector<std::string>& v, const std::string& desc) {
+  hsize_t n = v.size();
   Hid space(H5Screate_simple(1, &n, nullptr));
   Hid t(utf8_vlen_type());
-  Hid d(H5Dcreate2(g, name, t, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  Hid d(H5Dcreate2(g, name.c_str(), t, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
   std::vector<const char*> p;
   for (const auto& s : v) p.push_back(s.c_str());
   if (!d.ok() || (n && H5Dwrite(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, p.data()) < 0))
-    m.fail("cannot write " + group + "/" + name);
+    m.fail("cannot write " + where + "/" + name);
   write_str_attr(d, "unit", "");
   write_str_attr(d, "description", desc);
 }
 
-void TableOut::attr_f64(const char* name, double v) {
-  Hid space(H5Screate(H5S_SCALAR));
-  Hid a(H5Acreate2(g, name, H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT));
-  if (!a.ok() || H5Awrite(a, H5T_NATIVE_DOUBLE, &v) < 0) m.fail("cannot write " + group + "@" + name);
+void TableOut::dimensions(hid_t g, const std::string& rows, const std::string& columns) {
+  if (!name_netcdf_dimensions(g, rows, columns)) m.fail("cannot name the dimensions of " + where);
 }
 
-void TableOut::attr_i64(const char* name, std::int64_t v) { write_i64_attr(g, name, v); }
+Hid TableOut::group(hid_t parent, const std::string& name) {
+  Hid g(H5Gcreate2(parent, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  if (!g.ok()) m.fail("cannot create " + where + "/" + name);
+  return g;
+}
 
 TableIn::TableIn(hid_t g_, const std::string& path_, const std::string& group_, const char* count_column)
     : g(g_), path(path_), group(group_) {

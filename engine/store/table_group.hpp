@@ -16,19 +16,25 @@ namespace ks::store::detail {
 /// marked freed). Fails the writer (m.fail) when HDF5 refuses.
 Hid replace_group(ResultsWriter::Impl& m, const char* name);
 
-/// Writes the columns of table group `g` (named `group`, as "/verification", in error messages).
+/// Writes datasets and attributes of the groups under `where` ("/verification", "/optimizations/x",
+/// named in error messages); every failure fails the writer (m.fail).
 struct TableOut {
   ResultsWriter::Impl& m;
-  hid_t g;
-  std::string group;
-  /// `v`: rows (cols == 0) or rows x cols values, row by row.
-  void f64(const char* name, const std::vector<double>& v, std::size_t cols, const std::string& unit,
+  std::string where;
+  /// `v`: rows (cols == 0: a 1-D dataset) or rows x cols values, row by row; chunked, shuffled and
+  /// deflated from 4096 values on.
+  void f64(hid_t g, const std::string& name, const std::vector<double>& v, std::size_t cols, const std::string& unit,
            const std::string& desc);
-  void i64(const char* name, const std::vector<std::int64_t>& v, const std::string& desc);
-  void str(const char* name, const std::vector<std::string>& v, const std::string& desc);
-  /// A scalar attribute of the group.
-  void attr_f64(const char* name, double v);
-  void attr_i64(const char* name, std::int64_t v);
+  void i64(hid_t g, const std::string& name, const std::vector<std::int64_t>& v, const std::string& desc);
+  void str(hid_t g, const std::string& name, const std::vector<std::string>& v, const std::string& desc);
+  /// An attribute of `obj` (a scalar, or a 1-D array; an empty one has a null dataspace), replaced
+  /// when present.
+  void f64_attr(hid_t obj, const char* name, double v);
+  void f64_attr(hid_t obj, const char* name, const std::vector<double>& v);
+  /// netCDF dimensions of the datasets of `g` (name_netcdf_dimensions).
+  void dimensions(hid_t g, const std::string& rows, const std::string& columns = "");
+  /// A new group `name` in `parent`.
+  Hid group(hid_t parent, const std::string& name);
 };
 
 /// Reads the columns of table group `g` of file `path`; the row count is the length of the column

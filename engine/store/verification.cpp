@@ -30,8 +30,8 @@ void ResultsWriter::write_verification(const VerificationTable& t) {
   write_str_attr(g, "description",
                  "grid convergence of the best runs: each row one quantity of one run computed at three grids "
                  "(1 finest, 3 the run as stored) and Roache's grid convergence index");
-  TableOut o{m, g, "/verification"};
-  o.attr_f64("safety_factor", t.safety_factor);
+  TableOut o{m, "/verification"};
+  o.f64_attr(g, "safety_factor", t.safety_factor);
   const auto& rows = t.rows;
   auto strings = [&](auto field) {
     std::vector<std::string> v;
@@ -45,37 +45,37 @@ void ResultsWriter::write_verification(const VerificationTable& t) {
   };
   std::vector<std::int64_t> run;
   for (const auto& r : rows) run.push_back(r.run);
-  o.i64("run", run, "the run id (row of /runs)");
-  o.str("block", strings([](auto& r) { return r.block; }), "the run's block");
-  o.str("method", strings([](auto& r) { return r.method; }), "the run's method");
-  o.str("group", strings([](auto& r) { return r.group; }), "what the run is the best of (column=value, ...)");
-  o.str("quantity", strings([](auto& r) { return r.quantity; }), "the /runs metric verified");
-  o.str("quantity_unit", strings([](auto& r) { return r.unit; }), "its unit (of value and extrapolated)");
-  o.str("refinement", strings([](auto& r) { return r.refinement; }), "dt (dt, dt/2, dt/4) or knots (K, 2K, 4K)");
-  o.f64("ratio", numbers([](auto& r) { return r.ratio; }), 0, "", "refinement ratio r between consecutive grids");
-  o.f64("dt", per_grid(rows, [](auto& r) { return r.dt; }), 3, "s", "time step per grid (1 finest .. 3 as stored)");
-  o.f64("knots", per_grid(rows, [](auto& r) { return r.knots; }), 3, "",
+  o.i64(g, "run", run, "the run id (row of /runs)");
+  o.str(g, "block", strings([](auto& r) { return r.block; }), "the run's block");
+  o.str(g, "method", strings([](auto& r) { return r.method; }), "the run's method");
+  o.str(g, "group", strings([](auto& r) { return r.group; }), "what the run is the best of (column=value, ...)");
+  o.str(g, "quantity", strings([](auto& r) { return r.quantity; }), "the /runs metric verified");
+  o.str(g, "quantity_unit", strings([](auto& r) { return r.unit; }), "its unit (of value and extrapolated)");
+  o.str(g, "refinement", strings([](auto& r) { return r.refinement; }), "dt (dt, dt/2, dt/4) or knots (K, 2K, 4K)");
+  o.f64(g, "ratio", numbers([](auto& r) { return r.ratio; }), 0, "", "refinement ratio r between consecutive grids");
+  o.f64(g, "dt", per_grid(rows, [](auto& r) { return r.dt; }), 3, "s", "time step per grid (1 finest .. 3 as stored)");
+  o.f64(g, "knots", per_grid(rows, [](auto& r) { return r.knots; }), 3, "",
         "spline knots per grid (1 finest .. 3 as stored); NaN for methods without knots");
-  o.f64("value", per_grid(rows, [](auto& r) { return r.value; }), 3, "",
+  o.f64(g, "value", per_grid(rows, [](auto& r) { return r.value; }), 3, "",
         "the quantity per grid (1 finest .. 3 as stored; unit: quantity_unit); NaN when the run failed");
   {
     std::vector<std::string> s[3];
     for (const auto& r : rows)
       for (int k = 0; k < 3; ++k) s[k].push_back(r.status[static_cast<std::size_t>(k)]);
-    o.str("status_1", s[0], "the run's status on grid 1 (finest)");
-    o.str("status_2", s[1], "the run's status on grid 2");
-    o.str("status_3", s[2], "the run's status on grid 3 (as stored)");
+    o.str(g, "status_1", s[0], "the run's status on grid 1 (finest)");
+    o.str(g, "status_2", s[1], "the run's status on grid 2");
+    o.str(g, "status_3", s[2], "the run's status on grid 3 (as stored)");
   }
-  o.str("convergence", strings([](auto& r) { return r.convergence; }),
+  o.str(g, "convergence", strings([](auto& r) { return r.convergence; }),
         "monotone | unchanged | oscillatory | divergent | not_enough");
-  o.f64("order", numbers([](auto& r) { return r.order; }), 0, "", "observed order p (monotone only; else NaN)");
-  o.f64("extrapolated", numbers([](auto& r) { return r.extrapolated; }), 0, "",
+  o.f64(g, "order", numbers([](auto& r) { return r.order; }), 0, "", "observed order p (monotone only; else NaN)");
+  o.f64(g, "extrapolated", numbers([](auto& r) { return r.extrapolated; }), 0, "",
         "Richardson extrapolation of the grid-converged value (unit: quantity_unit; monotone, unchanged)");
-  o.f64("gci_fine", numbers([](auto& r) { return r.gci_fine; }), 0, "",
+  o.f64(g, "gci_fine", numbers([](auto& r) { return r.gci_fine; }), 0, "",
         "grid convergence index of grid 1, relative (0.01 = 1 %)");
-  o.f64("gci_coarse", numbers([](auto& r) { return r.gci_coarse; }), 0, "",
+  o.f64(g, "gci_coarse", numbers([](auto& r) { return r.gci_coarse; }), 0, "",
         "grid convergence index of grid 3, the run as stored, relative (0.01 = 1 %)");
-  if (!name_netcdf_dimensions(g, "verification_row", "grid")) m.fail("cannot name the dimensions of /verification");
+  o.dimensions(g, "verification_row", "grid");
   m.do_flush();
 }
 
