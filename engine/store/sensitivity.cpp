@@ -14,10 +14,7 @@ constexpr const char* kSensitivityGroup = "sensitivity";
 void ResultsWriter::write_sensitivity(const SensitivityTable& t) {
   QuietHdf5 quiet;
   Impl& m = *impl_;
-  m.usable();
-  m.touched = true;
-  Hid g = replace_group(m, kSensitivityGroup);
-  write_str_attr(g, "description",
+  Hid g = replace_group(m, kSensitivityGroup,
                  "first-order and total Sobol' indices of the Saltelli designs (/designs): each row one factor of "
                  "one metric at one combination of its block's other dimensions (Saltelli 2010's centred "
                  "first-order estimator, Jansen's total one, over the sample rows whose runs all have the kind's "
@@ -27,38 +24,23 @@ void ResultsWriter::write_sensitivity(const SensitivityTable& t) {
   o.f64_attr(g, "confidence", t.confidence);
   write_i64_attr(g, "seed", t.seed);
   const auto& rows = t.rows;
-  auto strings = [&](auto field) {
-    std::vector<std::string> v;
-    for (const auto& r : rows) v.push_back(field(r));
-    return v;
-  };
-  auto numbers = [&](auto field) {
-    std::vector<double> v;
-    for (const auto& r : rows) v.push_back(field(r));
-    return v;
-  };
-  auto integers = [&](auto field) {
-    std::vector<std::int64_t> v;
-    for (const auto& r : rows) v.push_back(field(r));
-    return v;
-  };
-  o.str(g, "block", strings([](auto& r) { return r.block; }), "the design's block");
-  o.str(g, "metric", strings([](auto& r) { return r.metric; }), "the /runs metric");
-  o.i64(g, "combination", integers([](auto& r) { return r.combination; }),
+  o.str(g, "block", column_of(rows, [](const auto& r) { return r.block; }), "the design's block");
+  o.str(g, "metric", column_of(rows, [](const auto& r) { return r.metric; }), "the /runs metric");
+  o.i64(g, "combination", column_of(rows, [](const auto& r) { return r.combination; }),
         "the combination of the block's other dimensions, in run order (0 when it has none)");
-  o.str(g, "factor", strings([](auto& r) { return r.factor; }), "the factor (an axis of the design)");
-  o.i64(g, "factor_index", integers([](auto& r) { return r.factor_index; }),
+  o.str(g, "factor", column_of(rows, [](const auto& r) { return r.factor; }), "the factor (an axis of the design)");
+  o.i64(g, "factor_index", column_of(rows, [](const auto& r) { return r.factor_index; }),
         "its position in /designs/<block>@factors");
-  o.f64(g, "first", numbers([](auto& r) { return r.first; }), 0, "", "first-order index S_i");
-  o.f64(g, "first_lo", numbers([](auto& r) { return r.first_lo; }), 0, "", "S_i's bootstrap interval, lower end");
-  o.f64(g, "first_hi", numbers([](auto& r) { return r.first_hi; }), 0, "", "S_i's bootstrap interval, upper end");
-  o.f64(g, "total", numbers([](auto& r) { return r.total; }), 0, "", "total index S_Ti");
-  o.f64(g, "total_lo", numbers([](auto& r) { return r.total_lo; }), 0, "", "S_Ti's bootstrap interval, lower end");
-  o.f64(g, "total_hi", numbers([](auto& r) { return r.total_hi; }), 0, "", "S_Ti's bootstrap interval, upper end");
-  o.f64(g, "variance", numbers([](auto& r) { return r.variance; }), 0, "",
+  o.f64(g, "first", column_of(rows, [](const auto& r) { return r.first; }), 0, "", "first-order index S_i");
+  o.f64(g, "first_lo", column_of(rows, [](const auto& r) { return r.first_lo; }), 0, "", "S_i's bootstrap interval, lower end");
+  o.f64(g, "first_hi", column_of(rows, [](const auto& r) { return r.first_hi; }), 0, "", "S_i's bootstrap interval, upper end");
+  o.f64(g, "total", column_of(rows, [](const auto& r) { return r.total; }), 0, "", "total index S_Ti");
+  o.f64(g, "total_lo", column_of(rows, [](const auto& r) { return r.total_lo; }), 0, "", "S_Ti's bootstrap interval, lower end");
+  o.f64(g, "total_hi", column_of(rows, [](const auto& r) { return r.total_hi; }), 0, "", "S_Ti's bootstrap interval, upper end");
+  o.f64(g, "variance", column_of(rows, [](const auto& r) { return r.variance; }), 0, "",
         "the metric's variance over the sample rows A and B (the metric's unit squared)");
-  o.i64(g, "samples", integers([](auto& r) { return r.samples; }), "sample rows used");
-  o.i64(g, "dropped", integers([](auto& r) { return r.dropped; }),
+  o.i64(g, "samples", column_of(rows, [](const auto& r) { return r.samples; }), "sample rows used");
+  o.i64(g, "dropped", column_of(rows, [](const auto& r) { return r.dropped; }),
         "sample rows left out: a run of the row failed or is not done");
   o.dimensions(g, "sensitivity_row");
   m.do_flush();
@@ -67,11 +49,9 @@ void ResultsWriter::write_sensitivity(const SensitivityTable& t) {
 SensitivityTable ResultsReader::read_sensitivity() const {
   QuietHdf5 quiet;
   SensitivityTable t;
-  const hid_t f = impl_->file;
-  const std::string& path = impl_->path;
-  if (!link_exists(f, kSensitivityGroup)) return t;
-  Hid g(check(H5Gopen2(f, kSensitivityGroup, H5P_DEFAULT), path, "open /sensitivity"));
-  const TableIn in(g, path, "/sensitivity", "block");
+  const std::optional<TableIn> table = TableIn::open(impl_->file, impl_->path, kSensitivityGroup, "block");
+  if (!table) return t;
+  const TableIn& in = *table;
   t.bootstrap = in.attr_i64("bootstrap", t.bootstrap);
   t.confidence = in.attr_f64("confidence", t.confidence);
   t.seed = in.attr_i64("seed", t.seed);

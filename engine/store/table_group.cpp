@@ -5,13 +5,16 @@
 
 namespace ks::store::detail {
 
-Hid replace_group(ResultsWriter::Impl& m, const char* name) {
+Hid replace_group(ResultsWriter::Impl& m, const char* name, const std::string& description) {
+  m.usable();
+  m.touched = true;
   if (link_exists(m.file, name)) {
     if (H5Ldelete(m.file, name, H5P_DEFAULT) < 0) m.fail(std::string("cannot replace /") + name);
     m.freed_space = true;
   }
   Hid g(H5Gcreate2(m.file, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
   if (!g.ok()) m.fail(std::string("cannot create /") + name);
+  write_str_attr(g, "description", description);
   return g;
 }
 
@@ -83,54 +86,58 @@ Hid TableOut::group(hid_t parent, const std::string& name) {
   return g;
 }
 
-TableIn::TableIn(hid_t g_, const std::string& path_, const std::string& group_, const char* count_column)
-    : g(g_), path(path_), group(group_) {
-  Hid d(check(H5Dopen2(g, count_column, H5P_DEFAULT), path, "open " + group + "/" + count_column));
+std::optional<TableIn> TableIn::open(hid_t file, const std::string& path, const char* name,
+                                     const char* count_column) {
+  if (!link_exists(file, name)) return std::nullopt;
+  const std::string where = std::string("/") + name;
+  TableIn in(Hid(check(H5Gopen2(file, name, H5P_DEFAULT), path, "open " + where)), path, where);
+  Hid d(check(H5Dopen2(in.g_, count_column, H5P_DEFAULT), path, "open " + where + "/" + count_column));
   Hid s(H5Dget_space(d));
-  n = static_cast<std::size_t>(std::max<hssize_t>(0, H5Sget_simple_extent_npoints(s)));
+  in.n_ = static_cast<std::size_t>(std::max<hssize_t>(0, H5Sget_simple_extent_npoints(s)));
+  return in;
 }
 
-Hid TableIn::open(const char* name, std::size_t cols) const {
-  Hid d(check(H5Dopen2(g, name, H5P_DEFAULT), path, "open " + group + "/" + name));
+Hid TableIn::dataset(const char* name, std::size_t cols) const {
+  Hid d(check(H5Dopen2(g_, name, H5P_DEFAULT), path_, "open " + where_ + "/" + name));
   Hid s(H5Dget_space(d));
   const hssize_t points = H5Sget_simple_extent_npoints(s);
-  if (points < 0 || static_cast<std::size_t>(points) != n * cols)
-    throw StoreError(path, group + "/" + name + " holds " + std::to_string(points) + " values; expected " +
-                               std::to_string(n * cols) + " (" + std::to_string(n) + " rows)");
+  if (points < 0 || static_cast<std::size_t>(points) != n_ * cols)
+    throw StoreError(path_, where_ + "/" + name + " holds " + std::to_string(points) + " values; expected " +
+                                std::to_string(n_ * cols) + " (" + std::to_string(n_) + " rows)");
   return d;
 }
 
 std::vector<double> TableIn::f64(const char* name, std::size_t cols) const {
-  Hid d = open(name, cols);
-  std::vector<double> v(n * cols);
+  Hid d = dataset(name, cols);
+  std::vector<double> v(n_ * cols);
   if (!v.empty())
-    check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), path, "read " + group + "/" + name);
+    check(H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), path_, "read " + where_ + "/" + name);
   return v;
 }
 
 std::vector<std::int64_t> TableIn::i64(const char* name) const {
-  Hid d = open(name, 1);
-  std::vector<std::int64_t> v(n);
+  Hid d = dataset(name, 1);
+  std::vector<std::int64_t> v(n_);
   if (!v.empty())
-    check(H5Dread(d, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), path, "read " + group + "/" + name);
+    check(H5Dread(d, H5T_NATIVE_INT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()), path_, "read " + where_ + "/" + name);
   return v;
 }
 
 std::vector<std::string> TableIn::str(const char* name) const {
-  Hid d = open(name, 1);
-  return read_vlen_strings(d, H5S_ALL, H5S_ALL, n, path, "read " + group + "/" + name);
+  Hid d = dataset(name, 1);
+  return read_vlen_strings(d, H5S_ALL, H5S_ALL, n_, path_, "read " + where_ + "/" + name);
 }
 
 double TableIn::attr_f64(const char* name, double fallback) const {
-  if (!has_attr(g, name)) return fallback;
-  Hid a(check(H5Aopen(g, name, H5P_DEFAULT), path, "open " + group + "@" + name));
+  if (!has_attr(g_, name)) return fallback;
+  Hid a(check(H5Aopen(g_, name, H5P_DEFAULT), path_, "open " + where_ + "@" + name));
   double v = fallback;
-  check(H5Aread(a, H5T_NATIVE_DOUBLE, &v), path, "read " + group + "@" + name);
+  check(H5Aread(a, H5T_NATIVE_DOUBLE, &v), path_, "read " + where_ + "@" + name);
   return v;
 }
 
 std::int64_t TableIn::attr_i64(const char* name, std::int64_t fallback) const {
-  return read_i64_attr(g, name, fallback);
+  return read_i64_attr(g_, name, fallback);
 }
 
 }  // namespace ks::store::detail

@@ -24,35 +24,20 @@ std::vector<double> per_grid(const std::vector<VerificationRow>& rows, F field) 
 void ResultsWriter::write_verification(const VerificationTable& t) {
   QuietHdf5 quiet;
   Impl& m = *impl_;
-  m.usable();
-  m.touched = true;
-  Hid g = replace_group(m, kGroup);
-  write_str_attr(g, "description",
+  Hid g = replace_group(m, kGroup,
                  "grid convergence of the best runs: each row one quantity of one run computed at three grids "
                  "(1 finest, 3 the run as stored) and Roache's grid convergence index");
   TableOut o{m, "/verification"};
   o.f64_attr(g, "safety_factor", t.safety_factor);
   const auto& rows = t.rows;
-  auto strings = [&](auto field) {
-    std::vector<std::string> v;
-    for (const auto& r : rows) v.push_back(field(r));
-    return v;
-  };
-  auto numbers = [&](auto field) {
-    std::vector<double> v;
-    for (const auto& r : rows) v.push_back(field(r));
-    return v;
-  };
-  std::vector<std::int64_t> run;
-  for (const auto& r : rows) run.push_back(r.run);
-  o.i64(g, "run", run, "the run id (row of /runs)");
-  o.str(g, "block", strings([](auto& r) { return r.block; }), "the run's block");
-  o.str(g, "method", strings([](auto& r) { return r.method; }), "the run's method");
-  o.str(g, "group", strings([](auto& r) { return r.group; }), "what the run is the best of (column=value, ...)");
-  o.str(g, "quantity", strings([](auto& r) { return r.quantity; }), "the /runs metric verified");
-  o.str(g, "quantity_unit", strings([](auto& r) { return r.unit; }), "its unit (of value and extrapolated)");
-  o.str(g, "refinement", strings([](auto& r) { return r.refinement; }), "dt (dt, dt/2, dt/4) or knots (K, 2K, 4K)");
-  o.f64(g, "ratio", numbers([](auto& r) { return r.ratio; }), 0, "", "refinement ratio r between consecutive grids");
+  o.i64(g, "run", column_of(rows, [](const auto& r) { return r.run; }), "the run id (row of /runs)");
+  o.str(g, "block", column_of(rows, [](const auto& r) { return r.block; }), "the run's block");
+  o.str(g, "method", column_of(rows, [](const auto& r) { return r.method; }), "the run's method");
+  o.str(g, "group", column_of(rows, [](const auto& r) { return r.group; }), "what the run is the best of (column=value, ...)");
+  o.str(g, "quantity", column_of(rows, [](const auto& r) { return r.quantity; }), "the /runs metric verified");
+  o.str(g, "quantity_unit", column_of(rows, [](const auto& r) { return r.unit; }), "its unit (of value and extrapolated)");
+  o.str(g, "refinement", column_of(rows, [](const auto& r) { return r.refinement; }), "dt (dt, dt/2, dt/4) or knots (K, 2K, 4K)");
+  o.f64(g, "ratio", column_of(rows, [](const auto& r) { return r.ratio; }), 0, "", "refinement ratio r between consecutive grids");
   o.f64(g, "dt", per_grid(rows, [](auto& r) { return r.dt; }), 3, "s", "time step per grid (1 finest .. 3 as stored)");
   o.f64(g, "knots", per_grid(rows, [](auto& r) { return r.knots; }), 3, "",
         "spline knots per grid (1 finest .. 3 as stored); NaN for methods without knots");
@@ -66,14 +51,14 @@ void ResultsWriter::write_verification(const VerificationTable& t) {
     o.str(g, "status_2", s[1], "the run's status on grid 2");
     o.str(g, "status_3", s[2], "the run's status on grid 3 (as stored)");
   }
-  o.str(g, "convergence", strings([](auto& r) { return r.convergence; }),
+  o.str(g, "convergence", column_of(rows, [](const auto& r) { return r.convergence; }),
         "monotone | unchanged | oscillatory | divergent | not_enough");
-  o.f64(g, "order", numbers([](auto& r) { return r.order; }), 0, "", "observed order p (monotone only; else NaN)");
-  o.f64(g, "extrapolated", numbers([](auto& r) { return r.extrapolated; }), 0, "",
+  o.f64(g, "order", column_of(rows, [](const auto& r) { return r.order; }), 0, "", "observed order p (monotone only; else NaN)");
+  o.f64(g, "extrapolated", column_of(rows, [](const auto& r) { return r.extrapolated; }), 0, "",
         "Richardson extrapolation of the grid-converged value (unit: quantity_unit; monotone, unchanged)");
-  o.f64(g, "gci_fine", numbers([](auto& r) { return r.gci_fine; }), 0, "",
+  o.f64(g, "gci_fine", column_of(rows, [](const auto& r) { return r.gci_fine; }), 0, "",
         "grid convergence index of grid 1, relative (0.01 = 1 %)");
-  o.f64(g, "gci_coarse", numbers([](auto& r) { return r.gci_coarse; }), 0, "",
+  o.f64(g, "gci_coarse", column_of(rows, [](const auto& r) { return r.gci_coarse; }), 0, "",
         "grid convergence index of grid 3, the run as stored, relative (0.01 = 1 %)");
   o.dimensions(g, "verification_row", "grid");
   m.do_flush();
@@ -82,11 +67,9 @@ void ResultsWriter::write_verification(const VerificationTable& t) {
 VerificationTable ResultsReader::read_verification() const {
   QuietHdf5 quiet;
   VerificationTable t;
-  const hid_t f = impl_->file;
-  const std::string& path = impl_->path;
-  if (!link_exists(f, kGroup)) return t;
-  Hid g(check(H5Gopen2(f, kGroup, H5P_DEFAULT), path, "open /verification"));
-  const TableIn in(g, path, "/verification", "run");
+  const std::optional<TableIn> table = TableIn::open(impl_->file, impl_->path, kGroup, "run");
+  if (!table) return t;
+  const TableIn& in = *table;
   t.safety_factor = in.attr_f64("safety_factor", t.safety_factor);
   const std::size_t n = in.rows();
   const auto run = in.i64("run");
