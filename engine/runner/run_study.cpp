@@ -210,8 +210,17 @@ int conclude(const Study& study, const RunRequest& r, SweepBackend& backend, Swe
   }
   {
     res.writer->flush();
-    const store::SensitivityTable indices = design_sensitivity(study, store::ResultsReader(res.writer->path()), backend.threads(r));
-    if (!indices.rows.empty()) res.writer->write_sensitivity(indices);
+    const store::ResultsReader file(res.writer->path());
+    if (!file.designs().empty()) {
+      if (r.options.stop && r.options.stop->load()) {  // a resume computes them
+        res.writer->close();
+        out << "interrupted: " << backend.kept(r, "the sweep's " + std::to_string(report.total) + " runs")
+            << "; the Sobol' indices were not computed\nresume with: " << backend.resume_command(r) << '\n';
+        return 130;
+      }
+      const store::SensitivityTable indices = design_sensitivity(study, file, backend.threads(r));
+      if (!indices.rows.empty()) res.writer->write_sensitivity(indices);
+    }
   }
   res.writer->close();
   backend.publish(r);
