@@ -229,14 +229,6 @@ std::optional<Format> parse_format(const std::string& s) {
   return std::nullopt;
 }
 
-std::string format_double(double v) {
-  if (std::isnan(v)) return "nan";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 namespace {
 std::string full_double(double v) {  // csv/json: round-trip precision
   if (std::isnan(v)) return "nan";

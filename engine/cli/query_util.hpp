@@ -9,6 +9,7 @@
 #include <variant>
 #include <vector>
 
+#include "common/format_double.hpp"
 #include "store/record.hpp"
 #include "store/store.hpp"
 
@@ -132,7 +133,7 @@ std::optional<Format> parse_format(const std::string& s);
 /// json: {"columns": [...], "units": {name: unit}, "rows": [{name: value}, ...]} (NaN -> null).
 void print_out(const OutTable& t, Format f, std::ostream& os);
 
-std::string format_double(double v);  ///< %.6g; "nan", "inf"
+using ks::format_double;  ///< %.6g; "nan", "inf" (common/format_double.hpp)
 std::string json_string(const std::string& s);
 std::string csv_field(const std::string& s);
 /// Closest candidate by edit distance (empty when none is close).

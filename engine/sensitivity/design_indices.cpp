@@ -10,18 +10,14 @@
 
 #include <tbb/parallel_for.h>
 
+#include "common/format_double.hpp"
+
 namespace ks {
 
 namespace {
 /// A cell as the tables print it: numbers with 6 significant digits.
 std::string cell_text(const Cell& c) {
-  if (const double* d = std::get_if<double>(&c)) {
-    if (std::isnan(*d)) return "nan";
-    if (std::isinf(*d)) return *d > 0 ? "inf" : "-inf";
-    char buf[40];
-    std::snprintf(buf, sizeof buf, "%.6g", *d);
-    return buf;
-  }
+  if (const double* d = std::get_if<double>(&c)) return format_double(*d);
   if (const std::int64_t* i = std::get_if<std::int64_t>(&c)) return std::to_string(*i);
   if (const std::string* s = std::get_if<std::string>(&c)) return *s;
   return "";
