@@ -16,7 +16,6 @@
 namespace ks {
 namespace {
 
-constexpr double kViolationWeight = 1e6;
 constexpr double kInfeasibleFloor = 1e4;  // per unit of 1 / samples, in the objective's units
 constexpr double kSingularDet = 1e-12;    // an extension this close to singular costs the floor too
 
@@ -57,13 +56,34 @@ double ChainGlobalProblem::ratio(const LimitConstraints& limits, const std::arra
   }
 }
 
+double ChainGlobalProblem::term_weight(std::size_t i, GlobalObjective objective) const {
+  const std::size_t n = samples();
+  if (objective == GlobalObjective::E || objective == GlobalObjective::E_M) return 1.0 / static_cast<double>(n);
+  return (i == 0 || i + 1 == n) ? 0.5 * task_.path.dt() : task_.path.dt();
+}
+
+double ChainGlobalProblem::ratio_partial(const LimitConstraints& limits, const std::array<int, 2>& row,
+                                         const ChainGlobalSample& s, const ChainSamplePartials& d, int input) const {
+  const LimitTable& L = limits.table;
+  const int j = row[1];
+  const auto sign = [](double x) { return static_cast<double>((x > 0.0) - (x < 0.0)); };
+  switch (row[0]) {
+    case 0: {
+      const double off = s.q[j] - L.mid[j];
+      return sign(wraps_angles() ? remainder_2pi(off) : off) * L.inv_half[j] * d.q[j][input];
+    }
+    case 1: return sign(s.qd[j]) * L.inv_velocity[j] * d.qd[j][input];
+    default: return sign(s.tau[j]) * L.inv_effort[j] * d.tau[j][input];
+  }
+}
+
 double ChainGlobalProblem::cost(std::size_t i, const ChainGlobalSample& s, GlobalObjective objective) const {
   const std::size_t n = samples();
   const double trapezoid = (i == 0 || i + 1 == n) ? 0.5 * task_.path.dt() : task_.path.dt();
   // a sample off the chart or out of reach: its torques (at the clamped boundary, near singular) are
   // left out, and a floor above any valid sample's cost and a penalty growing with the violation
   // keep the optimiser away
-  if (s.violation > 0.0) return kInfeasibleFloor / static_cast<double>(n) + kViolationWeight * s.violation * s.violation;
+  if (s.violation > 0.0) return kInfeasibleFloor / static_cast<double>(n) + kViolationPenalty * s.violation * s.violation;
   double f = 0.0;
   if (singular(s, kSingularDet)) f += kInfeasibleFloor / static_cast<double>(n);
   switch (objective) {
@@ -88,6 +108,7 @@ double ChainGlobalProblem::objective(const AlphaBasis& basis, const double* c, G
   std::size_t window = 0;
   double f = 0.0, z[kMaxJoints][3];
   ChainGlobalSample s, up, down;
+  ChainSamplePartials exact;
   begin_pass();
   for (std::size_t i = 0; i < samples(); ++i) {
     for (int k = 0; k < r; ++k) basis.at(i, c + k * K, z[k][0], z[k][1], z[k][2]);
@@ -105,6 +126,20 @@ double ChainGlobalProblem::objective(const AlphaBasis& basis, const double* c, G
     }
     if (!grad && !(jac && !raised.empty())) continue;
     const BasisRow& brow = basis.rows[i];
+    if (partials(i, z, s, objective, term_weight(i, objective), exact)) {
+      for (int k = 0; k < r; ++k)
+        for (int d = 0; d < 3; ++d) {
+          const int input = 3 * k + d;
+          if (grad)
+            for (int m = 0; m < kBasisWidth && brow.first + m < K; ++m)
+              grad[k * K + brow.first + m] += exact.cost[input] * brow.w[d][m];
+          if (jac)
+            for (std::size_t row : raised)
+              partial[row * width + static_cast<std::size_t>(input)] =
+                  ratio_partial(*limits, limits->rows[row % P], s, exact, input);
+        }
+      continue;
+    }
     for (int k = 0; k < r; ++k)
       for (int d = 0; d < 3; ++d) {
         const double x = z[k][d], h = 1e-6 * std::max(1.0, std::abs(x));

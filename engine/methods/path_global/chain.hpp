@@ -30,6 +30,16 @@ struct ChainGlobalSample {
   double alpha = 0;      ///< the tip angle [rad] (planar tasks; NaN for spatial ones)
 };
 
+/// One sample's exact partials with respect to its 3r inputs (r coordinates), input 3k + d for
+/// coordinate k's value (d = 0), rate (1) and acceleration (2).
+struct ChainSamplePartials {
+  int inputs = 0;                          ///< 3r
+  double cost[3 * kMaxJoints];             ///< of the sample's term of the objective
+  double q[kMaxJoints][3 * kMaxJoints];    ///< of each joint's position
+  double qd[kMaxJoints][3 * kMaxJoints];   ///< of each joint's rate
+  double tau[kMaxJoints][3 * kMaxJoints];  ///< of each joint's torque or force
+};
+
 /// The robot's joint limits as inequality constraints of the optimiser. The samples are cut into
 /// windows (as many as the spline has knots, in order); for each window and each limited quantity —
 /// a joint's position (|q - middle| over half its range), velocity (|qd| over its limit) or effort
@@ -66,6 +76,14 @@ class ChainGlobalProblem {
   virtual bool wraps_angles() const = 0;
   /// A pass over the samples in order begins (extensions solved by continuation restart from their start).
   virtual void begin_pass() const {}
+  /// The exact partials of sample s = sample(i, z) (the last sample computed; state_ holds its
+  /// dynamics) into out: of its term of the objective (weight: the term's factor, term_weight()) and
+  /// of its positions, rates and torques. False when the extension has none: the objective then takes
+  /// central differences of sample().
+  virtual bool partials(std::size_t /*i*/, const double (*/*z*/)[3], const ChainGlobalSample& /*s*/,
+                        GlobalObjective /*objective*/, double /*weight*/, ChainSamplePartials& /*out*/) const {
+    return false;
+  }
   /// Sample i at z was the pass's (continuation starts sample i + 1, and perturbations of i, from it).
   virtual void accept(std::size_t /*i*/, const double (*/*z*/)[3], const ChainGlobalSample& /*s*/) const {}
 
@@ -89,10 +107,17 @@ class ChainGlobalProblem {
  protected:
   /// task: a position path (planar_position or spatial_position), sampled at the run's dt.
   ChainGlobalProblem(const Chain& chain, const ChainTask& task);
+  /// A sample off the chart or out of reach costs a floor plus this times its squared violation.
+  static constexpr double kViolationPenalty = 1e6;
+  /// The factor of sample i's term of the objective: 1 / samples (means) or the trapezoid's step (integrals).
+  double term_weight(std::size_t i, GlobalObjective objective) const;
   /// Sample i's term of the objective (state_ holds s's dynamics).
   double cost(std::size_t i, const ChainGlobalSample& s, GlobalObjective objective) const;
   /// The ratio of limited quantity `row` ({quantity, joint}) at s to its limit.
   double ratio(const LimitConstraints& limits, const std::array<int, 2>& row, const ChainGlobalSample& s) const;
+  /// Its partial with respect to input `input` of the sample, from the sample's partials d.
+  double ratio_partial(const LimitConstraints& limits, const std::array<int, 2>& row, const ChainGlobalSample& s,
+                       const ChainSamplePartials& d, int input) const;
 
   const Chain& chain_;
   const ChainTask& task_;

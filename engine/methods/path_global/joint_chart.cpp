@@ -1,6 +1,7 @@
 // JointExtensionProblem (methods/path_global/joint_chart.hpp): Newton's method on the solved joints, their
 // rates and accelerations, and the choice of the solved joints.
 #include "methods/path_global/joint_chart.hpp"
+#include "methods/path_global/joint_partials.hpp"
 
 #include <Eigen/LU>
 #include <algorithm>
@@ -111,6 +112,7 @@ void JointExtensionProblem::sample(std::size_t i, const double (*z)[3], ChainGlo
       for (int k = 0; k < r; ++k) current_JC_(a, k) = J(a, coordinate_joints_[k]);
     }
     current_lu_.compute(JS);
+    current_res_ = res;
     s.det = JS.determinant();
     s.violation = converged && std::isfinite(rn) ? 0.0 : (std::isfinite(rn) ? std::max(rn, kResidual) : 1.0);
     s.alpha = m == 2 ? std::atan2(data_.tip.R(1, 0), data_.tip.R(0, 0)) : std::numeric_limits<double>::quiet_NaN();
@@ -134,6 +136,34 @@ void JointExtensionProblem::sample(std::size_t i, const double (*z)[3], ChainGlo
   for (int k = 0; k < r; ++k) s.qdd[coordinate_joints_[k]] = z[k][2];
   for (int b = 0; b < m; ++b) s.qdd[solved_[b]] = qddS[b];
   s.tau = st.M * s.qdd + st.c + st.g;
+}
+
+bool JointExtensionProblem::partials(std::size_t, const double (*z)[3], const ChainGlobalSample& s,
+                                     GlobalObjective objective, double weight, ChainSamplePartials& out) const {
+  const int r = coordinates(), inputs = 3 * r;
+  if (s.violation > 0.0) {
+    out.inputs = inputs;
+    for (int k = 0; k < inputs; ++k) out.cost[k] = 0.0;
+    for (int j = 0; j < n_; ++j)
+      for (int k = 0; k < inputs; ++k) out.q[j][k] = out.qd[j][k] = out.tau[j][k] = 0.0;
+    if (s.violation < 1.0 && current_res_.size() == rows_ && current_res_.allFinite())
+      for (int k = 0; k < r; ++k) out.cost[3 * k] = -2.0 * kViolationPenalty * current_res_.dot(current_JC_.col(k));
+    return true;
+  }
+  JointSampleAt at;
+  at.chain = &chain_;
+  at.data = &data_;
+  at.solved = solved_.data();
+  at.coordinate = coordinate_joints_.data();
+  at.m = rows_;
+  at.r = r;
+  at.lu = &current_lu_;
+  at.JC = &current_JC_;
+  at.q = &s.q, at.qd = &s.qd, at.qdd = &s.qdd, at.tau = &s.tau;
+  at.M = &state_.M;
+  at.z = z;
+  joint_sample_partials(at, objective, weight, out);
+  return true;
 }
 
 void JointExtensionProblem::coordinates_of(std::size_t, const VecN& q, double* z, Elbow& elbow) const {

@@ -31,6 +31,11 @@ class JointExtensionProblem final : public ChainGlobalProblem {
   bool wraps_angles() const override { return false; }
   void begin_pass() const override;
   void accept(std::size_t i, const double (*z)[3], const ChainGlobalSample& s) const override;
+  /// Exact partials (methods/path_global/joint_partials.hpp). A sample whose Newton iteration did not
+  /// converge costs a floor plus 1e6 |res|^2, res the residual where it stopped: its partials are those
+  /// of the residual with the solved joints held, d|res|^2/dz = -2 res^T J_C.
+  bool partials(std::size_t i, const double (*z)[3], const ChainGlobalSample& s, GlobalObjective objective,
+                double weight, ChainSamplePartials& out) const override;
 
   const std::vector<int>& solved_joints() const { return solved_; }
   const std::vector<int>& coordinate_joints() const { return coordinate_joints_; }
@@ -59,6 +64,7 @@ class JointExtensionProblem final : public ChainGlobalProblem {
   mutable double accepted_det_ = 0, accepted_alpha_ = 0;
   mutable Eigen::PartialPivLU<SquareM> accepted_lu_, current_lu_;  // of J_S
   mutable JacobianC accepted_JC_, current_JC_;
+  mutable TaskV current_res_;  // the Newton residual at the last sample computed [m]
 };
 
 }  // namespace ks
