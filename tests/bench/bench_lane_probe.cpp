@@ -1,7 +1,9 @@
 // The trajectory kernel in lanes (simulate_lanes) against the lane probe (lane_probe.hpp), the
 // minimal arithmetic of the same runs, in one process: case 1a, batches of `width` runs with alpha1A
-// spread over +-1 degree as bench_trajectory's lanes benchmark does. The counter per_run is the CPU
-// time per run. tests/bench/lane_probe_ratios.py runs this binary and prints the ratios.
+// spread over +-1 degree as bench_trajectory's lanes benchmark does. Probe computes E only (the
+// per-step arithmetic); ProbeMetrics computes every metric the kernel stores for these runs. The
+// counter per_run is the CPU time per run. tests/bench/lane_probe_ratios.py runs this binary and
+// prints the ratios.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -44,20 +46,21 @@ void kernel(benchmark::State& st) {
   per_run(st, width);
 }
 
-void probe(benchmark::State& st) {
+void probe(benchmark::State& st, ks_probe::Metrics metrics) {
   const int width = static_cast<int>(st.range(0));
   if ((width == 4 && !ks_probe::runs_x4()) || (width == 8 && !ks_probe::runs_x8())) {
     st.SkipWithError("this processor or build does not run this lane width");
     return;
   }
   const std::vector<TrajectoryOptions> o = batch(width);
-  std::vector<double> alpha(width), k(width), E(width);
+  std::vector<double> alpha(width), k(width);
+  std::vector<ks_probe::ProbeResult> out(width);
   for (int i = 0; i < width; ++i) alpha[i] = o[i].alpha1A, k[i] = o[i].k;
   const ks_probe::ProbePath path = ks_probe::seed_square_path(o[0].dt);
   const auto run = width == 8 ? ks_probe::run_x8 : width == 4 ? ks_probe::run_x4 : ks_probe::run_x1;
   for (auto _ : st) {
-    run(path, alpha.data(), k.data(), E.data());
-    benchmark::DoNotOptimize(E.data());
+    run(metrics, path, alpha.data(), k.data(), out.data());
+    benchmark::DoNotOptimize(out.data());
   }
   per_run(st, width);
 }
@@ -67,5 +70,6 @@ double minimum(const std::vector<double>& v) { return *std::min_element(v.begin(
 }  // namespace
 
 BENCHMARK(kernel)->Name("Kernel")->Arg(1)->Arg(4)->Arg(8)->Unit(benchmark::kMicrosecond)->ComputeStatistics("min", minimum);
-BENCHMARK(probe)->Name("Probe")->Arg(1)->Arg(4)->Arg(8)->Unit(benchmark::kMicrosecond)->ComputeStatistics("min", minimum);
+BENCHMARK_CAPTURE(probe, e, ks_probe::Metrics::E)->Name("Probe")->Arg(1)->Arg(4)->Arg(8)->Unit(benchmark::kMicrosecond)->ComputeStatistics("min", minimum);
+BENCHMARK_CAPTURE(probe, all, ks_probe::Metrics::all)->Name("ProbeMetrics")->Arg(1)->Arg(4)->Arg(8)->Unit(benchmark::kMicrosecond)->ComputeStatistics("min", minimum);
 BENCHMARK_MAIN();

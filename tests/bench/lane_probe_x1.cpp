@@ -13,6 +13,7 @@ ProbePath seed_square_path(double dt) {
   ProbePath p;
   p.dt = dt;
   p.n = static_cast<std::size_t>(std::floor(total / dt + 1e-9)) + 1;
+  p.pos.resize(2 * p.n);
   p.acc.resize(2 * p.n);
   for (std::size_t i = 0; i < p.n; ++i) {
     const double t = static_cast<double>(i) * dt;
@@ -20,27 +21,30 @@ ProbePath seed_square_path(double dt) {
     while (seg < 3 && t > T * (seg + 1)) ++seg;
     const double s = (t - T * seg) / T;
     const double f = (60 * s - 180 * s * s + 120 * s * s * s) / (T * T);
+    const double b = s * s * s * (10 - 15 * s + 6 * s * s);
+    p.pos[2 * i] = vx[seg] + (vx[seg + 1] - vx[seg]) * b;
+    p.pos[2 * i + 1] = vy[seg] + (vy[seg + 1] - vy[seg]) * b;
     p.acc[2 * i] = (vx[seg + 1] - vx[seg]) * f;
     p.acc[2 * i + 1] = (vy[seg + 1] - vy[seg]) * f;
   }
   return p;
 }
 
-void run_x1(const ProbePath& path, const double* alpha1A, const double* k, double* E) {
-  simulate<1>(path, alpha1A, k, E);
+void run_x1(Metrics metrics, const ProbePath& path, const double* alpha1A, const double* k, ProbeResult* out) {
+  run<1>(metrics, path, alpha1A, k, out);
 }
 
 #ifdef KS_PROBE_X4
 bool runs_x4() { return __builtin_cpu_supports("avx2"); }
 #else
 bool runs_x4() { return false; }
-void run_x4(const ProbePath&, const double*, const double*, double*) {}
+void run_x4(Metrics, const ProbePath&, const double*, const double*, ProbeResult*) {}
 #endif
 #ifdef KS_PROBE_X8
 bool runs_x8() { return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq"); }
 #else
 bool runs_x8() { return false; }
-void run_x8(const ProbePath&, const double*, const double*, double*) {}
+void run_x8(Metrics, const ProbePath&, const double*, const double*, ProbeResult*) {}
 #endif
 
 }  // namespace ks_probe

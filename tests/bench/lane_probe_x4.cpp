@@ -4,8 +4,8 @@
 
 namespace ks_probe {
 
-void run_x4(const ProbePath& path, const double* alpha1A, const double* k, double* E) {
-  simulate<4>(path, alpha1A, k, E);
+void run_x4(Metrics metrics, const ProbePath& path, const double* alpha1A, const double* k, ProbeResult* out) {
+  run<4>(metrics, path, alpha1A, k, out);
 }
 
 }  // namespace ks_probe

@@ -9,8 +9,8 @@
 
 namespace ks_probe {
 
-void run_x8(const ProbePath& path, const double* alpha1A, const double* k, double* E) {
-  simulate<8>(path, alpha1A, k, E);
+void run_x8(Metrics metrics, const ProbePath& path, const double* alpha1A, const double* k, ProbeResult* out) {
+  run<8>(metrics, path, alpha1A, k, out);
 }
 
 }  // namespace ks_probe

@@ -139,7 +139,7 @@ void trajectory_loop(Model& model, RunSums* out) {
     SampleValues<T> v;  // field by field: no zero-filling aggregate initialiser per sample
     v.n = n, v.tt = tt, v.ff = ff, v.p6 = p6;
     model.values(e, i, q, qd, tau, v);
-    M crossed = sums.add(i, t, v, abs_tau, n, keep) & active;
+    M crossed = sums.template add<Model::prismatic_joints>(i, t, v, abs_tau, n, keep) & active;
     bool beyond = false;
     if constexpr (one) beyond = sums.limits(v.q, v.qd, v.tau, n);
     sums.mark(crossed, beyond);

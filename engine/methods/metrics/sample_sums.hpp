@@ -76,8 +76,10 @@ class SampleSums {
 
   /// Adds sample i at time t with per-joint |tau_j| in abs_tau (n joints); returns the lanes that
   /// cross the tracking bound at this sample: |tip - path| > bound, the distance itself compared (a
-  /// distance equal to the bound is on the path; the limits' crossings: limits()).
-  template <class Keep>
+  /// distance equal to the bound is on the path; the limits' crossings: limits()). kForces false: the
+  /// model has no prismatic joint (v.ff is 0), so E_force's sum (never read then) and the + 0 in
+  /// tau^T tau + f^T f are skipped: the sums are those of ff = 0 bit for bit (tt >= +0, tt + 0 = tt).
+  template <bool kForces = true, class Keep>
   M add(std::size_t i, double t, const SampleValues<T>& v, const T* abs_tau, int n, Keep&& keep) {
     T err;
     if constexpr (one) {
@@ -90,12 +92,13 @@ class SampleSums {
       sumEM = keep(sumEM + vsqrt(v.qf / v.det), sumEM);
       sum_err_ = keep(sum_err_ + err, sum_err_);
     }
-    sumEF = keep(sumEF + vsqrt(v.ff), sumEF);
+    if constexpr (kForces) sumEF = keep(sumEF + vsqrt(v.ff), sumEF);
     for (int j = 0; j < n; ++j) inf[j] = keep(vmax(inf[j], abs_tau[j]), inf[j]);
     min_w2 = keep(vmin(min_w2, v.w2), min_w2);
     max_err2 = keep(vmax(max_err2, v.err2), max_err2);
     max_orient = keep(vmax(max_orient, v.orient), max_orient);
-    const T tt = v.tt + v.ff;
+    T tt = v.tt;
+    if constexpr (kForces) tt = tt + v.ff;
     f5 = keep(f5 + tt, f5);
     f6 = keep(f6 + v.p6, f6);
     if (i == 0) {
