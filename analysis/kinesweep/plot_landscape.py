@@ -272,15 +272,16 @@ def main(argv=None):
     xlog = not xa.categorical and ksplot.is_log_spaced(xa.values)
     ylog = not ya.categorical and ksplot.is_log_spaced(ya.values)
 
-    plt, size = ksplot.figure(args)
+    size = ksplot.figure_size(args)
+    from matplotlib import colormaps
     from matplotlib.colors import ListedColormap, LogNorm, Normalize
     from matplotlib import patheffects
     from matplotlib.patches import Patch
     n = Z.shape[0]
     ncols = min(n, 3)
     nrows = -(-n // ncols)
-    fig, axs = plt.subplots(nrows, ncols, figsize=size, constrained_layout=True, squeeze=False,
-                            sharex=True, sharey=True)
+    fig = ksplot.agg_figure(size, constrained_layout=True)
+    axs = fig.subplots(nrows, ncols, squeeze=False, sharex=True, sharey=True)
     for k in range(n, nrows * ncols):
         axs.flat[k].set_visible(False)
     xv = np.arange(len(xa.values)) if xa.categorical else xa.values
@@ -303,7 +304,7 @@ def main(argv=None):
         norm = LogNorm(vmin=vmin, vmax=max(vmax, vmin * 1.0001))
     else:
         norm = Normalize(vmin=vmin, vmax=vmax if vmax > vmin else vmin + 1)
-    cmap = plt.get_cmap("viridis").copy()
+    cmap = colormaps["viridis"].copy()
     cmap.set_bad((0, 0, 0, 0))
     levels = []
     if args.levels > 0 and any_finite and len(xv) > 2 and len(yv) > 2 and metric != "convergence":
