@@ -3,6 +3,7 @@ the best runs of each block (parameters and metrics, units in the headers, angle
 Run with /usr/bin/python3."""
 import numpy as np
 
+from kinesweep.chunks import one_value
 from kinesweep.kinds import enum_labels, text_values
 from kinesweep.read import RAD2DEG
 from kinesweep.report_page import esc, fmt, table
@@ -187,6 +188,8 @@ def varying_parameters(view, block, rows):
 
 
 def _varies(view, c, rows):
+    if one_value(view.g[c]):  # one value in every row of the file: in these rows too
+        return False
     first = lo = hi = None
     for v in view.chunks(c, rows):
         if v.dtype.kind == "f":
@@ -207,6 +210,8 @@ def _held(view, c, rows):
     """Whether the column holds a value in one of `rows` (or `rows` is empty), read until it does."""
     if not len(rows):
         return True
+    if one_value(view.g[c]):  # one value in every row: held or not in all of them
+        return bool(held(np.asarray(view.values(c, rows[:1]))).any())
     return any(held(v).any() for v in view.chunks(c, rows))
 
 
