@@ -53,6 +53,10 @@ def parse_args(argv=None):
                    help="heatmap cells drawn over all grid figures (default %(default)s; bigger grids are "
                         "subsampled and the caption says so)")
     p.add_argument("--title", help="page title (default: the study's name)")
+    p.add_argument("--importance", action="store_true",
+                   help="fit the permutation importance of the swept parameters of each block that sweeps two or more "
+                   "(a random forest per block, scikit-learn: a second or more each); without it the importance "
+                   "section only names those blocks")
     p.add_argument("--pareto", metavar="M1,M2[,M3]",
                    help="add a section on the Pareto front of these 2 or 3 metrics, each COL, COL:min (default) "
                    "or COL:max (e.g. torque_sq_integral,min_manipulability:max)")
@@ -275,11 +279,12 @@ def sensitivity_section(res, limit=MAX_SENSITIVITY_FIGURES):
     return "".join(parts)
 
 
-def importance_section(res, limit=MAX_IMPORTANCE_FIGURES):
+def importance_section(res, limit=MAX_IMPORTANCE_FIGURES, fit=True):
     """One bar chart per block that sweeps two or more parameters and is not a Saltelli design (those
     have Sobol' indices): each swept parameter's permutation importance in a random-forest fit of the
     kind's objective (kinesweep.importance), whiskers ± one std over the permutation repeats. Blocks
-    with too few good runs are named with the reason. Needs python3-sklearn: without it, a note."""
+    with too few good runs are named with the reason. Needs python3-sklearn: without it, a note.
+    fit=False: no fit, a caption naming those blocks and how to rank their parameters."""
     from kinesweep import importance as ksimp
     from kinesweep.sensitivity import designs
     saltelli = set(designs(res.f))
@@ -287,6 +292,12 @@ def importance_section(res, limit=MAX_IMPORTANCE_FIGURES):
     blocks = [b for b, ps in swept.items() if len(ps) >= 2]
     if not blocks:
         return ""
+    if not fit:
+        names = "; ".join(f"{esc(b)} ({esc(', '.join(swept[b]))})" for b in blocks)
+        return (f'<p class="caption" id="importance-not-fitted">Not fitted (a random forest per block, scikit-learn: '
+                f"a second or more each): the report's <code>--importance</code> option adds the permutation "
+                f"importance of the swept parameters of the blocks {names}; "
+                f"<code>python3 -m kinesweep.importance FILE</code> prints it.</p>")
     try:
         ksimp._sklearn()
     except ImportError as e:
@@ -332,8 +343,9 @@ def importance_section(res, limit=MAX_IMPORTANCE_FIGURES):
     return "".join(parts) + "".join(f'<p class="caption">{x}</p>' for x in notes)
 
 
-def build(path, best=5, max_cells=CELL_BUDGET, title=None, pareto=None):
-    """The page's html for one results file (`pareto`: the metrics of a Pareto section, or None)."""
+def build(path, best=5, max_cells=CELL_BUDGET, title=None, pareto=None, importance=False):
+    """The page's html for one results file (`pareto`: the metrics of a Pareto section, or None;
+    `importance`: fit the importance section's random forests, else name the blocks it would rank)."""
     with ksread.open_results(path) as res:
         view = RunsView(res)
         sections = [("study", "Study and file", metadata_section(res, view)),
@@ -355,7 +367,7 @@ def build(path, best=5, max_cells=CELL_BUDGET, title=None, pareto=None):
         sens = sensitivity_section(res)
         if sens:
             sections.append(("sensitivity", "Which parameter matters: Sobol' indices", sens))
-        imp = importance_section(res)
+        imp = importance_section(res, fit=importance)
         if imp:
             sections.append(("importance", "Which parameter matters: permutation importance", imp))
         front = pareto_section(res, pareto) if pareto and len([m for m in pareto.split(",") if m.strip()]) >= 2 else ""
@@ -381,7 +393,8 @@ def main(argv=None):
     args = parse_args(argv)
     out = args.output or os.path.splitext(args.file)[0] + "_report.html"
     try:
-        text = build(args.file, best=args.best, max_cells=args.max_cells, title=args.title, pareto=args.pareto)
+        text = build(args.file, best=args.best, max_cells=args.max_cells, title=args.title, pareto=args.pareto,
+                     importance=args.importance)
     except (FileNotFoundError, ksread.FormatVersionError, ValueError) as e:
         raise SystemExit(f"report: {e}")
     d = os.path.dirname(out)
