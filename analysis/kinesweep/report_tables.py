@@ -107,18 +107,26 @@ class RunsView:
         k = self.res.run_kinds()
         return k[0] if len(k) == 1 else ""
 
-    def ranked(self, block):
+    def ranked(self, block, limit=None):
         """The block's done rows of good status, best first by the kind's ranking (the file's /kinds:
         trajectory by E, IK by iterations then error); ties by run id. Returns (row indices, the
-        ranking metric names)."""
+        ranking metric names, how many rows the whole ranking has). limit: the first `limit` rows of
+        it only (sorted among the rows whose first key is at most the limit-th smallest: the same
+        rows, without sorting them all)."""
         meaning = self.res.kind_meaning(self.kind(block))
         keys = [k for k in meaning.get("ranking", []) if k in self.g]
         rows = self.rows(block)
         good = [i for i, s in enumerate(self.status_labels) if s in meaning.get("good_statuses", [])]
         rows = rows[np.isin(self.status_codes[rows], good)]
+        total = len(rows)
         cols = [rows] + [np.nan_to_num(np.asarray(self.values(k, rows), dtype=float), nan=np.inf)
                          for k in reversed(keys)]
-        return rows[np.lexsort(cols)], keys
+        if limit is not None and keys and total > limit:
+            first = cols[-1]
+            cut = np.partition(first, max(limit, 1) - 1)[max(limit, 1) - 1]
+            keep = first <= cut
+            cols = [c[keep] for c in cols]
+        return cols[0][np.lexsort(cols)][:limit], keys, total
 
 
 def metadata_section(res, view):
@@ -225,13 +233,12 @@ def shown_metrics(view, block, rows):
 def best_section(view, n_best):
     parts = []
     for b in view.block_names:
-        ranked, keys = view.ranked(b)
+        top, keys, n_ranked = view.ranked(b, limit=n_best)
         rows_done = view.rows(b)
         if not len(rows_done):
             continue
         kind = view.kind(b)
         good = "/".join(view.res.kind_meaning(kind).get("good_statuses", []))
-        top = ranked[:n_best]
         varying, fixed = varying_parameters(view, b, rows_done)
         metrics = shown_metrics(view, b, rows_done)
         columns = [("rank", ""), ("run_id", ""), ("status", "")] + [(c, view.units[c]) for c in varying] + \
@@ -245,7 +252,7 @@ def best_section(view, n_best):
         fixed_text = ", ".join(f"{c} = {v}{(' ' + view.units[c]) if view.units[c] not in ('', '1') else ''}"
                                for c, v in fixed_values if v not in ("", "–"))
         order = " then ".join(keys) if keys else "run id"
-        cap = (f"The {len(top)} best of the block's {len(ranked)} {good} runs ({len(rows_done)} done), "
+        cap = (f"The {len(top)} best of the block's {n_ranked} {good} runs ({len(rows_done)} done), "
                f"smallest {order} first. " if len(top) else f"No {good} run among the block's {len(rows_done)} "
                "done runs. ")
         if fixed_text:
