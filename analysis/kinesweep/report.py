@@ -138,6 +138,38 @@ def plotly_base64(js):
     return data
 
 
+DEBIAN_PLOTLY = "/usr/share/python3-plotly/plotly.js"  # what python3-plotly's get_plotlyjs() reads
+
+
+def plotly_page_js():
+    """(plotly_js() or None, plotly_base64 of it) for the page, which embeds the base64 only. With
+    Debian's bundle, that is read from the cache under the bundle's size and modification time (and
+    whether esbuild minifies it), without importing plotly or reading and hashing its 8.7 MB; else,
+    or the first time, through plotly_js and plotly_base64 (and then kept under that key)."""
+    import hashlib
+    import shutil
+    import tempfile
+    key = None
+    try:
+        st = os.stat(DEBIAN_PLOTLY)
+        key = hashlib.sha256(f"{DEBIAN_PLOTLY} {st.st_size} {st.st_mtime_ns} {shutil.which('esbuild')}"
+                             .encode("utf-8")).hexdigest()[:16]
+        with open(os.path.join(_cache_dir(), f"plotly-file-{key}.js.gz.b64"), encoding="ascii") as f:
+            return None, f.read()
+    except OSError:
+        pass
+    js = plotly_js()
+    data = plotly_base64(js)
+    if key:
+        try:
+            with tempfile.NamedTemporaryFile("w", encoding="ascii", dir=_cache_dir(), delete=False) as f:
+                f.write(data)
+            os.replace(f.name, os.path.join(_cache_dir(), f"plotly-file-{key}.js.gz.b64"))
+        except OSError:
+            pass
+    return js, data
+
+
 def grid_sections(res, cap_total):
     """The landscapes and basins sections' html ("" when none), and the blocks whose landscape has a
     dimension of sampled points (drawn as points in the sampled-runs section)."""
@@ -385,8 +417,8 @@ def build(path, best=5, max_cells=CELL_BUDGET, title=None, pareto=None, importan
         sub = (f"{esc(os.path.basename(path))}: {done} of {n} runs done, written by kinesweep "
                f"{esc(res.meta.get('engine_version', '?'))} on {esc(res.meta.get('created', '?'))}; "
                f"report made {now}. Angles in degrees.")
-        js = plotly_js()
-        return page(title or f"kinesweep report: {name}", sub, sections, js, plotly_base64(js))
+        js, data = plotly_page_js()
+        return page(title or f"kinesweep report: {name}", sub, sections, js, data)
 
 
 def main(argv=None):
