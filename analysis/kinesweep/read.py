@@ -33,6 +33,7 @@ import h5py
 import numpy as np
 
 from kinesweep import frame
+from kinesweep.chunks import one_value
 from kinesweep import history as kshistory
 from kinesweep import live as kslive
 from kinesweep import where as kswhere
@@ -57,7 +58,8 @@ THESIS_OPTIMA = {
 
 def _grid(d):
     """A landscape grid as float64: a grid of codes (integer, format 5) with -1 (no run) as NaN."""
-    v = np.array(d[()], dtype=float)
+    v = d[()]  # a new array: float64 grids are not copied again
+    v = v if v.dtype == np.float64 else v.astype(float)
     if d.dtype.kind in "iu":
         v[v == -1] = np.nan
     return v
@@ -380,6 +382,9 @@ class Results:
             return []
         d = self.f["runs"]["block"]
         labels = enum_labels(d)
+        if labels is not None and one_value(d):  # one block (its code in every row): no row decoded
+            c = int(d[0])
+            return [labels[c]] if c < len(labels) else []
         if labels is not None:  # in order of first appearance, as for strings
             codes = d[()]
             present, first = np.unique(codes, return_index=True)
@@ -439,16 +444,18 @@ class Results:
         runs are of one kind), that row read by index."""
         if "block" not in self._roles:
             return self.run_kinds()[0] if len(self.run_kinds()) == 1 else ""
-        d = self.f["runs"]["block"]
+        d, done = self.f["runs"]["block"], self.f["runs"]["done"]
         labels = enum_labels(d)
-        if labels is not None:
-            if block not in labels:
-                return ""
-            mine = d[()] == labels.index(block)
-        else:
-            mine = text_values(d) == block
-        rows = np.flatnonzero(mine & self.f["runs"]["done"][()].astype(bool))
-        return self.row_kinds(rows=rows[:1])[0] if len(rows) else ""
+        if labels is not None and block not in labels:
+            return ""
+        step = 1 << 16  # the first done row is looked for a slice at a time (usually in the first)
+        for a in range(0, d.shape[0], step):
+            codes = d[a:a + step]
+            mine = codes == labels.index(block) if labels is not None else text_values(d, codes) == block
+            rows = np.flatnonzero(mine & done[a:a + len(codes)].astype(bool))
+            if len(rows):
+                return self.row_kinds(rows=[a + int(rows[0])])[0]
+        return ""
 
 
     @kslive.consistent
