@@ -180,18 +180,27 @@ def reduce_grid(ls, args):
         g = np.transpose(g, order)
         return g.reshape((g.shape[0] if facet else 1,) + g.shape[(1 if facet else 0):(3 if facet else 2)] + (-1,))
 
-    status = arrange(ls.metrics["status_code"])
+    read = ls.metrics.read if hasattr(ls.metrics, "read") else ls.metrics.__getitem__  # grids not kept
+    status = arrange(read("status_code"))
     good = 0  # ok / converged
     if metric == "convergence":
-        z = np.nanmean(arrange(ls.metrics[ls.statuses[0]]), axis=3)
+        conv = arrange(read(ls.statuses[0]))
+        if conv.shape[3] == 1:  # one run per cell: its 1 / 0 (NaN: no run), as nanmean gives it
+            z = conv[..., 0]
+        else:
+            z = np.nanmean(conv, axis=3)
+        del conv
         cat = np.full(z.shape, -1, dtype=np.int8)
         if multi:
             notes.append(f"mean over {', '.join(multi)}")
         reduce = "mean" if multi else None
     else:
-        grid = ls.metrics.read(metric) if hasattr(ls.metrics, "read") else ls.metrics[metric]  # not kept
-        vals = np.where(status == good, arrange(grid), np.nan)
+        grid = read(metric)
+        vals = arrange(grid)
+        if np.shares_memory(vals, grid):  # arranged without a copy: the grid read may be a kept one
+            vals = vals.copy()
         del grid
+        vals[status != good] = np.nan  # the failed runs' values are not drawn (one grid, not a third)
         if vals.shape[3] == 1:  # nothing to reduce: the grid itself (no copy)
             z = vals[..., 0]
         else:
@@ -215,6 +224,12 @@ def reduce_grid(ls, args):
     fa = ls.axis(facet) if facet else None
     return {"metric": metric, "x": xa, "y": ya, "z": z, "cat": cat, "notes": notes, "reduce": reduce,
             "fixed": fixed, "facet": facet, "panel_labels": list(fa.labels) if fa else [None]}
+
+
+def nan_mean(z):
+    """np.nanmean(z) without its copy of z (the mean of the values that are not NaN)."""
+    keep = ~np.isnan(z)
+    return float(np.sum(z, where=keep) / np.count_nonzero(keep))
 
 
 def failed_category(status, none, good):
@@ -338,7 +353,7 @@ def main(argv=None):
         # Minimum (the mean for the convergence fraction).
         best = None
         if metric == "convergence" and has_values:
-            ax.plot([], [], ls="none", label=f"mean convergence fraction {np.nanmean(z):.0%}")
+            ax.plot([], [], ls="none", label=f"mean convergence fraction {nan_mean(z):.0%}")
         elif has_values:
             # nanargmin's first minimum, without its copy of the grid
             i, j = np.unravel_index(int(np.flatnonzero(z == np.nanmin(z))[0]), z.shape)

@@ -26,6 +26,8 @@ import math
 import os
 import sys
 
+import numpy as np
+
 from kinesweep import read as ksread  # noqa: E402
 from kinesweep.report_basins import basins_figure  # noqa: E402
 from kinesweep.report_grids import landscape_figure  # noqa: E402
@@ -311,12 +313,20 @@ def sensitivity_section(res, limit=MAX_SENSITIVITY_FIGURES):
     return "".join(parts)
 
 
-def importance_section(res, limit=MAX_IMPORTANCE_FIGURES, fit=True):
+def _good_runs(view, block):
+    """How many of the block's done runs have a good status (ok / converged)."""
+    good = view.res.kind_meaning(view.kind(block)).get("good_statuses", [])
+    codes = [i for i, s in enumerate(view.status_labels) if s in good]
+    return int(np.isin(view.status_codes[view.rows(block)], codes).sum())
+
+
+def importance_section(res, limit=MAX_IMPORTANCE_FIGURES, fit=True, view=None):
     """One bar chart per block that sweeps two or more parameters and is not a Saltelli design (those
     have Sobol' indices): each swept parameter's permutation importance in a random-forest fit of the
     kind's objective (kinesweep.importance), whiskers ± one std over the permutation repeats. Blocks
     with too few good runs are named with the reason. Needs python3-sklearn: without it, a note.
-    fit=False: no fit, a caption naming those blocks and how to rank their parameters."""
+    fit=False: no fit, a caption naming those of them with enough good runs (counted in `view`, a
+    RunsView) and how to rank their parameters."""
     from kinesweep import importance as ksimp
     from kinesweep.sensitivity import designs
     saltelli = set(designs(res.f))
@@ -325,10 +335,13 @@ def importance_section(res, limit=MAX_IMPORTANCE_FIGURES, fit=True):
     if not blocks:
         return ""
     if not fit:
+        blocks = [b for b in blocks if _good_runs(view, b) >= ksimp.MIN_RUNS] if view is not None else blocks
+        if not blocks:
+            return ""
         names = "; ".join(f"{esc(b)} ({esc(', '.join(swept[b]))})" for b in blocks)
         return (f'<p class="caption" id="importance-not-fitted">Not fitted (a random forest per block, scikit-learn: '
                 f"a second or more each): the report's <code>--importance</code> option adds the permutation "
-                f"importance of the swept parameters of the blocks {names}; "
+                f"importance of the swept parameters of the blocks with at least {ksimp.MIN_RUNS} good runs: {names}; "
                 f"<code>python3 -m kinesweep.importance FILE</code> prints it.</p>")
     try:
         ksimp._sklearn()
@@ -399,7 +412,7 @@ def build(path, best=5, max_cells=CELL_BUDGET, title=None, pareto=None, importan
         sens = sensitivity_section(res)
         if sens:
             sections.append(("sensitivity", "Which parameter matters: Sobol' indices", sens))
-        imp = importance_section(res, fit=importance)
+        imp = importance_section(res, fit=importance, view=view)
         if imp:
             sections.append(("importance", "Which parameter matters: permutation importance", imp))
         front = pareto_section(res, pareto) if pareto and len([m for m in pareto.split(",") if m.strip()]) >= 2 else ""
