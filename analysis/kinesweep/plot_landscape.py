@@ -232,6 +232,14 @@ def nan_mean(z):
     return float(np.sum(z, where=keep) / np.count_nonzero(keep))
 
 
+def small_codes(v):
+    """np.unique(v).astype(int) of status codes (small integers): counted, not sorted."""
+    iv = v.astype(np.int64)
+    if iv.size and (iv.min() < 0 or iv.max() > 1 << 16 or np.any(iv != v)):  # not codes: sorted after all
+        return np.unique(v).astype(int)
+    return np.flatnonzero(np.bincount(iv))
+
+
 def failed_category(status, none, good):
     """Per cell (panels x ny x nx) of `status` (same x cells reduced): -1 where `none` is false (the
     cell has a value), else the most common failed status of its runs (the smallest code on a tie),
@@ -240,7 +248,7 @@ def failed_category(status, none, good):
     if not none.any():
         return cat
     st = status[none]  # cells without a value x their runs
-    codes = np.unique(st[np.isfinite(st) & (st != good)]).astype(int)
+    codes = small_codes(st[np.isfinite(st) & (st != good)])
     if codes.size == 0:
         cat[none] = -2
         return cat
@@ -335,7 +343,7 @@ def main(argv=None):
         mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(z[::step, ::step]), cmap=cmap, norm=norm, shading="flat")
         # Failed cells in their own colours.
         handles = []
-        present = np.unique(cat[cat >= 0]).tolist()
+        present = small_codes(cat[cat >= 0]).tolist()
         if present or (cat == -2).any():
             colours = ["#ffffff"] * (len(statuses) + 1)
             for s in present:
