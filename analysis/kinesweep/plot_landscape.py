@@ -247,6 +247,12 @@ def failed_category(status, none, good):
     cat = np.full(none.shape, -1, dtype=np.int8)  # status codes are small
     if not none.any():
         return cat
+    if status.shape[-1] == 1:  # one run per cell: its own status when that is a failed one, else no run
+        s = status[..., 0]
+        failed = none & np.isfinite(s) & (s != good)
+        cat[failed] = s[failed]
+        cat[none & ~failed] = -2
+        return cat
     st = status[none]  # cells without a value x their runs
     codes = small_codes(st[np.isfinite(st) & (st != good)])
     if codes.size == 0:
