@@ -21,7 +21,6 @@ import numpy as np
 
 from kinesweep import plotting as ksplot  # noqa: E402
 from kinesweep import read as ksread  # noqa: E402
-from kinesweep.report_grids import ordinal  # noqa: E402
 
 MAX_PANELS = 6  # small multiples: at most this many panels, one per value of a categorical dim
 STATUS_COLOURS = ksread.STATUS_COLOURS
@@ -321,6 +320,7 @@ def main(argv=None):
     dx, dy = xv[::step], yv[::step]
     X, Y = np.meshgrid(ksplot.cell_edges(dx, xlog), ksplot.cell_edges(dy, ylog))
     if step > 1:
+        from kinesweep.report_grids import ordinal  # (the report's modules are not otherwise needed)
         d["notes"].append(f"every {ordinal(step)} cell of {len(yv)} × {len(xv)} drawn")
     any_finite = bool(np.isfinite(Z).any())  # one colour scale for every panel
     vmin = args.vmin if args.vmin is not None else (np.nanmin(Z) if any_finite else 0.0)
