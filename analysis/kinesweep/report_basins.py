@@ -28,15 +28,22 @@ def final_iterates(res, block):
     units = [("mm" if scara else "rad") if stored[c].startswith("rad or") else stored[c] for c in qcols]
     contiguous = len(rows) and rows[-1] - rows[0] + 1 == len(rows)
 
-    def column(c):
+    q = np.zeros((len(rows), len(qcols)))
+    for j, c in enumerate(qcols if len(rows) else []):  # filled a column at a time (no second copy)
         d = g[c]
-        return d[int(rows[0]):int(rows[-1]) + 1] if contiguous else d[()][rows]
-
-    q = np.column_stack([column(c) for c in qcols]) if qcols and len(rows) else np.zeros((len(rows), len(qcols)))
+        q[:, j] = d[int(rows[0]):int(rows[-1]) + 1] if contiguous else d[()][rows]
     conv = done[rows] & _is_one_of(g["status"], res.kind_meaning("ik")["good_statuses"])[rows]
-    q = q.astype(float)
     q[~conv] = np.nan
     return rows, q, qcols, units
+
+
+def _codes_present(v):
+    """sorted({int(c) for c in v}) of status codes (small non-negative numbers): counted, not a set
+    built a row at a time."""
+    iv = v.astype(np.int64)
+    if iv.size and (iv.min() < 0 or iv.max() > 1 << 16):
+        return sorted({int(c) for c in iv})
+    return np.flatnonzero(np.bincount(iv)).tolist()
 
 
 def _is_one_of(d, values):
@@ -110,7 +117,7 @@ def basins_figure(res, ls, cap):
     status = ls.metrics["status_code"]
     statuses = ls.statuses
     flat_status = status.reshape(-1)
-    failed = sorted({int(c) for c in flat_status[np.isfinite(flat_status) & (flat_status != 0)]})
+    failed = _codes_present(flat_status[np.isfinite(flat_status) & (flat_status != 0)])
     for c in failed:
         code[flat_status == c] = len(classes)
         classes.append(statuses[c])

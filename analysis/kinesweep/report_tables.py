@@ -119,14 +119,17 @@ class RunsView:
         good = [i for i, s in enumerate(self.status_labels) if s in meaning.get("good_statuses", [])]
         rows = rows[np.isin(self.status_codes[rows], good)]
         total = len(rows)
-        cols = [rows] + [np.nan_to_num(np.asarray(self.values(k, rows), dtype=float), nan=np.inf)
-                         for k in reversed(keys)]
+
+        def key(k, rows):
+            return np.nan_to_num(np.asarray(self.values(k, rows), dtype=float), nan=np.inf)
+
+        first = key(keys[0], rows) if keys else None
         if limit is not None and keys and total > limit:
-            first = cols[-1]
             cut = np.partition(first, max(limit, 1) - 1)[max(limit, 1) - 1]
             keep = first <= cut
-            cols = [c[keep] for c in cols]
-        return cols[0][np.lexsort(cols)][:limit], keys, total
+            rows, first = rows[keep], first[keep]  # the other keys are read for these rows only
+        cols = [rows] + [key(k, rows) for k in reversed(keys[1:])] + ([first] if keys else [])
+        return rows[np.lexsort(cols)][:limit], keys, total
 
 
 def metadata_section(res, view):
