@@ -194,10 +194,8 @@ def reduce_grid(ls, args):
             notes.append(f"mean over {', '.join(multi)}")
         reduce = "mean" if multi else None
     else:
-        grid = read(metric)
-        vals = arrange(grid)
-        if np.shares_memory(vals, grid):  # arranged without a copy: the grid read may be a kept one
-            vals = vals.copy()
+        grid = ls.metrics.fresh(metric) if hasattr(ls.metrics, "fresh") else np.array(ls.metrics[metric])
+        vals = arrange(grid)  # (a view of this new grid, or a copy)
         del grid
         vals[status != good] = np.nan  # the failed runs' values are not drawn (one grid, not a third)
         if vals.shape[3] == 1:  # nothing to reduce: the grid itself (no copy)

@@ -86,6 +86,15 @@ class _Grids(Mapping):
             raise KeyError(name)
         return self._grids[name] if name in self._grids else self._read(name)
 
+    def fresh(self, name):
+        """The grid `name` read from the file again: a new array the caller may change."""
+        if name not in self._names:
+            raise KeyError(name)
+        return self._read(name)
+
+    def __contains__(self, name):  # by name (Mapping's would read the grid and keep it)
+        return name in self._names
+
     def __iter__(self):
         return iter(self._names)
 
