@@ -27,8 +27,11 @@ class RunsView:
         self.units = {c: ("deg" if u == "rad" else u) for c, u in res.units().items()}
         self.block_codes, self.block_labels = self._codes("block")
         self.status_codes, self.status_labels = self._codes("status")
-        order = np.unique(self.block_codes, return_index=True)
-        self.block_names = [self.block_labels[c] for c in order[0][np.argsort(order[1])]]
+        if self.n and "block" in self.g and one_value(self.g["block"]):  # one code in every row: not sorted
+            self.block_names = [self.block_labels[int(self.block_codes[0])]]
+        else:
+            order = np.unique(self.block_codes, return_index=True)
+            self.block_names = [self.block_labels[c] for c in order[0][np.argsort(order[1])]]
 
     def _codes(self, c):
         """A text column as (codes per row, labels by code): its enum codes (format 4, the missing value
