@@ -27,7 +27,6 @@ in version 4 the text columns with few distinct values are HDF5 enums (read here
 values, and by to_pandas() as pandas categoricals).
 """
 import os
-from collections.abc import Mapping
 
 import h5py
 import numpy as np
@@ -43,6 +42,7 @@ from kinesweep.kinds import FormatVersionError  # noqa: F401 (the same)
 from kinesweep.kinds import (GOOD_STATUSES, IK_STATUSES, KIND_MEANING, METRIC_LABELS, OTHER_SOLUTION_COLOUR,  # noqa: F401
                              STATUS_COLOURS, THESIS_TABLE4, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s,
                              axis_dataset_name, display_name, enum_labels, text_values)
+from kinesweep.kinds import _grid, _Grids  # noqa: F401 (a landscape's grids, read when asked for)
 
 RAD2DEG = 180.0 / np.pi
 FORMAT_VERSIONS = (2, 3, 4, 5)  # the results formats this module reads (engine/store/FORMAT.md)
@@ -54,52 +54,6 @@ THESIS_OPTIMA = {
     "local_weighted": {"global": "1h", "partial": ["1d", "1f", "1g"]},
     "local_unweighted": {"global": "2h", "partial": ["2d", "2f", "2g"]},
 }
-
-
-def _grid(d):
-    """A landscape grid as float64: a grid of codes (integer, format 5) with -1 (no run) as NaN."""
-    v = d[()]  # a new array: float64 grids are not copied again
-    v = v if v.dtype == np.float64 else v.astype(float)
-    if d.dtype.kind in "iu":
-        v[v == -1] = np.nan
-    return v
-
-class _Grids(Mapping):
-    """A landscape's metric grids by name, each read from the file when first asked for (a
-    3163 x 3163 landscape's 14 grids are 1.1 GB; a plot reads one or two), so while the Results
-    that made it is open (read_landscape() reads them all)."""
-
-    def __init__(self, names, read):
-        self._names, self._read, self._grids = list(names), read, {}
-
-    def __getitem__(self, name):
-        if name not in self._names:
-            raise KeyError(name)
-        if name not in self._grids:
-            self._grids[name] = self._read(name)
-        return self._grids[name]
-
-    def read(self, name):
-        """The grid `name` without keeping it (the kept one when it was read before): for a caller
-        that goes through every grid once and keeps less than all of them."""
-        if name not in self._names:
-            raise KeyError(name)
-        return self._grids[name] if name in self._grids else self._read(name)
-
-    def fresh(self, name):
-        """The grid `name` read from the file again: a new array the caller may change."""
-        if name not in self._names:
-            raise KeyError(name)
-        return self._read(name)
-
-    def __contains__(self, name):  # by name (Mapping's would read the grid and keep it)
-        return name in self._names
-
-    def __iter__(self):
-        return iter(self._names)
-
-    def __len__(self):
-        return len(self._names)
 
 
 class Results:
