@@ -185,7 +185,10 @@ def _take(d, rows):
 def _varies_in(d, sel):
     """Whether dataset `d` takes more than one value over the rows `sel` (NaN is no value; a labelled
     text column compares its codes), read CHUNK rows at a time."""
+    from kinesweep.chunks import one_value
     from kinesweep.kinds import enum_labels
+    if one_value(d):  # one value in every row of the file: in the rows `sel` too
+        return False
     if enum_labels(d) is None and d.dtype.kind not in "fiub":
         return _varies(text_values_of(d)[sel])
     seen = None

@@ -3,6 +3,8 @@ block's gridded metrics), with their conversions to pandas and xarray (each an o
 imported when asked for), and FormatVersionError (a file of a format_version the readers do not read).
 Run with Debian's interpreter: /usr/bin/python3.
 """
+from collections.abc import Mapping
+
 import numpy as np
 
 TRAJECTORY_STATUSES = ["ok", "unreachable_start", "singular", "diverged", "undersampled", "off_path",
@@ -240,3 +242,49 @@ class Landscape:
         data = {m: (dims, v, {"units": self.units.get(m, ""), "long_name": self.descriptions.get(m, "")})
                 for m, v in self.metrics.items()}
         return xr.Dataset(data, coords=coords, attrs={"block": self.block, "kind": self.kind})
+
+
+def _grid(d):
+    """A landscape grid as float64: a grid of codes (integer, format 5) with -1 (no run) as NaN."""
+    v = d[()]  # a new array: float64 grids are not copied again
+    v = v if v.dtype == np.float64 else v.astype(float)
+    if d.dtype.kind in "iu":
+        v[v == -1] = np.nan
+    return v
+
+class _Grids(Mapping):
+    """A landscape's metric grids by name, each read from the file when first asked for (a
+    3163 x 3163 landscape's 14 grids are 1.1 GB; a plot reads one or two), so while the Results
+    that made it is open (read_landscape() reads them all)."""
+
+    def __init__(self, names, read):
+        self._names, self._read, self._grids = list(names), read, {}
+
+    def __getitem__(self, name):
+        if name not in self._names:
+            raise KeyError(name)
+        if name not in self._grids:
+            self._grids[name] = self._read(name)
+        return self._grids[name]
+
+    def read(self, name):
+        """The grid `name` without keeping it (the kept one when it was read before): for a caller
+        that goes through every grid once and keeps less than all of them."""
+        if name not in self._names:
+            raise KeyError(name)
+        return self._grids[name] if name in self._grids else self._read(name)
+
+    def fresh(self, name):
+        """The grid `name` read from the file again: a new array the caller may change."""
+        if name not in self._names:
+            raise KeyError(name)
+        return self._read(name)
+
+    def __contains__(self, name):  # by name (Mapping's would read the grid and keep it)
+        return name in self._names
+
+    def __iter__(self):
+        return iter(self._names)
+
+    def __len__(self):
+        return len(self._names)

@@ -21,7 +21,6 @@ import numpy as np
 
 from kinesweep import plotting as ksplot  # noqa: E402
 from kinesweep import read as ksread  # noqa: E402
-from kinesweep.report_grids import ordinal  # noqa: E402
 
 MAX_PANELS = 6  # small multiples: at most this many panels, one per value of a categorical dim
 STATUS_COLOURS = ksread.STATUS_COLOURS
@@ -180,18 +179,25 @@ def reduce_grid(ls, args):
         g = np.transpose(g, order)
         return g.reshape((g.shape[0] if facet else 1,) + g.shape[(1 if facet else 0):(3 if facet else 2)] + (-1,))
 
-    status = arrange(ls.metrics["status_code"])
+    read = ls.metrics.read if hasattr(ls.metrics, "read") else ls.metrics.__getitem__  # grids not kept
+    status = arrange(read("status_code"))
     good = 0  # ok / converged
     if metric == "convergence":
-        z = np.nanmean(arrange(ls.metrics[ls.statuses[0]]), axis=3)
+        conv = arrange(read(ls.statuses[0]))
+        if conv.shape[3] == 1:  # one run per cell: its 1 / 0 (NaN: no run), as nanmean gives it
+            z = conv[..., 0]
+        else:
+            z = np.nanmean(conv, axis=3)
+        del conv
         cat = np.full(z.shape, -1, dtype=np.int8)
         if multi:
             notes.append(f"mean over {', '.join(multi)}")
         reduce = "mean" if multi else None
     else:
-        grid = ls.metrics.read(metric) if hasattr(ls.metrics, "read") else ls.metrics[metric]  # not kept
-        vals = np.where(status == good, arrange(grid), np.nan)
+        grid = ls.metrics.fresh(metric) if hasattr(ls.metrics, "fresh") else np.array(ls.metrics[metric])
+        vals = arrange(grid)  # (a view of this new grid, or a copy)
         del grid
+        vals[status != good] = np.nan  # the failed runs' values are not drawn (one grid, not a third)
         if vals.shape[3] == 1:  # nothing to reduce: the grid itself (no copy)
             z = vals[..., 0]
         else:
@@ -217,6 +223,20 @@ def reduce_grid(ls, args):
             "fixed": fixed, "facet": facet, "panel_labels": list(fa.labels) if fa else [None]}
 
 
+def nan_mean(z):
+    """np.nanmean(z) without its copy of z (the mean of the values that are not NaN)."""
+    keep = ~np.isnan(z)
+    return float(np.sum(z, where=keep) / np.count_nonzero(keep))
+
+
+def small_codes(v):
+    """np.unique(v).astype(int) of status codes (small integers): counted, not sorted."""
+    iv = v.astype(np.int64)
+    if iv.size and (iv.min() < 0 or iv.max() > 1 << 16 or np.any(iv != v)):  # not codes: sorted after all
+        return np.unique(v).astype(int)
+    return np.flatnonzero(np.bincount(iv))
+
+
 def failed_category(status, none, good):
     """Per cell (panels x ny x nx) of `status` (same x cells reduced): -1 where `none` is false (the
     cell has a value), else the most common failed status of its runs (the smallest code on a tie),
@@ -224,8 +244,14 @@ def failed_category(status, none, good):
     cat = np.full(none.shape, -1, dtype=np.int8)  # status codes are small
     if not none.any():
         return cat
+    if status.shape[-1] == 1:  # one run per cell: its own status when that is a failed one, else no run
+        s = status[..., 0]
+        failed = none & np.isfinite(s) & (s != good)
+        cat[failed] = s[failed]
+        cat[none & ~failed] = -2
+        return cat
     st = status[none]  # cells without a value x their runs
-    codes = np.unique(st[np.isfinite(st) & (st != good)]).astype(int)
+    codes = small_codes(st[np.isfinite(st) & (st != good)])
     if codes.size == 0:
         cat[none] = -2
         return cat
@@ -272,15 +298,16 @@ def main(argv=None):
     xlog = not xa.categorical and ksplot.is_log_spaced(xa.values)
     ylog = not ya.categorical and ksplot.is_log_spaced(ya.values)
 
-    plt, size = ksplot.figure(args)
+    size = ksplot.figure_size(args)
+    from matplotlib import colormaps
     from matplotlib.colors import ListedColormap, LogNorm, Normalize
     from matplotlib import patheffects
     from matplotlib.patches import Patch
     n = Z.shape[0]
     ncols = min(n, 3)
     nrows = -(-n // ncols)
-    fig, axs = plt.subplots(nrows, ncols, figsize=size, constrained_layout=True, squeeze=False,
-                            sharex=True, sharey=True)
+    fig = ksplot.agg_figure(size, constrained_layout=True)
+    axs = fig.subplots(nrows, ncols, squeeze=False, sharex=True, sharey=True)
     for k in range(n, nrows * ncols):
         axs.flat[k].set_visible(False)
     xv = np.arange(len(xa.values)) if xa.categorical else xa.values
@@ -291,6 +318,7 @@ def main(argv=None):
     dx, dy = xv[::step], yv[::step]
     X, Y = np.meshgrid(ksplot.cell_edges(dx, xlog), ksplot.cell_edges(dy, ylog))
     if step > 1:
+        from kinesweep.report_grids import ordinal  # (the report's modules are not otherwise needed)
         d["notes"].append(f"every {ordinal(step)} cell of {len(yv)} × {len(xv)} drawn")
     any_finite = bool(np.isfinite(Z).any())  # one colour scale for every panel
     vmin = args.vmin if args.vmin is not None else (np.nanmin(Z) if any_finite else 0.0)
@@ -303,7 +331,7 @@ def main(argv=None):
         norm = LogNorm(vmin=vmin, vmax=max(vmax, vmin * 1.0001))
     else:
         norm = Normalize(vmin=vmin, vmax=vmax if vmax > vmin else vmin + 1)
-    cmap = plt.get_cmap("viridis").copy()
+    cmap = colormaps["viridis"].copy()
     cmap.set_bad((0, 0, 0, 0))
     levels = []
     if args.levels > 0 and any_finite and len(xv) > 2 and len(yv) > 2 and metric != "convergence":
@@ -319,7 +347,7 @@ def main(argv=None):
         mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(z[::step, ::step]), cmap=cmap, norm=norm, shading="flat")
         # Failed cells in their own colours.
         handles = []
-        present = np.unique(cat[cat >= 0]).tolist()
+        present = small_codes(cat[cat >= 0]).tolist()
         if present or (cat == -2).any():
             colours = ["#ffffff"] * (len(statuses) + 1)
             for s in present:
@@ -337,7 +365,7 @@ def main(argv=None):
         # Minimum (the mean for the convergence fraction).
         best = None
         if metric == "convergence" and has_values:
-            ax.plot([], [], ls="none", label=f"mean convergence fraction {np.nanmean(z):.0%}")
+            ax.plot([], [], ls="none", label=f"mean convergence fraction {nan_mean(z):.0%}")
         elif has_values:
             # nanargmin's first minimum, without its copy of the grid
             i, j = np.unravel_index(int(np.flatnonzero(z == np.nanmin(z))[0]), z.shape)

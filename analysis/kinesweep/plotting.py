@@ -21,11 +21,26 @@ def figure(args):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    return plt, figure_size(args)
+
+
+def figure_size(args):
+    """--size in inches at --dpi."""
     try:
         w, h = (int(x) for x in args.size.lower().split("x"))
     except ValueError:
         raise SystemExit(f"--size {args.size!r}: expected WxH in pixels, e.g. 800x600")
-    return plt, (w / args.dpi, h / args.dpi)
+    return w / args.dpi, h / args.dpi
+
+
+def agg_figure(size, **kw):
+    """A matplotlib Figure on an Agg canvas, without pyplot (whose import and figure manager a
+    script that saves one picture does not need): Figure(figsize=size, **kw)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=size, **kw)
+    FigureCanvasAgg(fig)
+    return fig
 
 
 def output_path(args, suffix):

@@ -27,12 +27,12 @@ in version 4 the text columns with few distinct values are HDF5 enums (read here
 values, and by to_pandas() as pandas categoricals).
 """
 import os
-from collections.abc import Mapping
 
 import h5py
 import numpy as np
 
 from kinesweep import frame
+from kinesweep.chunks import one_value
 from kinesweep import history as kshistory
 from kinesweep import live as kslive
 from kinesweep import where as kswhere
@@ -42,6 +42,7 @@ from kinesweep.kinds import FormatVersionError  # noqa: F401 (the same)
 from kinesweep.kinds import (GOOD_STATUSES, IK_STATUSES, KIND_MEANING, METRIC_LABELS, OTHER_SOLUTION_COLOUR,  # noqa: F401
                              STATUS_COLOURS, THESIS_TABLE4, TRAJECTORY_STATUSES, Axis, Landscape, Table, _s,
                              axis_dataset_name, display_name, enum_labels, text_values)
+from kinesweep.kinds import _grid, _Grids  # noqa: F401 (a landscape's grids, read when asked for)
 
 RAD2DEG = 180.0 / np.pi
 FORMAT_VERSIONS = (2, 3, 4, 5)  # the results formats this module reads (engine/store/FORMAT.md)
@@ -53,42 +54,6 @@ THESIS_OPTIMA = {
     "local_weighted": {"global": "1h", "partial": ["1d", "1f", "1g"]},
     "local_unweighted": {"global": "2h", "partial": ["2d", "2f", "2g"]},
 }
-
-
-def _grid(d):
-    """A landscape grid as float64: a grid of codes (integer, format 5) with -1 (no run) as NaN."""
-    v = np.array(d[()], dtype=float)
-    if d.dtype.kind in "iu":
-        v[v == -1] = np.nan
-    return v
-
-class _Grids(Mapping):
-    """A landscape's metric grids by name, each read from the file when first asked for (a
-    3163 x 3163 landscape's 14 grids are 1.1 GB; a plot reads one or two), so while the Results
-    that made it is open (read_landscape() reads them all)."""
-
-    def __init__(self, names, read):
-        self._names, self._read, self._grids = list(names), read, {}
-
-    def __getitem__(self, name):
-        if name not in self._names:
-            raise KeyError(name)
-        if name not in self._grids:
-            self._grids[name] = self._read(name)
-        return self._grids[name]
-
-    def read(self, name):
-        """The grid `name` without keeping it (the kept one when it was read before): for a caller
-        that goes through every grid once and keeps less than all of them."""
-        if name not in self._names:
-            raise KeyError(name)
-        return self._grids[name] if name in self._grids else self._read(name)
-
-    def __iter__(self):
-        return iter(self._names)
-
-    def __len__(self):
-        return len(self._names)
 
 
 class Results:
@@ -380,6 +345,9 @@ class Results:
             return []
         d = self.f["runs"]["block"]
         labels = enum_labels(d)
+        if labels is not None and one_value(d):  # one block (its code in every row): no row decoded
+            c = int(d[0])
+            return [labels[c]] if c < len(labels) else []
         if labels is not None:  # in order of first appearance, as for strings
             codes = d[()]
             present, first = np.unique(codes, return_index=True)
@@ -439,16 +407,18 @@ class Results:
         runs are of one kind), that row read by index."""
         if "block" not in self._roles:
             return self.run_kinds()[0] if len(self.run_kinds()) == 1 else ""
-        d = self.f["runs"]["block"]
+        d, done = self.f["runs"]["block"], self.f["runs"]["done"]
         labels = enum_labels(d)
-        if labels is not None:
-            if block not in labels:
-                return ""
-            mine = d[()] == labels.index(block)
-        else:
-            mine = text_values(d) == block
-        rows = np.flatnonzero(mine & self.f["runs"]["done"][()].astype(bool))
-        return self.row_kinds(rows=rows[:1])[0] if len(rows) else ""
+        if labels is not None and block not in labels:
+            return ""
+        step = 1 << 16  # the first done row is looked for a slice at a time (usually in the first)
+        for a in range(0, d.shape[0], step):
+            codes = d[a:a + step]
+            mine = codes == labels.index(block) if labels is not None else text_values(d, codes) == block
+            rows = np.flatnonzero(mine & done[a:a + len(codes)].astype(bool))
+            if len(rows):
+                return self.row_kinds(rows=[a + int(rows[0])])[0]
+        return ""
 
 
     @kslive.consistent

@@ -26,6 +26,8 @@ import math
 import os
 import sys
 
+import numpy as np
+
 from kinesweep import read as ksread  # noqa: E402
 from kinesweep.report_basins import basins_figure  # noqa: E402
 from kinesweep.report_grids import landscape_figure  # noqa: E402
@@ -53,6 +55,10 @@ def parse_args(argv=None):
                    help="heatmap cells drawn over all grid figures (default %(default)s; bigger grids are "
                         "subsampled and the caption says so)")
     p.add_argument("--title", help="page title (default: the study's name)")
+    p.add_argument("--importance", action="store_true",
+                   help="fit the permutation importance of the swept parameters of each block that sweeps two or more "
+                   "(a random forest per block, scikit-learn: a second or more each); without it the importance "
+                   "section only names those blocks")
     p.add_argument("--pareto", metavar="M1,M2[,M3]",
                    help="add a section on the Pareto front of these 2 or 3 metrics, each COL, COL:min (default) "
                    "or COL:max (e.g. torque_sq_integral,min_manipulability:max)")
@@ -132,6 +138,38 @@ def plotly_base64(js):
     except OSError:
         pass
     return data
+
+
+DEBIAN_PLOTLY = "/usr/share/python3-plotly/plotly.js"  # what python3-plotly's get_plotlyjs() reads
+
+
+def plotly_page_js():
+    """(plotly_js() or None, plotly_base64 of it) for the page, which embeds the base64 only. With
+    Debian's bundle, that is read from the cache under the bundle's size and modification time (and
+    whether esbuild minifies it), without importing plotly or reading and hashing its 8.7 MB; else,
+    or the first time, through plotly_js and plotly_base64 (and then kept under that key)."""
+    import hashlib
+    import shutil
+    import tempfile
+    key = None
+    try:
+        st = os.stat(DEBIAN_PLOTLY)
+        key = hashlib.sha256(f"{DEBIAN_PLOTLY} {st.st_size} {st.st_mtime_ns} {shutil.which('esbuild')}"
+                             .encode("utf-8")).hexdigest()[:16]
+        with open(os.path.join(_cache_dir(), f"plotly-file-{key}.js.gz.b64"), encoding="ascii") as f:
+            return None, f.read()
+    except OSError:
+        pass
+    js = plotly_js()
+    data = plotly_base64(js)
+    if key:
+        try:
+            with tempfile.NamedTemporaryFile("w", encoding="ascii", dir=_cache_dir(), delete=False) as f:
+                f.write(data)
+            os.replace(f.name, os.path.join(_cache_dir(), f"plotly-file-{key}.js.gz.b64"))
+        except OSError:
+            pass
+    return js, data
 
 
 def grid_sections(res, cap_total):
@@ -275,11 +313,20 @@ def sensitivity_section(res, limit=MAX_SENSITIVITY_FIGURES):
     return "".join(parts)
 
 
-def importance_section(res, limit=MAX_IMPORTANCE_FIGURES):
+def _good_runs(view, block):
+    """How many of the block's done runs have a good status (ok / converged)."""
+    good = view.res.kind_meaning(view.kind(block)).get("good_statuses", [])
+    codes = [i for i, s in enumerate(view.status_labels) if s in good]
+    return int(np.isin(view.status_codes[view.rows(block)], codes).sum())
+
+
+def importance_section(res, limit=MAX_IMPORTANCE_FIGURES, fit=True, view=None):
     """One bar chart per block that sweeps two or more parameters and is not a Saltelli design (those
     have Sobol' indices): each swept parameter's permutation importance in a random-forest fit of the
     kind's objective (kinesweep.importance), whiskers ± one std over the permutation repeats. Blocks
-    with too few good runs are named with the reason. Needs python3-sklearn: without it, a note."""
+    with too few good runs are named with the reason. Needs python3-sklearn: without it, a note.
+    fit=False: no fit, a caption naming those of them with enough good runs (counted in `view`, a
+    RunsView) and how to rank their parameters."""
     from kinesweep import importance as ksimp
     from kinesweep.sensitivity import designs
     saltelli = set(designs(res.f))
@@ -287,6 +334,15 @@ def importance_section(res, limit=MAX_IMPORTANCE_FIGURES):
     blocks = [b for b, ps in swept.items() if len(ps) >= 2]
     if not blocks:
         return ""
+    if not fit:
+        blocks = [b for b in blocks if _good_runs(view, b) >= ksimp.MIN_RUNS] if view is not None else blocks
+        if not blocks:
+            return ""
+        names = "; ".join(f"{esc(b)} ({esc(', '.join(swept[b]))})" for b in blocks)
+        return (f'<p class="caption" id="importance-not-fitted">Not fitted (a random forest per block, scikit-learn: '
+                f"a second or more each): the report's <code>--importance</code> option adds the permutation "
+                f"importance of the swept parameters of the blocks with at least {ksimp.MIN_RUNS} good runs: {names}; "
+                f"<code>python3 -m kinesweep.importance FILE</code> prints it.</p>")
     try:
         ksimp._sklearn()
     except ImportError as e:
@@ -332,8 +388,9 @@ def importance_section(res, limit=MAX_IMPORTANCE_FIGURES):
     return "".join(parts) + "".join(f'<p class="caption">{x}</p>' for x in notes)
 
 
-def build(path, best=5, max_cells=CELL_BUDGET, title=None, pareto=None):
-    """The page's html for one results file (`pareto`: the metrics of a Pareto section, or None)."""
+def build(path, best=5, max_cells=CELL_BUDGET, title=None, pareto=None, importance=False):
+    """The page's html for one results file (`pareto`: the metrics of a Pareto section, or None;
+    `importance`: fit the importance section's random forests, else name the blocks it would rank)."""
     with ksread.open_results(path) as res:
         view = RunsView(res)
         sections = [("study", "Study and file", metadata_section(res, view)),
@@ -355,7 +412,7 @@ def build(path, best=5, max_cells=CELL_BUDGET, title=None, pareto=None):
         sens = sensitivity_section(res)
         if sens:
             sections.append(("sensitivity", "Which parameter matters: Sobol' indices", sens))
-        imp = importance_section(res)
+        imp = importance_section(res, fit=importance, view=view)
         if imp:
             sections.append(("importance", "Which parameter matters: permutation importance", imp))
         front = pareto_section(res, pareto) if pareto and len([m for m in pareto.split(",") if m.strip()]) >= 2 else ""
@@ -373,15 +430,16 @@ def build(path, best=5, max_cells=CELL_BUDGET, title=None, pareto=None):
         sub = (f"{esc(os.path.basename(path))}: {done} of {n} runs done, written by kinesweep "
                f"{esc(res.meta.get('engine_version', '?'))} on {esc(res.meta.get('created', '?'))}; "
                f"report made {now}. Angles in degrees.")
-        js = plotly_js()
-        return page(title or f"kinesweep report: {name}", sub, sections, js, plotly_base64(js))
+        js, data = plotly_page_js()
+        return page(title or f"kinesweep report: {name}", sub, sections, js, data)
 
 
 def main(argv=None):
     args = parse_args(argv)
     out = args.output or os.path.splitext(args.file)[0] + "_report.html"
     try:
-        text = build(args.file, best=args.best, max_cells=args.max_cells, title=args.title, pareto=args.pareto)
+        text = build(args.file, best=args.best, max_cells=args.max_cells, title=args.title, pareto=args.pareto,
+                     importance=args.importance)
     except (FileNotFoundError, ksread.FormatVersionError, ValueError) as e:
         raise SystemExit(f"report: {e}")
     d = os.path.dirname(out)

@@ -17,18 +17,44 @@ RAD2DEG = 180.0 / np.pi
 
 def final_iterates(res, block):
     """The block's rows (run-id order), their final iterates (runs x joints, stored units), which
-    columns are angles, and the units shown (the SCARA's third joint is d in mm)."""
+    columns are angles, and the units shown (the SCARA's third joint is d in mm). Text columns are
+    compared by their codes (not decoded row by row)."""
+    g = res.f["runs"]
     qcols = sorted((c for c in res.columns() if c.startswith("q_final_")), key=lambda c: int(c.rsplit("_", 1)[1]))
-    t = res.runs(columns=["block", "status"] + qcols + (["problem"] if "problem" in res.columns() else []),
-                 done_only=False)
-    rows = np.flatnonzero(t["block"] == block)
-    scara = "problem" in t and bool(np.any(t["problem"][rows] == "scara"))
-    units = [("mm" if scara else "rad") if t.units[c].startswith("rad or") else t.units[c] for c in qcols]
-    q = np.column_stack([t[c][rows] for c in qcols]) if qcols else np.zeros((len(rows), 0))
-    conv = t["done"][rows] & np.isin(t["status"][rows], res.kind_meaning("ik")["good_statuses"])
-    q = q.astype(float)
+    done = g["done"][()].astype(bool)  # before the columns (a writer may be committing)
+    rows = np.flatnonzero(_is_one_of(g["block"], [block]))
+    scara = "problem" in g and bool(np.any(_is_one_of(g["problem"], ["scara"])[rows]))
+    stored = {c: ksread._s(g[c].attrs.get("unit", "")) for c in qcols}
+    units = [("mm" if scara else "rad") if stored[c].startswith("rad or") else stored[c] for c in qcols]
+    contiguous = len(rows) and rows[-1] - rows[0] + 1 == len(rows)
+
+    q = np.zeros((len(rows), len(qcols)))
+    for j, c in enumerate(qcols if len(rows) else []):  # filled a column at a time (no second copy)
+        d = g[c]
+        q[:, j] = d[int(rows[0]):int(rows[-1]) + 1] if contiguous else d[()][rows]
+    conv = done[rows] & _is_one_of(g["status"], res.kind_meaning("ik")["good_statuses"])[rows]
     q[~conv] = np.nan
     return rows, q, qcols, units
+
+
+def _codes_present(v):
+    """sorted({int(c) for c in v}) of status codes (small non-negative numbers): counted, not a set
+    built a row at a time."""
+    iv = v.astype(np.int64)
+    if iv.size and (iv.min() < 0 or iv.max() > 1 << 16):
+        return sorted({int(c) for c in iv})
+    return np.flatnonzero(np.bincount(iv)).tolist()
+
+
+def _is_one_of(d, values):
+    """Which rows of the text column `d` hold one of `values` (bool over all rows): an enum's codes
+    compared, strings decoded."""
+    labels = ksread.enum_labels(d)
+    if labels is None:
+        return np.isin(ksread.text_values(d), list(values))
+    wanted = np.zeros(256 ** d.dtype.itemsize, dtype=bool)
+    wanted[[i for i, x in enumerate(labels) if x in values]] = True
+    return wanted[d[()]]
 
 
 def solution_text(q, qcols, units):
@@ -91,7 +117,7 @@ def basins_figure(res, ls, cap):
     status = ls.metrics["status_code"]
     statuses = ls.statuses
     flat_status = status.reshape(-1)
-    failed = sorted({int(c) for c in flat_status[np.isfinite(flat_status) & (flat_status != 0)]})
+    failed = _codes_present(flat_status[np.isfinite(flat_status) & (flat_status != 0)])
     for c in failed:
         code[flat_status == c] = len(classes)
         classes.append(statuses[c])

@@ -3,6 +3,7 @@ the best runs of each block (parameters and metrics, units in the headers, angle
 Run with /usr/bin/python3."""
 import numpy as np
 
+from kinesweep.chunks import one_value
 from kinesweep.kinds import enum_labels, text_values
 from kinesweep.read import RAD2DEG
 from kinesweep.report_page import esc, fmt, table
@@ -26,8 +27,11 @@ class RunsView:
         self.units = {c: ("deg" if u == "rad" else u) for c, u in res.units().items()}
         self.block_codes, self.block_labels = self._codes("block")
         self.status_codes, self.status_labels = self._codes("status")
-        order = np.unique(self.block_codes, return_index=True)
-        self.block_names = [self.block_labels[c] for c in order[0][np.argsort(order[1])]]
+        if self.n and "block" in self.g and one_value(self.g["block"]):  # one code in every row: not sorted
+            self.block_names = [self.block_labels[int(self.block_codes[0])]]
+        else:
+            order = np.unique(self.block_codes, return_index=True)
+            self.block_names = [self.block_labels[c] for c in order[0][np.argsort(order[1])]]
 
     def _codes(self, c):
         """A text column as (codes per row, labels by code): its enum codes (format 4, the missing value
@@ -106,18 +110,29 @@ class RunsView:
         k = self.res.run_kinds()
         return k[0] if len(k) == 1 else ""
 
-    def ranked(self, block):
+    def ranked(self, block, limit=None):
         """The block's done rows of good status, best first by the kind's ranking (the file's /kinds:
         trajectory by E, IK by iterations then error); ties by run id. Returns (row indices, the
-        ranking metric names)."""
+        ranking metric names, how many rows the whole ranking has). limit: the first `limit` rows of
+        it only (sorted among the rows whose first key is at most the limit-th smallest: the same
+        rows, without sorting them all)."""
         meaning = self.res.kind_meaning(self.kind(block))
         keys = [k for k in meaning.get("ranking", []) if k in self.g]
         rows = self.rows(block)
         good = [i for i, s in enumerate(self.status_labels) if s in meaning.get("good_statuses", [])]
         rows = rows[np.isin(self.status_codes[rows], good)]
-        cols = [rows] + [np.nan_to_num(np.asarray(self.values(k, rows), dtype=float), nan=np.inf)
-                         for k in reversed(keys)]
-        return rows[np.lexsort(cols)], keys
+        total = len(rows)
+
+        def key(k, rows):
+            return np.nan_to_num(np.asarray(self.values(k, rows), dtype=float), nan=np.inf)
+
+        first = key(keys[0], rows) if keys else None
+        if limit is not None and keys and total > limit:
+            cut = np.partition(first, max(limit, 1) - 1)[max(limit, 1) - 1]
+            keep = first <= cut
+            rows, first = rows[keep], first[keep]  # the other keys are read for these rows only
+        cols = [rows] + [key(k, rows) for k in reversed(keys[1:])] + ([first] if keys else [])
+        return rows[np.lexsort(cols)][:limit], keys, total
 
 
 def metadata_section(res, view):
@@ -187,6 +202,8 @@ def varying_parameters(view, block, rows):
 
 
 def _varies(view, c, rows):
+    if one_value(view.g[c]):  # one value in every row of the file: in these rows too
+        return False
     first = lo = hi = None
     for v in view.chunks(c, rows):
         if v.dtype.kind == "f":
@@ -207,6 +224,8 @@ def _held(view, c, rows):
     """Whether the column holds a value in one of `rows` (or `rows` is empty), read until it does."""
     if not len(rows):
         return True
+    if one_value(view.g[c]):  # one value in every row: held or not in all of them
+        return bool(held(np.asarray(view.values(c, rows[:1]))).any())
     return any(held(v).any() for v in view.chunks(c, rows))
 
 
@@ -220,13 +239,12 @@ def shown_metrics(view, block, rows):
 def best_section(view, n_best):
     parts = []
     for b in view.block_names:
-        ranked, keys = view.ranked(b)
+        top, keys, n_ranked = view.ranked(b, limit=n_best)
         rows_done = view.rows(b)
         if not len(rows_done):
             continue
         kind = view.kind(b)
         good = "/".join(view.res.kind_meaning(kind).get("good_statuses", []))
-        top = ranked[:n_best]
         varying, fixed = varying_parameters(view, b, rows_done)
         metrics = shown_metrics(view, b, rows_done)
         columns = [("rank", ""), ("run_id", ""), ("status", "")] + [(c, view.units[c]) for c in varying] + \
@@ -240,7 +258,7 @@ def best_section(view, n_best):
         fixed_text = ", ".join(f"{c} = {v}{(' ' + view.units[c]) if view.units[c] not in ('', '1') else ''}"
                                for c, v in fixed_values if v not in ("", "–"))
         order = " then ".join(keys) if keys else "run id"
-        cap = (f"The {len(top)} best of the block's {len(ranked)} {good} runs ({len(rows_done)} done), "
+        cap = (f"The {len(top)} best of the block's {n_ranked} {good} runs ({len(rows_done)} done), "
                f"smallest {order} first. " if len(top) else f"No {good} run among the block's {len(rows_done)} "
                "done runs. ")
         if fixed_text:

@@ -23,7 +23,7 @@ def history_ids(res):
 
 def best_with_history(view, block, ids):
     """The block's best good run (report_tables ranking) that has a history, or None."""
-    ranked, _ = view.ranked(block)
+    ranked, _, _ = view.ranked(block)
     for r in ranked:
         if (int(r) in ids) if ids is not None else view.res.has_history(int(r)):
             return r

@@ -4,6 +4,7 @@ in the same script.
 
 usage: /usr/bin/python3 tests/bench/results_scale.py build/kinesweep [--before OLD_KINESWEEP] [--analysis-before DIR]
            [--runs 100000 1000000] [--kinds trajectory ik] [--repeat 3] [--mpi] [--workdir DIR] [--keep]
+           [--reuse] [--only write query compact group info pandas plot report]
 
 For each study kind and run count: `kinesweep run` (wall time, peak RSS, file bytes per run;
 alternated with --before's binary, whose write time gives the ratio new / old), then, on the file
@@ -26,7 +27,8 @@ just written, repeated --repeat times (min and median of each):
 against h5py reading the columns each touches (query: the metric, run_id and done; compact: every
 parameter and metric, block, status and done; group: method, the metric and done; info: the
 columns info reads; pandas: every /runs column).
-Ratios over the h5py read are what the targets are stated in. Run with Debian's /usr/bin/python3.
+--reuse takes a file already in --workdir (from --keep) instead of writing it; --only times just the
+steps named. Ratios over the h5py read are what the targets are stated in. Run with Debian's /usr/bin/python3.
 """
 import argparse
 import os
@@ -185,6 +187,9 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--workdir")
     ap.add_argument("--keep", action="store_true", help="keep the files written")
+    ap.add_argument("--reuse", action="store_true", help="use a file already in --workdir instead of writing it")
+    steps = ["write", "query", "compact", "group", "info", "pandas", "plot", "report"]
+    ap.add_argument("--only", nargs="+", choices=steps, default=steps, help="time only these steps")
     ap.add_argument("--analysis-before", metavar="DIR",
                     help="also time plot_landscape and the report of another analysis/ directory (PYTHONPATH=DIR), "
                          "alternated with this one's")
@@ -204,25 +209,29 @@ def main():
                 out = os.path.join(work, f"{kind}_{n}.h5")
                 print(f"{kind}, {a * b} runs", flush=True)
                 writes, before = [], []
-                for _ in range(args.repeat):
+                reused = args.reuse and os.path.exists(out)
+                for _ in range(0 if reused else args.repeat if "write" in args.only else 1):
                     writes.append(timed([ks, "run", study, "-o", out, "--overwrite", "-q", "--threads",
                                          str(args.threads)]))
-                    if args.before:
+                    if args.before and "write" in args.only:
                         old = out + ".before.h5"
                         before.append(timed([args.before, "run", study, "-o", old, "--overwrite", "-q",
                                              "--threads", str(args.threads)]))
                 size = os.path.getsize(out)
-                w = [t for t, _ in writes]
-                line = (f"  write    {min(w):8.2f} s (median {statistics.median(w):6.2f})   "
-                        f"peak {max(r for _, r in writes) / 1e6:5.0f} MB   {size / (a * b):6.1f} B/run")
-                if before:
-                    wb = [t for t, _ in before]
-                    bsize = os.path.getsize(out + ".before.h5")
-                    line += (f"   before: {min(wb):.2f} s, {bsize / (a * b):.1f} B/run;"
-                             f" write ratio new/old {min(w) / min(wb):.3f} (min), "
-                             f"{statistics.median(w) / statistics.median(wb):.3f} (median)")
-                    os.remove(out + ".before.h5")
-                print(line, flush=True)
+                if reused or "write" not in args.only:
+                    print(f"  file     {size / 1e6:.0f} MB{' (reused)' if reused else ''}", flush=True)
+                else:
+                    w = [t for t, _ in writes]
+                    line = (f"  write    {min(w):8.2f} s (median {statistics.median(w):6.2f})   "
+                            f"peak {max(r for _, r in writes) / 1e6:5.0f} MB   {size / (a * b):6.1f} B/run")
+                    if before:
+                        wb = [t for t, _ in before]
+                        bsize = os.path.getsize(out + ".before.h5")
+                        line += (f"   before: {min(wb):.2f} s, {bsize / (a * b):.1f} B/run;"
+                                 f" write ratio new/old {min(w) / min(wb):.3f} (min), "
+                                 f"{statistics.median(w) / statistics.median(wb):.3f} (median)")
+                        os.remove(out + ".before.h5")
+                    print(line, flush=True)
                 metric = METRIC[kind]
                 with h5py.File(out, "r") as f:
                     v = f["runs"][metric][()]
@@ -241,6 +250,8 @@ def main():
                                   ["method", metric, "done"]),
                         "info": ([ks, "info", out], info_cols)}
                 for name, (cmd, cols) in runs.items():
+                    if name not in args.only:
+                        continue
                     ours, rss, base = [], [], []
                     for _ in range(args.repeat):
                         t, r = timed(cmd)
@@ -249,15 +260,16 @@ def main():
                         base.append(h5py_read(out, cols))
                     report(name, ours, base, rss)
                 ours, rss, base, frame = [], [], [], 0
-                for _ in range(args.repeat):
+                for _ in range(args.repeat if "pandas" in args.only else 0):
                     p = subprocess.run([sys.executable, "-c", PANDAS, out], capture_output=True, text=True, check=True)
                     seconds, frame = p.stdout.split()[-2:]
                     ours.append(float(seconds))  # to_pandas() alone (not the interpreter's start)
                     frame = int(frame)
                     base.append(h5py_read(out, columns))
-                t, r = timed([sys.executable, "-c", PANDAS, out])
-                rss.append(r)
-                report("pandas", ours, base, rss, f"   frame {frame / 1e6:.0f} MB (peak/frame {max(rss) / frame:.2f})")
+                if ours:
+                    t, r = timed([sys.executable, "-c", PANDAS, out])
+                    rss.append(r)
+                    report("pandas", ours, base, rss, f"   frame {frame / 1e6:.0f} MB (peak/frame {max(rss) / frame:.2f})")
                 with h5py.File(out, "r") as f:
                     block = list(f["landscapes"])[0]
                     grids = [f"landscapes/{block}/{m}" for m in f["landscapes"][block]]
@@ -265,6 +277,8 @@ def main():
                                   f"landscapes/{block}/status_code"],
                          "report": [f"runs/{c}" for c in ("block", "status", "done", "run_id", metric)] + grids}
                 for name, command in (("plot", "plot_landscape"), ("report", "report")):
+                    if name not in args.only:
+                        continue
                     ours, rss, base, base_rss, old, old_rss = [], [], [], [], [], []
                     page = out + "." + name + (".png" if name == "plot" else ".html")
                     for _ in range(args.repeat):  # alternated with the plain read of what it draws

@@ -199,14 +199,14 @@ def analysis_command(name, *args):
 ANALYSIS_ENV = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [ANALYSIS, os.environ.get("PYTHONPATH")])))
 
 
-def report_page(test, results, directory):
-    """kinesweep.report on `results` (the test fails unless it exits 0): the page's html and its
-    figures' data islands, id -> the JSON text (gzip and base64 undone)."""
+def report_page(test, results, directory, *options):
+    """kinesweep.report on `results` with `options` (the test fails unless it exits 0): the page's html
+    and its figures' data islands, id -> the JSON text (gzip and base64 undone)."""
     import base64
     import gzip
     import re
     page = os.path.join(directory, "report.html")
-    r = subprocess.run(analysis_command("report", results, "-o", page), env=ANALYSIS_ENV, capture_output=True,
+    r = subprocess.run(analysis_command("report", results, "-o", page, *options), env=ANALYSIS_ENV, capture_output=True,
                        text=True, timeout=300)
     test.assertEqual(r.returncode, 0, r.stderr)
     with open(page, encoding="utf-8") as fh:

@@ -6,7 +6,8 @@ what to install when a fit is asked for. End to end on studies/examples_lhs.toml
 runs): alpha1A ranks above k and every swept parameter is listed, the ranking agrees with Optuna's
 fANOVA (the figures the issue recorded, 0.67 / 0.30 / 0.03, and recomputed when python3-optuna is
 installed), the command's table and JSON, and the report's importance section (its figures' data
-islands: one bar chart per block, bars and whiskers the module's numbers, the caption's R²).
+islands with --importance: one bar chart per block, bars and whiskers the module's numbers, the caption's R²;
+without it the section names the blocks and the parameters it would rank, and fits nothing).
 
 usage: /usr/bin/python3 test_importance.py KINESWEEP_BINARY SOURCE_DIR
 """
@@ -191,9 +192,21 @@ class ExamplesLhs(TempDirTest):
         self.assertEqual(r.returncode, 2)
         self.assertIn("did you mean 'E'", r.stderr)
 
-    def test_report_has_the_importance_section(self):
+    def test_report_names_the_blocks_without_a_fit(self):
         html, islands = report_page(self, self.h5, self.dir)
         self.assertIn('<section id="importance">', html)
+        self.assertIn('id="importance-not-fitted"', html)
+        note = html.split('id="importance-not-fitted"')[1].split("</p>")[0]
+        for want in (self.lhs, self.lm):  # each block the fit ranks, with the parameters it ranks
+            part = note.split(f"{want['block']} (")[1].split(")")[0]
+            self.assertEqual(sorted(part.split(", ")), sorted(p["name"] for p in want["parameters"]))
+        self.assertIn("--importance", note)
+        self.assertNotIn("importance-0-data", islands)
+
+    def test_report_has_the_importance_section(self):
+        html, islands = report_page(self, self.h5, self.dir, "--importance")
+        self.assertIn('<section id="importance">', html)
+        self.assertNotIn('id="importance-not-fitted"', html)
         self.assertIn("permutation importance of a random-forest fit (R² = "
                       f"{self.lhs['r2']:.3f}", html)
         self.assertIn("not a variance decomposition", html)
