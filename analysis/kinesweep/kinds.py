@@ -246,7 +246,7 @@ class Landscape:
 
 def _grid(d):
     """A landscape grid as float64: a grid of codes (integer, format 5) with -1 (no run) as NaN."""
-    v = d[()]  # a new array: float64 grids are not copied again
+    v = np.asarray(d[()])  # a new array (0-d for a scalar dataset): float64 grids are not copied again
     v = v if v.dtype == np.float64 else v.astype(float)
     if d.dtype.kind in "iu":
         v[v == -1] = np.nan
