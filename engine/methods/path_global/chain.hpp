@@ -49,7 +49,7 @@ struct LimitConstraints {
   LimitTable table;
   std::vector<std::size_t> window_end;  ///< one past the last sample of each window
   std::vector<std::array<int, 2>> rows;  ///< the limited quantities: {0 position, 1 velocity, 2 effort; joint}
-  double margin = 1e-6;
+  double margin = 1e-4;  // room for SLSQP's constraint tolerance and the peaks between samples
 
   unsigned count() const { return static_cast<unsigned>(window_end.size() * rows.size()); }
   /// The limits of `chain` over `samples` samples cut into `windows` windows (none: count() = 0).

@@ -17,6 +17,13 @@
 #include "model/planar_chain_dynamics.hpp"
 
 namespace ks {
+namespace {
+
+constexpr int kMaxRestarts = 2;    // SLSQP's restarts from its end under the limit constraints
+constexpr int kDescentSteps = 30;  // steps of the steepest-descent check, each half the last
+constexpr double kFirstStep = 0.1; // [rad]: the first step's largest change of a coefficient
+
+}  // namespace
 
 TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask& task, const VecN& q0,
                                             const TrajectoryOptions& o, ChainHistory* history,
@@ -171,6 +178,29 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
       for (unsigned row = 0; row < rows; ++row)
         for (std::size_t m = 0; m < free.size(); ++m) jx[row * free.size() + m] = jac[row * c.size() + free[m]];
   };
+  // whether a step from x along the objective's steepest descent (over the free coefficients, each
+  // step halving the last, the first moving a coefficient by kFirstStep) lowers the objective by
+  // more than the tolerance without leaving the limits further; x moves to the first that does. A
+  // point where no limit binds and the gradient is not zero fails it (SLSQP's restarts can end at one)
+  const auto descends = [&]() {
+    evaluate(x.data());
+    const double f_end = cached_f, worst_end = *std::ranges::max_element(con);
+    std::vector<double> d(free.size()), y(free.size());
+    double largest = 0.0;
+    for (std::size_t m = 0; m < free.size(); ++m) d[m] = -grad[free[m]], largest = std::max(largest, std::abs(d[m]));
+    if (!(largest > 0.0) || !std::isfinite(largest)) return false;
+    for (int k = 0; k < kDescentSteps; ++k) {
+      const double t = kFirstStep / largest * std::ldexp(1.0, -k);
+      for (std::size_t m = 0; m < free.size(); ++m) y[m] = std::clamp(x[m] + t * d[m], -bound, bound);
+      ++evaluations;
+      evaluate(y.data());
+      if (f_end - cached_f > g.tolerance * std::abs(f_end) && *std::ranges::max_element(con) <= std::max(worst_end, 0.0)) {
+        x = y;
+        return true;
+      }
+    }
+    return false;
+  };
   // without the limits first; when the optimum leaves them, again from the start with the limits as
   // constraints (SLSQP from a point beyond them may not get back within them)
   const auto solve = [&](std::vector<double> from) {
@@ -191,6 +221,26 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
         spec.max_evaluations = g.max_evaluations - (evaluations - begun);
         x = from;
         status = minimise_slsqp(spec, x);
+        // SLSQP can stall on these constraints (their gradients jump where a window's largest sample
+        // changes, which spoils its quasi-Newton model): it is restarted from its end with a fresh
+        // model while a restart lowers the objective by more than the tolerance within the limits;
+        // a run whose last restart still did is not_converged
+        for (int restart = 0; status == RunStatus::ok; ++restart) {
+          const long left = g.max_evaluations - (evaluations - begun);
+          if (left <= 0) break;
+          evaluate(x.data());
+          const double f_end = cached_f, worst_end = *std::ranges::max_element(con);
+          std::vector<double> y = x;
+          spec.max_evaluations = left;
+          const RunStatus again = minimise_slsqp(spec, y);
+          if (again == RunStatus::interrupted) return again;
+          evaluate(y.data());
+          const double worst = *std::ranges::max_element(con);
+          if (!(f_end - cached_f > g.tolerance * std::abs(f_end)) || !(worst <= std::max(worst_end, 0.0))) break;
+          x = y, status = again;
+          if (restart + 1 == kMaxRestarts) status = RunStatus::not_converged;
+        }
+        if (status == RunStatus::ok && descends()) status = RunStatus::not_converged;
       }
     }
     return status;
