@@ -18,6 +18,7 @@
 #include "methods/path_global/slsqp.hpp"
 #include "methods/path_global/joint_chart.hpp"
 #include "robot/urdf.hpp"
+#include "widest_raise.hpp"
 
 using namespace ks;
 
@@ -191,13 +192,7 @@ TEST(PathGlobalJoints, ALimitTheUnconstrainedOptimumCrossesIsKept) {
   const TrajectoryMetrics free = simulate(chain, task, planar_start_guess(4), o, &free_h);
   ASSERT_EQ(free.status, RunStatus::ok) << to_string(free.status) << " at " << free.stop_time << " s, E " << free.E;
   // the joint whose largest |q| the unconstrained optimum raises most above the local run's
-  int j = 0;
-  double local_max = 0, free_max = -1;
-  for (int i = 0; i < 4; ++i) {
-    const double l = local_h.q.row(i).head(local_h.size).cwiseAbs().maxCoeff();
-    const double f = free_h.q.row(i).head(free_h.size).cwiseAbs().maxCoeff();
-    if (f - l > free_max - local_max) j = i, local_max = l, free_max = f;
-  }
+  const auto [j, local_max, free_max] = widest_raise(local_h, free_h, 4);
   ASSERT_GT(free_max, local_max + 0.05) << "no limit between the two ranges";
   const double limit = 0.5 * (local_max + free_max);
   chain.joints[j].lower = -limit, chain.joints[j].upper = limit;

@@ -20,6 +20,7 @@
 #include "methods/path_global/chain.hpp"
 #include "methods/path_global/joint_chart.hpp"
 #include "robot/urdf.hpp"
+#include "widest_raise.hpp"
 #include "task/task_path.hpp"
 
 using namespace ks;
@@ -146,13 +147,7 @@ TEST(PathGlobalLimitsOptimum, FourLinkArmWithALimitTheUnconstrainedOptimumCrosse
   lo.method = TrajectoryMethod::local_unweighted;
   ASSERT_EQ(simulate(chain, task, planar_start_guess(4), lo, &local_h).status, RunStatus::ok);
   ASSERT_EQ(simulate(chain, task, planar_start_guess(4), o, &free_h).status, RunStatus::ok);
-  int j = 0;
-  double local_max = 0, free_max = -1;
-  for (int i = 0; i < 4; ++i) {
-    const double l = local_h.q.row(i).head(local_h.size).cwiseAbs().maxCoeff();
-    const double f = free_h.q.row(i).head(free_h.size).cwiseAbs().maxCoeff();
-    if (f - l > free_max - local_max) j = i, local_max = l, free_max = f;
-  }
+  const auto [j, local_max, free_max] = widest_raise(local_h, free_h, 4);
   const double limit = 0.5 * (local_max + free_max);
   chain.joints[j].lower = -limit, chain.joints[j].upper = limit;
   const FromEnd e = mma_from_end(chain, task, planar_start_guess(4), o);
