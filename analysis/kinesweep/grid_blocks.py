@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-BLOCK_CELLS = 1 << 19  # cells per block (4 MB of float64)
+BLOCK_CELLS = 1 << 18  # cells per block (2 MB of float64)
 
 
 def blocks(shape, cells=BLOCK_CELLS):
