@@ -1,7 +1,9 @@
 """IK basins for kinesweep.report: each cell of an IK block's grid of initial guesses coloured by the
 solution its run converged to (named as /runs' solution column names them, where the engine names the
 solutions; else the converged final iterates named by kinesweep.solutions.cluster_solutions),
-failed runs in their status colours; hover with the iterations and status. Run with /usr/bin/python3."""
+failed runs in their status colours; hover with the iterations and status. A solution's name gives the
+median of its runs' final joint values: over all of them up to 20000 runs, else over every t-th in
+run order (kinesweep.basins_scan.Medians). Run with /usr/bin/python3."""
 import numpy as np
 
 from kinesweep import read as ksread

@@ -7,13 +7,17 @@ limit and every t-th beyond. Needs no kinesweep binary.
 
 usage: /usr/bin/python3 test_grid_blocks.py
 """
+import json
 import os
+import subprocess
 import sys
+import tempfile
 import unittest
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis"))
+ANALYSIS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "analysis")
+sys.path.insert(0, ANALYSIS)
 from kinesweep.basins_scan import Medians, StreamClusters  # noqa: E402
 from kinesweep.grid_blocks import blocks, first_min, flat_start, frame_parts, read_block, take_drawn  # noqa: E402
 from kinesweep.kinds import Axis, Landscape  # noqa: E402
@@ -122,5 +126,120 @@ class GridBlocks(unittest.TestCase):
                 self.assertGreater(len(m.buf[lab]), 2000)
 
 
+KS = None
+BIG = """
+[study]
+name = "big_grid"
+histories = "none"
+[[block]]
+name = "local"
+kind = "trajectory"
+method = "local_weighted"
+[block.axes]
+alpha1A = { from = -34, to = 30, count = 83 }
+k = { from = 0, to = 1, count = 61 }
+[[block]]
+name = "basins"
+kind = "ik"
+problem = "scara"
+method = "newton"
+[block.axes]
+q0_1 = { from = -180, to = 180, count = 71 }
+q0_2 = { from = -180, to = 180, count = 64 }
+"""
+
+
+def blocks_of(g, s, reduce):
+    """g (rows y x columns x) reduced over blocks of s x s cells (the last ones smaller)."""
+    ny, nx = g.shape
+    out = np.full((-(-ny // s), -(-nx // s)), np.nan)
+    for i in range(out.shape[0]):
+        for j in range(out.shape[1]):
+            b = g[i * s:(i + 1) * s, j * s:(j + 1) * s]
+            if np.isfinite(b).any():
+                out[i, j] = reduce(b)
+    return out
+
+
+@unittest.skipIf(len(sys.argv) < 2 and KS is None, "needs a kinesweep binary")
+class AggregatedPlot(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        study = os.path.join(cls.tmp.name, "big.toml")
+        with open(study, "w") as f:
+            f.write(BIG)
+        cls.h5 = os.path.join(cls.tmp.name, "big.h5")
+        subprocess.run([KS, "run", study, "-o", cls.h5, "-q"], check=True, capture_output=True)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def plot(self, *args):
+        env = dict(os.environ, PYTHONPATH=ANALYSIS)
+        r = subprocess.run([sys.executable, "-m", "kinesweep.plot_landscape", self.h5, "-o",
+                            os.path.join(self.tmp.name, "p.png"), "--print-data", *args],
+                           capture_output=True, text=True, env=env)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        return json.loads(r.stdout)
+
+    def test_blocks_of_a_metric_are_their_min(self):
+        import h5py
+        for size in ("40x40", "800x30", "41x50", "30x30"):
+            d = self.plot("--block", "local", "--size", size)
+            with h5py.File(self.h5, "r") as f:
+                g = f["landscapes/local"]
+                E = np.where(g["status_code"][()] == 0, g["E"][()], np.nan).T  # rows k, columns alpha1A
+                st = g["status_code"][()].T
+            s = -(-max(E.shape) // min(int(v) for v in size.split("x")))
+            self.assertGreater(s, 1)
+            self.assertEqual(d["drawn"]["block"], [s, s])
+            drawn = np.array(d["drawn"]["z"], dtype=float)
+            np.testing.assert_array_equal(drawn, blocks_of(E, s, np.nanmin))
+            self.assertEqual(np.nanmin(drawn), np.nanmin(E))
+            i, j = np.unravel_index(np.nanargmin(E), E.shape)
+            self.assertEqual((d["best"]["i"], d["best"]["j"], d["best"]["value"]), (i, j, E[i, j]))
+            np.testing.assert_array_equal(np.array(d["z"], dtype=float), E)  # --print-data: the full grid
+            masked = np.array([[c or "" for c in row] for row in d["masked_status"]])
+            self.assertEqual(int((masked != "").sum()), int((np.isnan(E) & (st > 0)).sum()))
+
+    def test_bands_give_the_grid_read_whole(self):
+        """reduce_grid read a few cells at a time (bands of a few rows) gives what one piece gives."""
+        import argparse
+        from kinesweep import landscape_grid
+        from kinesweep.read import open_results
+        with open_results(self.h5) as res:
+            for block, metric, pixels in (("local", None, 30), ("local", None, 600), ("basins", None, 25),
+                                          ("basins", "iterations", 20)):
+                ls = res.landscape(block, degrees=True)
+                args = argparse.Namespace(metric=metric, fix=[], x=None, y=None, reduce=None)
+                whole = landscape_grid.reduce_grid(ls, args, pixels, keep_full=True)
+                saved = landscape_grid.BAND_CELLS
+                try:
+                    landscape_grid.BAND_CELLS = 200
+                    bands = landscape_grid.reduce_grid(ls, args, pixels, keep_full=True)
+                finally:
+                    landscape_grid.BAND_CELLS = saved
+                for k in ("z", "cat", "full_z", "full_cat"):
+                    np.testing.assert_array_equal(bands[k], whole[k], err_msg=f"{block} {k}")
+                for k in ("best", "vmin", "vmax", "pos", "no_run", "count"):
+                    self.assertEqual(bands[k], whole[k], f"{block} {k}")
+                np.testing.assert_allclose(bands["sum"], whole["sum"], rtol=1e-12)
+                for a, b in zip(bands["counts"], whole["counts"]):
+                    np.testing.assert_array_equal(np.trim_zeros(a, "b"), np.trim_zeros(b, "b"))
+
+    def test_blocks_of_the_convergence_fraction_are_their_mean(self):
+        import h5py
+        d = self.plot("--block", "basins", "--size", "30x30")
+        with h5py.File(self.h5, "r") as f:
+            conv = f["landscapes/basins/converged"][()].astype(float).T
+        s = -(-max(conv.shape) // 30)
+        drawn = np.array(d["drawn"]["z"], dtype=float)
+        np.testing.assert_allclose(drawn, blocks_of(conv, s, np.nanmean), rtol=1e-12)
+
+
 if __name__ == "__main__":
+    if len(sys.argv) > 1:
+        KS = os.path.abspath(sys.argv.pop(1))
     unittest.main(argv=[sys.argv[0], "-v"])
