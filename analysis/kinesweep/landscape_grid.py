@@ -201,25 +201,32 @@ def _band(out, pnl, pieces, y0, x0, block, mean, convergence, keep_full, swap=Fa
         cat = np.full(z.shape, -1, dtype=np.int8)
     else:
         cat = failed_category(st, np.isnan(z) if vals.shape[2] == 1 else np.all(np.isnan(vals), axis=2), 0)
-    with np.errstate(all="ignore"):
-        lo, hi = np.fmin.reduce(z, axis=None), np.fmax.reduce(z, axis=None)  # np.nanmin, np.nanmax
-    if np.isfinite(lo) or np.isfinite(hi) or np.isfinite(z).any():
+    if convergence:  # its mean, not its minimum, is marked; the colour scale is 0 .. 1
+        keep = ~np.isnan(z)
+        n = int(np.count_nonzero(keep))
+        if n:
+            out["finite"] = True
+            out["sum"][pnl] += np.sum(z, where=keep)
+            out["count"][pnl] += n
+            out["best"][pnl] = (0.0, 0, 0)  # (the panel has values)
+            pos = np.min(z, where=z > 0, initial=np.inf)  # (--log's lower end)
+            if np.isfinite(pos):
+                out["pos"] = pos if out["pos"] is None else min(out["pos"], pos)
+        lo = hi = np.nan
+    else:
+        with np.errstate(all="ignore"):
+            lo, hi = np.fmin.reduce(z, axis=None), np.fmax.reduce(z, axis=None)  # np.nanmin, np.nanmax
+    if not convergence and (np.isfinite(lo) or np.isfinite(hi) or np.isfinite(z).any()):
         out["finite"] = True
         out["vmin"] = lo if out["vmin"] is None else min(out["vmin"], lo)
         out["vmax"] = hi if out["vmax"] is None else max(out["vmax"], hi)
         pos = lo if lo > 0 else np.min(z, where=z > 0, initial=np.inf)
         if np.isfinite(pos):
             out["pos"] = pos if out["pos"] is None else min(out["pos"], pos)
-        if convergence:  # its mean, not its minimum, is marked
-            keep = ~np.isnan(z)
-            out["sum"][pnl] += np.sum(z, where=keep)
-            out["count"][pnl] += int(np.count_nonzero(keep))
-            out["best"][pnl] = out["best"][pnl] or (lo, 0, 0)
-        else:
-            zy = z.T if swap else z  # rows y
-            i, j = np.unravel_index(int(np.argmax(zy == lo)), zy.shape)  # np.nanargmin's first cell
-            b = (float(lo), int(i) + y0, int(j) + x0)
-            out["best"][pnl] = b if out["best"][pnl] is None else min(out["best"][pnl], b)
+        zy = z.T if swap else z  # rows y
+        i, j = np.unravel_index(int(np.argmax(zy == lo)), zy.shape)  # np.nanargmin's first cell
+        b = (float(lo), int(i) + y0, int(j) + x0)
+        out["best"][pnl] = b if out["best"][pnl] is None else min(out["best"][pnl], b)
     c = cat[cat >= 0].astype(np.int64)
     n = np.bincount(c, minlength=len(out["counts"][pnl]))
     n[:len(out["counts"][pnl])] += out["counts"][pnl]
