@@ -163,6 +163,7 @@ def reduce_grid(ls, args, pixels, keep_full=False):
                     if key_ in order:
                         g = np.take(g, order[key_], axis=axis)
                 pieces[k] = g
+            pieces["fresh"] = not isinstance(sources["value"], np.ndarray) and "x" not in order and "y" not in order
             y0, x0 = (0, b0) if band == x else (b0, 0)
             _band(out, pnl, pieces, y0, x0, (sy, sx), mean, metric == "convergence", keep_full, band == x)
     edges, centres = [], []
@@ -190,7 +191,10 @@ def _band(out, pnl, pieces, y0, x0, block, mean, convergence, keep_full, swap=Fa
     vals = pieces["value"]
     st = pieces.get("status")
     if not convergence:  # the failed runs' values are not drawn (0: ok / converged)
-        vals = np.where(st != 0, np.nan, vals)
+        if pieces.get("fresh"):  # a piece read from the file: masked in place
+            np.copyto(vals, np.nan, where=st != 0)
+        else:
+            vals = np.where(st != 0, np.nan, vals)
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         if vals.shape[2] == 1:  # nothing to reduce: the grid itself (no copy)
@@ -317,8 +321,9 @@ def failed_category(status, none, good):
         return cat
     if status.shape[-1] == 1:  # one run per cell: its own status when that is a failed one, else no run
         s = status[..., 0]
-        failed = none & _held(s) & (s != good)
-        return np.where(failed, s, np.where(none, -2, -1)).astype(np.int8)
+        cat[none] = -2
+        np.copyto(cat, s, casting="unsafe", where=none & _held(s) & (s != good))
+        return cat
     st = status[none]  # cells without a value x their runs
     fail = _held(st) & (st != good)
     if not fail.any():
