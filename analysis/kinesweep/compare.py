@@ -103,7 +103,7 @@ def _grid(rows, run, metric):
     return "converged", gci
 
 
-CHUNK = 1 << 20  # rows read at a time by compare (bounded memory; the result does not depend on it)
+CHUNK = 1 << 18  # rows read at a time by compare (bounded memory; the result does not depend on it)
 
 
 def _text_codes(d, v):

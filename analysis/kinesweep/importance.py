@@ -242,12 +242,16 @@ def _block_rows(res, block):
 def block_parameters(res, block, rows=None):
     """The parameters `block` sweeps: those of its run kind taking more than one value among its done
     runs, in file order ([] for a block without done runs). Read one column at a time, in chunks."""
-    kind, inblock, _ = _block_rows(res, block) if rows is None else (res._block_kind(block), rows, 0)
-    if not inblock.any():
-        return []
     g = res.f["runs"]
-    sel = np.zeros(g["done"].shape[0], dtype=bool)
-    sel[np.flatnonzero(g["done"][()].astype(bool))[inblock]] = True
+    kind = res._block_kind(block)
+    done = g["done"][()].astype(bool)
+    if rows is None:  # the block's done rows (a flag per row, no index of them)
+        sel = _block_mask(res, block) & done
+    else:
+        sel = np.zeros(g["done"].shape[0], dtype=bool)
+        sel[np.flatnonzero(done)[rows]] = True
+    if not sel.any():
+        return []
     return [c for c in res.parameters(kind) if _varies_in(g[c], sel)]
 
 

@@ -257,8 +257,8 @@ class _Grids(Mapping):
     3163 x 3163 landscape's 14 grids are 1.1 GB; a plot reads one or two), so while the Results
     that made it is open (read_landscape() reads them all)."""
 
-    def __init__(self, names, read):
-        self._names, self._read, self._grids = list(names), read, {}
+    def __init__(self, names, read, dataset=None):
+        self._names, self._read, self._grids, self._dataset = list(names), read, {}, dataset
 
     def __getitem__(self, name):
         if name not in self._names:
@@ -279,6 +279,17 @@ class _Grids(Mapping):
         if name not in self._names:
             raise KeyError(name)
         return self._read(name)
+
+    def is_read(self, name):
+        """Whether the grid `name` was read and kept (by metrics[name])."""
+        return name in self._grids
+
+    def dataset(self, name):
+        """The grid's h5py dataset (kinesweep.grid_blocks reads it a block at a time), or its array
+        when the landscape has no file behind it."""
+        if name not in self._names:
+            raise KeyError(name)
+        return self._dataset(name) if self._dataset is not None else self[name]
 
     def __contains__(self, name):  # by name (Mapping's would read the grid and keep it)
         return name in self._names

@@ -8,6 +8,12 @@ point overlaid (--optimization NAME, when its variables are the plotted axes). D
 are fixed (--fix AXIS=VALUE), reduced (--reduce min|mean over them; the title says which), or, when one
 categorical dim remains (method), drawn as small multiples: one panel per value, one colour scale.
 A log-spaced numeric axis (lambda from 1e-3 to 100) is drawn on a log scale; --log is the colour scale.
+A grid with more cells along an axis than the picture has pixels across (its smaller side) is drawn in
+blocks of s x s cells: each drawn cell is the min of its block's values (the mean with --reduce mean
+and for the convergence fraction), or where none has a value its runs' most common failed status; the
+title says so. The marked minimum, the colour scale's range, the mean convergence fraction and the
+failed-cell counts in the legend come from the full grid; --print-data prints the full grid (z,
+masked_status) and the drawn one (drawn: block, aggregate, x, y, z).
 
     python3 -m kinesweep.plot_landscape results/landscape_alpha_k.h5 --fix method=local_weighted --log --thesis
     python3 -m kinesweep.plot_landscape results/ik_basins.h5 --metric convergence --x q0_1 --y q0_2
@@ -21,8 +27,8 @@ import numpy as np
 
 from kinesweep import plotting as ksplot  # noqa: E402
 from kinesweep import read as ksread  # noqa: E402
+from kinesweep.landscape_grid import MAX_PANELS, numeric_axes, pick_index, reduce_grid  # noqa: E402,F401
 
-MAX_PANELS = 6  # small multiples: at most this many panels, one per value of a categorical dim
 STATUS_COLOURS = ksread.STATUS_COLOURS
 
 
@@ -79,34 +85,6 @@ def optimization_overlay(res, name, xa, ya):
                      "status": o.best["status"], "stage": o.best["stage"]}}
 
 
-def pick_index(axis, value):
-    if axis.categorical:
-        if value not in axis.labels:
-            raise SystemExit(f"--fix {axis.name}={value}: not a value of the axis; values: {', '.join(axis.labels)}")
-        return axis.labels.index(value)
-    try:
-        v = float(value)
-    except ValueError:
-        raise SystemExit(f"--fix {axis.name}={value}: expected a number")
-    i = int(np.argmin(np.abs(axis.values - v)))
-    span = np.ptp(axis.values) if len(axis.values) > 1 else 1.0
-    if abs(axis.values[i] - v) > 1e-6 * max(span, 1.0) + 1e-9:
-        vals = ", ".join(ksplot.fmt_num(x) for x in axis.values[:12])
-        raise SystemExit(f"--fix {axis.name}={value}: not on the grid; values: {vals}{' ...' if len(axis.values) > 12 else ''}")
-    return i
-
-
-def usage_exit(msg):
-    """A choice the user has to make: the message on stderr, exit status 2 (as argparse's usage errors)."""
-    print(f"plot_landscape: {msg}", file=sys.stderr)
-    raise SystemExit(2)
-
-
-def numeric_axes(ls):
-    """The axes a grid can be drawn over: numeric, swept, monotonic (not a design's sampled points)."""
-    return [a.name for a in ls.axes if not a.categorical and len(a.values) > 1 and not a.sampled]
-
-
 def choose_block(res, block):
     """The named landscape, or the first in file order with two swept numeric axes to plot."""
     names = res.landscapes()
@@ -123,151 +101,6 @@ def choose_block(res, block):
     raise SystemExit(f"plot_landscape: {res.path}: no landscape has two swept numeric axes to plot ({axes}); "
                      "a dimension of sampled points (LHS, zipped random draws, Saltelli) is not a grid axis: "
                      "python3 -m kinesweep.plot_runs draws such runs as points")
-
-
-def reduce_grid(ls, args):
-    """The metric over (y, x) per panel: dict with x/y axes, z (panels x ny x nx), cat (same shape:
-    -1 value, -2 no run, else the status index of the cell's failed runs), facet (axis or None), notes."""
-    names = [a.name for a in ls.axes]
-    metric = args.metric or ("convergence" if ls.kind == "ik" else ls.objective)
-    if metric != "convergence" and metric not in ls.metrics:
-        raise SystemExit(f"--metric {metric}: not in landscape {ls.block}; metrics: "
-                         f"{', '.join(list(ls.metrics) + (['convergence'] if ls.kind == 'ik' else []))}")
-    fixed = {}
-    for f in args.fix:
-        if "=" not in f:
-            raise SystemExit(f"--fix {f}: expected AXIS=VALUE")
-        k, v = f.split("=", 1)
-        if k not in names:
-            raise SystemExit(f"--fix {k}: no such axis; axes: {', '.join(names)}")
-        fixed[k] = v
-    free = [n for n in numeric_axes(ls) if n not in fixed]
-    x = args.x or (free[0] if free else None)
-    y = args.y or next((n for n in free if n != x), None)
-    for n, opt in ((x, "--x"), (y, "--y")):
-        if n is None:
-            raise SystemExit(f"{opt}: the landscape has no second swept axis to plot; axes: {', '.join(names)}")
-        if n not in names:
-            raise SystemExit(f"{opt} {n}: no such axis; axes: {', '.join(names)}")
-    if x == y or x in fixed or y in fixed:
-        raise SystemExit("--x and --y must be two different axes, neither of them fixed")
-    index = [slice(None)] * len(names)
-    notes = []
-    for k, v in fixed.items():
-        a = ls.axis(k)
-        index[names.index(k)] = pick_index(a, v)
-        notes.append(f"{k} = {v}" + (f" {a.unit}" if a.unit and not a.categorical else ""))
-    rest = [n for n in names if n not in (x, y) and n not in fixed]
-    multi = [n for n in rest if len(ls.axis(n).values) > 1]
-    facet = None
-    if metric != "convergence" and multi and args.reduce is None:
-        a = ls.axis(multi[0])
-        if len(multi) == 1 and a.categorical and len(a.labels) <= MAX_PANELS:
-            facet = multi[0]
-        else:
-            dims = ", ".join(f"{n} ({len(ls.axis(n).values)} values)" for n in multi)
-            usage_exit(f"landscape {ls.block}: the dims {dims} are neither plotted nor fixed; choose for each: "
-                       f"--fix AXIS=VALUE (e.g. --fix {multi[0]}={_first_value(ls.axis(multi[0]))}), or "
-                       f"--reduce min|mean over them" + ("" if len(multi) == 1 else
-                                                          ", or --fix all but one categorical dim (one panel per value)"))
-    rest = [n for n in rest if n != facet]
-
-    def arrange(g):  # -> panels x ny x nx x (cells reduced)
-        g = g[tuple(index)]
-        kept = [n for n in names if n not in fixed]
-        order = ([kept.index(facet)] if facet else []) + [kept.index(y), kept.index(x)] + [kept.index(n) for n in rest]
-        g = np.transpose(g, order)
-        return g.reshape((g.shape[0] if facet else 1,) + g.shape[(1 if facet else 0):(3 if facet else 2)] + (-1,))
-
-    read = ls.metrics.read if hasattr(ls.metrics, "read") else ls.metrics.__getitem__  # grids not kept
-    status = arrange(read("status_code"))
-    good = 0  # ok / converged
-    if metric == "convergence":
-        conv = arrange(read(ls.statuses[0]))
-        if conv.shape[3] == 1:  # one run per cell: its 1 / 0 (NaN: no run), as nanmean gives it
-            z = conv[..., 0]
-        else:
-            z = np.nanmean(conv, axis=3)
-        del conv
-        cat = np.full(z.shape, -1, dtype=np.int8)
-        if multi:
-            notes.append(f"mean over {', '.join(multi)}")
-        reduce = "mean" if multi else None
-    else:
-        grid = ls.metrics.fresh(metric) if hasattr(ls.metrics, "fresh") else np.array(ls.metrics[metric])
-        vals = arrange(grid)  # (a view of this new grid, or a copy)
-        del grid
-        vals[status != good] = np.nan  # the failed runs' values are not drawn (one grid, not a third)
-        if vals.shape[3] == 1:  # nothing to reduce: the grid itself (no copy)
-            z = vals[..., 0]
-        else:
-            import warnings
-            with np.errstate(all="ignore"), warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)
-                z = np.nanmean(vals, axis=3) if args.reduce == "mean" else np.nanmin(vals, axis=3)
-        cat = failed_category(status, np.isnan(z) if vals.shape[3] == 1 else np.all(np.isnan(vals), axis=3), good)
-        del vals
-        reduce = args.reduce if [n for n in rest if len(ls.axis(n).values) > 1] else None
-        if reduce:
-            notes.append(f"{reduce} over {', '.join(n for n in rest if len(ls.axis(n).values) > 1)}")
-    xa, ya = ls.axis(x), ls.axis(y)
-    # Axes in increasing order (random axes are stored in draw order).
-    for a, dim in ((xa, 2), (ya, 1)):
-        if not a.categorical and np.any(np.diff(a.values) < 0):
-            o = np.argsort(a.values, kind="stable")
-            z, cat = np.take(z, o, axis=dim), np.take(cat, o, axis=dim)
-            a = ksread.Axis(a.name, a.unit, a.values[o])
-            xa, ya = (a, ya) if dim == 2 else (xa, a)
-    fa = ls.axis(facet) if facet else None
-    return {"metric": metric, "x": xa, "y": ya, "z": z, "cat": cat, "notes": notes, "reduce": reduce,
-            "fixed": fixed, "facet": facet, "panel_labels": list(fa.labels) if fa else [None]}
-
-
-def nan_mean(z):
-    """np.nanmean(z) without its copy of z (the mean of the values that are not NaN)."""
-    keep = ~np.isnan(z)
-    return float(np.sum(z, where=keep) / np.count_nonzero(keep))
-
-
-def small_codes(v):
-    """np.unique(v).astype(int) of status codes (small integers): counted, not sorted."""
-    iv = v.astype(np.int64)
-    if iv.size and (iv.min() < 0 or iv.max() > 1 << 16 or np.any(iv != v)):  # not codes: sorted after all
-        return np.unique(v).astype(int)
-    return np.flatnonzero(np.bincount(iv))
-
-
-def failed_category(status, none, good):
-    """Per cell (panels x ny x nx) of `status` (same x cells reduced): -1 where `none` is false (the
-    cell has a value), else the most common failed status of its runs (the smallest code on a tie),
-    -2 when it has no run at all."""
-    cat = np.full(none.shape, -1, dtype=np.int8)  # status codes are small
-    if not none.any():
-        return cat
-    if status.shape[-1] == 1:  # one run per cell: its own status when that is a failed one, else no run
-        s = status[..., 0]
-        failed = none & np.isfinite(s) & (s != good)
-        cat[failed] = s[failed]
-        cat[none & ~failed] = -2
-        return cat
-    st = status[none]  # cells without a value x their runs
-    codes = small_codes(st[np.isfinite(st) & (st != good)])
-    if codes.size == 0:
-        cat[none] = -2
-        return cat
-    counts = np.stack([np.sum(st == c, axis=1) for c in codes], axis=1)
-    cat[none] = np.where(counts.max(axis=1) > 0, codes[np.argmax(counts, axis=1)], -2)
-    return cat
-
-
-def draw_stride(nx, ny, pixels):
-    """Every s-th cell of each axis drawn so that neither axis draws more cells than the picture has
-    pixels across (more would not show; the minimum is marked from the full grid)."""
-    return max(1, -(-max(nx, ny) // max(1, pixels)))
-
-
-def _first_value(a):
-    return a.labels[0] if a.categorical else ksplot.fmt_num(a.values[0])
 
 
 def block_method(res, ls, fixed):
@@ -291,14 +124,17 @@ def main(argv=None):
     args = parse_args(argv)
     res = ksread.open_results(args.file)
     ls = res.landscape(choose_block(res, args.block), degrees=True)
-    d = reduce_grid(ls, args)
+    size = ksplot.figure_size(args)
+    # A grid with more cells than the picture has pixels is drawn in blocks (landscape_grid); the
+    # minimum, the colour scale's range and the counts come from the full grid.
+    d = reduce_grid(ls, args, min(int(round(size[0] * args.dpi)), int(round(size[1] * args.dpi))),
+                    keep_full=args.print_data)
     xa, ya, Z, CAT, metric = d["x"], d["y"], d["z"], d["cat"], d["metric"]
     unit = "" if metric == "convergence" else ls.units.get(metric, "")
     label = ls.label(metric) + (f" [{unit}]" if unit else "")
     xlog = not xa.categorical and ksplot.is_log_spaced(xa.values)
     ylog = not ya.categorical and ksplot.is_log_spaced(ya.values)
 
-    size = ksplot.figure_size(args)
     from matplotlib import colormaps
     from matplotlib.colors import ListedColormap, LogNorm, Normalize
     from matplotlib import patheffects
@@ -312,22 +148,15 @@ def main(argv=None):
         axs.flat[k].set_visible(False)
     xv = np.arange(len(xa.values)) if xa.categorical else xa.values
     yv = np.arange(len(ya.values)) if ya.categorical else ya.values
-    # Big grids are drawn every s-th cell (the picture has fewer pixels); values, minimum and counts
-    # come from the full grid.
-    step = draw_stride(len(xv), len(yv), min(int(round(size[0] * args.dpi)), int(round(size[1] * args.dpi))))
-    dx, dy = xv[::step], yv[::step]
-    X, Y = np.meshgrid(ksplot.cell_edges(dx, xlog), ksplot.cell_edges(dy, ylog))
-    if step > 1:
-        from kinesweep.report_grids import ordinal  # (the report's modules are not otherwise needed)
-        d["notes"].append(f"every {ordinal(step)} cell of {len(yv)} × {len(xv)} drawn")
-    any_finite = bool(np.isfinite(Z).any())  # one colour scale for every panel
-    vmin = args.vmin if args.vmin is not None else (np.nanmin(Z) if any_finite else 0.0)
-    vmax = args.vmax if args.vmax is not None else (np.nanmax(Z) if any_finite else 1.0)
+    dx, dy = d["centres"]
+    X, Y = np.meshgrid(*d["edges"])
+    any_finite = d["finite"]  # one colour scale for every panel
+    vmin = args.vmin if args.vmin is not None else (d["vmin"] if any_finite else 0.0)
+    vmax = args.vmax if args.vmax is not None else (d["vmax"] if any_finite else 1.0)
     if metric == "convergence":
         vmin, vmax = (0.0 if args.vmin is None else vmin), (1.0 if args.vmax is None else vmax)
     if args.log:
-        pos = Z[np.isfinite(Z) & (Z > 0)]
-        vmin = max(vmin, pos.min() if pos.size else 1e-12)
+        vmin = max(vmin, d["pos"] if d["pos"] is not None else 1e-12)
         norm = LogNorm(vmin=vmin, vmax=max(vmax, vmin * 1.0001))
     else:
         norm = Normalize(vmin=vmin, vmax=vmax if vmax > vmin else vmin + 1)
@@ -343,37 +172,37 @@ def main(argv=None):
         opt = optimization_overlay(res, args.optimization, xa, ya)
     for p in range(n):
         ax, z, cat = axs.flat[p], Z[p], CAT[p]
-        has_values = bool(np.isfinite(z).any())
-        mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(z[::step, ::step]), cmap=cmap, norm=norm, shading="flat")
-        # Failed cells in their own colours.
+        has_values = d["best"][p] is not None
+        mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(z), cmap=cmap, norm=norm, shading="flat")
+        # Failed cells in their own colours (counted over the full grid).
         handles = []
-        present = small_codes(cat[cat >= 0]).tolist()
-        if present or (cat == -2).any():
+        counts = d["counts"][p]
+        present = np.flatnonzero(counts).tolist()
+        if present or d["no_run"][p]:
             colours = ["#ffffff"] * (len(statuses) + 1)
             for s in present:
                 colours[s] = STATUS_COLOURS.get(statuses[s], "#999999")
                 handles.append(Patch(facecolor=colours[s], edgecolor="0.3",
-                                     label=f"{statuses[s]} ({int((cat == s).sum())} cells)"))
-            if (cat == -2).any():
+                                     label=f"{statuses[s]} ({int(counts[s])} cells)"))
+            if d["no_run"][p]:
                 handles.append(Patch(facecolor="#ffffff", edgecolor="0.3", label="no run"))
-            c = np.where(cat[::step, ::step] == -2, len(statuses), cat[::step, ::step]).astype(float)
+            c = np.where(cat == -2, len(statuses), cat).astype(float)
             ax.pcolormesh(X, Y, np.ma.masked_less(c, 0), cmap=ListedColormap(colours),
                           vmin=-0.5, vmax=len(statuses) + 0.5, shading="flat")
         if len(levels) and has_values:
-            cs = ax.contour(dx, dy, np.ma.masked_invalid(z[::step, ::step]), levels=levels, colors="white", linewidths=0.7, alpha=0.8)
+            cs = ax.contour(dx, dy, np.ma.masked_invalid(z), levels=levels, colors="white", linewidths=0.7, alpha=0.8)
             ax.clabel(cs, fmt=lambda v: f"{v:g}", fontsize=7, inline=True)
         # Minimum (the mean for the convergence fraction).
         best = None
         if metric == "convergence" and has_values:
-            ax.plot([], [], ls="none", label=f"mean convergence fraction {nan_mean(z):.0%}")
+            ax.plot([], [], ls="none", label=f"mean convergence fraction {float(d['sum'][p] / d['count'][p]):.0%}")
         elif has_values:
-            # nanargmin's first minimum, without its copy of the grid
-            i, j = np.unravel_index(int(np.flatnonzero(z == np.nanmin(z))[0]), z.shape)
-            best = {"value": z[i, j], "x": xa.values[j], "y": ya.values[i], "i": int(i), "j": int(j)}
+            v, i, j = d["best"][p]  # nanargmin's first minimum of the full grid
+            best = {"value": v, "x": xa.values[j], "y": ya.values[i], "i": i, "j": j}
             xs = xa.labels[j] if xa.categorical else f"{ksplot.fmt_num(xa.values[j])}{'°' if xa.unit == 'deg' else ''}"
             ys = ya.labels[i] if ya.categorical else f"{ksplot.fmt_num(ya.values[i])}{'°' if ya.unit == 'deg' else ''}"
             ax.plot([xv[j]], [yv[i]], marker="*", ms=16, color="#ff3030", mec="white", mew=1.2, zorder=5, ls="none",
-                    label=f"min {ksplot.fmt_num(z[i, j])}{(' ' + unit) if unit else ''} at {xa.name} = {xs}, "
+                    label=f"min {ksplot.fmt_num(v)}{(' ' + unit) if unit else ''} at {xa.name} = {xs}, "
                           f"{ya.name} = {ys}")
         # Thesis optimum (of the panel's method).
         if args.thesis and {xa.name, ya.name} == {"alpha1A", "k"}:
@@ -398,7 +227,8 @@ def main(argv=None):
                   fontsize=8 if n == 1 else 7, framealpha=0.85)
         if d["facet"]:
             ax.set_title(f"{d['facet']} = {d['panel_labels'][p]}", fontsize=9)
-        panels.append({"label": d["panel_labels"][p], "z": z, "best": best, "cat": cat})
+        panels.append({"label": d["panel_labels"][p], "z": d["full_z"][p] if args.print_data else None, "best": best,
+                       "cat": d["full_cat"][p] if args.print_data else None})
     cb = fig.colorbar(mesh, ax=list(axs.flat[:n]), extend="max" if args.vmax is not None else "neither")
     cb.set_label(label)
     if args.log:
@@ -414,7 +244,7 @@ def main(argv=None):
             pan["masked_status"] = [[(statuses[c] if c >= 0 else None) for c in row] for row in cat]
     first = panels[0]
     # Saved first: the colour bar's ticks are read as the saving drew them (no draw of its own).
-    out = ksplot.save(fig, args, f"landscape_{ls.block}_{metric}")
+    out = ksplot.save(fig, args, f"landscape_{ls.block}_{metric}", layout_once=True)
     if not args.print_data:
         print(out)
         return 0
@@ -426,7 +256,9 @@ def main(argv=None):
          "x": {"name": xa.name, "unit": xa.unit, "values": xa.values, "labels": xa.labels, "log": xlog},
          "y": {"name": ya.name, "unit": ya.unit, "values": ya.values, "labels": ya.labels, "log": ylog},
          "z": first["z"], "masked_status": first.get("masked_status"), "best": first["best"], "panels": panels,
-         "draw_stride": step,
+         "draw_stride": d["stride"],
+         "drawn": {"block": d["block"], "aggregate": "mean" if metric == "convergence" or args.reduce == "mean" else "min",
+                   "x": dx, "y": dy, "z": Z[0]},
          "thesis": thesis, "optimization": opt, "xscale": axs.flat[0].get_xscale(),
          "yscale": axs.flat[0].get_yscale(), "colorbar": {"ticks": cticks, "labels": clabels}, "output": out})
     return 0

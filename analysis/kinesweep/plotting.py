@@ -53,12 +53,19 @@ def output_path(args, suffix):
     return out
 
 
-def save(fig, args, suffix):
+def save(fig, args, suffix, layout_once=False):
+    """Save the figure to its output path (output_path) and return that. layout_once (PNG): a figure
+    with a layout engine (constrained layout) is laid out once here, at the saving's dpi, and drawn
+    once: savefig would first draw it with rendering disabled to lay it out (the same layout)."""
     out = output_path(args, suffix)
     d = os.path.dirname(out)
     if d:
         os.makedirs(d, exist_ok=True)
     fmt = "svg" if out.lower().endswith(".svg") else "png"
+    if layout_once and fmt == "png" and fig.get_layout_engine() is not None:
+        fig.set_dpi(args.dpi)
+        fig.get_layout_engine().execute(fig)
+        fig.set_layout_engine("none")
     fig.savefig(out, dpi=args.dpi, format=fmt)
     return out
 

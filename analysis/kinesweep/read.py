@@ -398,7 +398,8 @@ class Results:
             units[m] = _s(g[m].attrs.get("unit", ""))
             desc[m] = _s(g[m].attrs.get("description", ""))
             shown[m] = display_name(g[m], m)
-        metrics = _Grids(names, lambda m: _grid(self.f["landscapes"][block][m]))
+        metrics = _Grids(names, lambda m: _grid(self.f["landscapes"][block][m]),
+                         lambda m: self.f["landscapes"][block][m])
         kind = self._block_kind(block)
         return Landscape(block, axes, metrics, units, desc, kind, self.kind_meaning(kind), shown)
 

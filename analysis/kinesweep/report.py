@@ -26,7 +26,6 @@ import math
 import os
 import sys
 
-import numpy as np
 
 from kinesweep import read as ksread  # noqa: E402
 from kinesweep.report_basins import basins_figure  # noqa: E402
@@ -317,7 +316,7 @@ def _good_runs(view, block):
     """How many of the block's done runs have a good status (ok / converged)."""
     good = view.res.kind_meaning(view.kind(block)).get("good_statuses", [])
     codes = [i for i, s in enumerate(view.status_labels) if s in good]
-    return int(np.isin(view.status_codes[view.rows(block)], codes).sum())
+    return int(view.status_counts()[1][view.block_labels.index(block), codes].sum())
 
 
 def importance_section(res, limit=MAX_IMPORTANCE_FIGURES, fit=True, view=None):

@@ -1,11 +1,14 @@
 """IK basins for kinesweep.report: each cell of an IK block's grid of initial guesses coloured by the
 solution its run converged to (named as /runs' solution column names them, where the engine names the
 solutions; else the converged final iterates named by kinesweep.solutions.cluster_solutions),
-failed runs in their status colours; hover with the iterations and status. Run with /usr/bin/python3."""
+failed runs in their status colours; hover with the iterations and status. A solution's name gives the
+median of its runs' final joint values: over all of them up to 20000 runs, else over every t-th in
+run order (kinesweep.basins_scan.Medians). Run with /usr/bin/python3."""
 import numpy as np
 
 from kinesweep import read as ksread
-from kinesweep.solutions import cluster_solutions
+from kinesweep.basins_scan import Source, StreamClusters, any_row, block_rows, joint_clusters, scan
+from kinesweep.grid_blocks import blocks, drawn_cells, grid_source, read_block
 from kinesweep.report_grids import STATUS_COLOURS, Selection, arrange, axis_values, capped_note, esc, legend_square, \
     value_text
 
@@ -15,52 +18,22 @@ CLUSTER_TOLERANCE = 1e-3  # max-norm distance [rad or mm] under which two final 
 RAD2DEG = 180.0 / np.pi
 
 
-def final_iterates(res, block):
-    """The block's rows (run-id order), their final iterates (runs x joints, stored units), which
-    columns are angles, and the units shown (the SCARA's third joint is d in mm). Text columns are
-    compared by their codes (not decoded row by row)."""
+def final_columns(res, rows):
+    """The final-iterate columns (q_final_1, ...), which are angles, and the units shown (the SCARA's
+    third joint is d in mm)."""
     g = res.f["runs"]
     qcols = sorted((c for c in res.columns() if c.startswith("q_final_")), key=lambda c: int(c.rsplit("_", 1)[1]))
-    done = g["done"][()].astype(bool)  # before the columns (a writer may be committing)
-    rows = np.flatnonzero(_is_one_of(g["block"], [block]))
-    scara = "problem" in g and bool(np.any(_is_one_of(g["problem"], ["scara"])[rows]))
+    scara = any_row(g, "problem", rows, ["scara"])
     stored = {c: ksread._s(g[c].attrs.get("unit", "")) for c in qcols}
     units = [("mm" if scara else "rad") if stored[c].startswith("rad or") else stored[c] for c in qcols]
-    contiguous = len(rows) and rows[-1] - rows[0] + 1 == len(rows)
-
-    q = np.zeros((len(rows), len(qcols)))
-    for j, c in enumerate(qcols if len(rows) else []):  # filled a column at a time (no second copy)
-        d = g[c]
-        q[:, j] = d[int(rows[0]):int(rows[-1]) + 1] if contiguous else d[()][rows]
-    conv = done[rows] & _is_one_of(g["status"], res.kind_meaning("ik")["good_statuses"])[rows]
-    q[~conv] = np.nan
-    return rows, q, qcols, units
+    return qcols, units
 
 
-def _codes_present(v):
-    """sorted({int(c) for c in v}) of status codes (small non-negative numbers): counted, not a set
-    built a row at a time."""
-    iv = v.astype(np.int64)
-    if iv.size and (iv.min() < 0 or iv.max() > 1 << 16):
-        return sorted({int(c) for c in iv})
-    return np.flatnonzero(np.bincount(iv)).tolist()
-
-
-def _is_one_of(d, values):
-    """Which rows of the text column `d` hold one of `values` (bool over all rows): an enum's codes
-    compared, strings decoded."""
-    labels = ksread.enum_labels(d)
-    if labels is None:
-        return np.isin(ksread.text_values(d), list(values))
-    wanted = np.zeros(256 ** d.dtype.itemsize, dtype=bool)
-    wanted[[i for i, x in enumerate(labels) if x in values]] = True
-    return wanted[d[()]]
-
-
-def solution_text(q, qcols, units):
+def solution_text(median, qcols, units):
+    """A solution named by its joints' median final values (`median`: one per column of qcols)."""
     parts = []
-    for j, (c, u) in enumerate(zip(qcols, units)):
-        v = float(np.median(q[:, j]))
+    for v, c, u in zip(median, qcols, units):
+        v = float(v)
         n = c.rsplit("_", 1)[1]
         if u == "rad":
             parts.append(f"θ{n} = {(v * RAD2DEG + 180.0) % 360.0 - 180.0:.1f}°")
@@ -71,66 +44,17 @@ def solution_text(q, qcols, units):
 
 def basins_figure(res, ls, cap):
     """Returns (figure dict, caption html, cells drawn), or None when the grid cannot be matched to the
-    block's runs."""
-    shape = ls.metrics["status_code"].shape
+    block's runs. The runs are read a block of cells at a time (kinesweep.basins_scan): memory holds
+    the drawn cells, not the grids or the final-iterate columns."""
+    status = grid_source(ls, "status_code")
+    shape = status.shape
     if len(shape) < 2:
         return None
-    rows, q, qcols, units = final_iterates(res, ls.block)
+    rows = block_rows(res.f["runs"], ls.block)
+    qcols, units = final_columns(res, rows)
     if len(rows) != int(np.prod(shape)) or not qcols:
         return None
-    revolute = [u == "rad" for u in units]
-    # The solutions as /runs names them (the engine's index of the known solution reached, as
-    # plot_basins shows them); clusters of the final iterates where the engine names none.
-    labels, named_by = None, "named by kinesweep.solutions.cluster_solutions"
-    if "solution" in ls.metrics:
-        s = np.asarray(ls.metrics["solution"], dtype=float).ravel()
-        if s.size == len(rows) and np.isfinite(s).any():
-            labels = np.where(np.isfinite(s) & np.all(np.isfinite(q), axis=1), s, -1).astype(int)
-            named_by = "named as the solution column of /runs names them"
-    if labels is None:
-        labels = cluster_solutions(q, revolute, CLUSTER_TOLERANCE)
-    n_sol = int(labels.max(initial=-1)) + 1
-    continuum, n_all = "", n_sol
-    if n_sol > len(SOLUTION_COLOURS):
-        # A continuum (a redundant problem): name the solutions by the joints whose final values take
-        # a few distinct values over the converged runs (e.g. an S-R-S arm's elbow), as plot_basins does.
-        few = [j for j in range(q.shape[1]) if cluster_solutions(q[:, [j]], [revolute[j]], CLUSTER_TOLERANCE)
-               .max(initial=-1) + 1 <= len(SOLUTION_COLOURS)]
-        if few:
-            continuum = (f" They form a continuum of postures: the colours name them "
-                         f"by the joints that take a few values ({', '.join(qcols[j] for j in few)}).")
-            q, qcols, units = q[:, few], [qcols[j] for j in few], [units[j] for j in few]
-            labels = cluster_solutions(q, [revolute[j] for j in few], CLUSTER_TOLERANCE)
-            n_sol = int(labels.max(initial=-1)) + 1
-    counts = np.bincount(labels[labels >= 0], minlength=n_sol)
-    # The largest clusters get their own colours (in order of first appearance); the rest share one.
-    named = sorted(np.argsort(-counts, kind="stable")[:len(SOLUTION_COLOURS)].tolist()) if n_sol else []
-    other = n_sol > len(named)
-    classes = [f"solution {s}" for s in named] + (["other solutions"] if other else [])
-    colours = SOLUTION_COLOURS[:len(named)] + ([OTHER_COLOUR] if other else [])
-    texts = [solution_text(q[labels == s], qcols, units) for s in named]
-    code = np.full(len(labels), np.nan)
-    for k, s in enumerate(named):
-        code[labels == s] = k
-    if other:
-        code[(labels >= 0) & ~np.isin(labels, named)] = len(named)
-    status = ls.metrics["status_code"]
-    statuses = ls.statuses
-    flat_status = status.reshape(-1)
-    failed = _codes_present(flat_status[np.isfinite(flat_status) & (flat_status != 0)])
-    for c in failed:
-        code[flat_status == c] = len(classes)
-        classes.append(statuses[c])
-        colours.append(STATUS_COLOURS.get(statuses[c], "#999999"))
-    conv_unnamed = (flat_status == 0) & np.isnan(code)
-    if conv_unnamed.any():  # converged without a finite final iterate (not expected)
-        code[conv_unnamed] = len(classes)
-        classes.append("converged (no final iterate)")
-        colours.append("#ffffff")
-    code = code.reshape(shape)
-    names = np.array(classes + ["no run"], dtype=object)
-    best = None
-    sel = Selection(ls, best)
+    sel = Selection(ls, None)
     for d in sel.held:  # basins: further dims at their first value (the caption says so)
         sel.fixed[d] = 0
     xa, ya = ls.axes[sel.x], ls.axes[sel.y] if sel.y is not None else None
@@ -138,7 +62,59 @@ def basins_figure(res, ls, cap):
         return None
     s = sel.stride(cap)
     xi, yi = np.arange(0, len(xa.values), s), np.arange(0, len(ya.values), s)
+    drawn = (len(yi), len(xi))
     xs, ys = axis_values(xa, xi), axis_values(ya, yi)
+    revolute = [u == "rad" for u in units]
+    src = Source(res, ls, rows, qcols)
+    joints = list(range(len(qcols)))
+    # The solutions as /runs names them (the engine's index of the known solution reached, as
+    # plot_basins shows them); clusters of the final iterates where the engine names none.
+    named_by = "named by kinesweep.solutions.cluster_solutions"
+    solution = grid_source(ls, "solution") if "solution" in ls.metrics else None
+    if solution is not None and any(np.isfinite(read_block(solution, lo, hi)).any() for lo, hi in blocks(shape)):
+        named_by = "named as the solution column of /runs names them"
+
+        def labeler(lo, hi, q):
+            v = read_block(solution, lo, hi).ravel()
+            return np.where(np.isfinite(v) & np.all(np.isfinite(q), axis=1), v, -1).astype(np.int64)
+    else:
+        labeler = _clusters(revolute)
+    out = scan(src, sel, s, drawn, joints, labeler)
+    n_sol = len(out["counts"])
+    continuum, n_all = "", n_sol
+    if n_sol > len(SOLUTION_COLOURS):
+        # A continuum (a redundant problem): name the solutions by the joints whose final values take
+        # a few distinct values over the converged runs (e.g. an S-R-S arm's elbow), as plot_basins does.
+        few = joint_clusters(src, revolute, CLUSTER_TOLERANCE, len(SOLUTION_COLOURS))
+        if few:
+            continuum = (f" They form a continuum of postures: the colours name them "
+                         f"by the joints that take a few values ({', '.join(qcols[j] for j in few)}).")
+            joints = few
+            out = scan(src, sel, s, drawn, joints, _clusters([revolute[j] for j in few]))
+            n_sol = len(out["counts"])
+    qcols, units = [qcols[j] for j in joints], [units[j] for j in joints]
+    counts = out["counts"]
+    # The largest clusters get their own colours (in order of first appearance); the rest share one.
+    named = sorted(np.argsort(-counts, kind="stable")[:len(SOLUTION_COLOURS)].tolist()) if n_sol else []
+    other = n_sol > len(named)
+    classes = [f"solution {s}" for s in named] + (["other solutions"] if other else [])
+    colours = SOLUTION_COLOURS[:len(named)] + ([OTHER_COLOUR] if other else [])
+    texts = [solution_text(out["medians"].median(s), qcols, units) for s in named]
+    lab2code = np.full(n_sol + 1, np.nan)  # the last: no solution
+    lab2code[:n_sol] = len(named) if other else np.nan
+    lab2code[named] = np.arange(len(named))
+    statuses = ls.statuses
+    status_class = {}
+    for c in sorted(out["failed"]):
+        status_class[c] = len(classes)
+        classes.append(statuses[c])
+        colours.append(STATUS_COLOURS.get(statuses[c], "#999999"))
+    unnamed = None
+    if out["unnamed"]:  # converged without a finite final iterate (not expected)
+        unnamed = len(classes)
+        classes.append("converged (no final iterate)")
+        colours.append("#ffffff")
+    names = np.array(classes + ["no run"], dtype=object)
     n = max(1, len(classes) - 1)
     scale = []
     for k, col in enumerate(colours):
@@ -148,13 +124,21 @@ def basins_figure(res, ls, cap):
     head = (f"{xa.name} = %{{x}}" + (f" {xa.unit}" if xa.unit else "") + f"<br>{ya.name} = %{{y}}"
             + (f" {ya.unit}" if ya.unit else ""))
     frames, cells, used = [], 0, {}
-    for flabel, f in sel.frames:
-        c = sel.slice(code, f)[np.ix_(yi, xi)]
-        its = sel.slice(ls.metrics["iterations"], f)[np.ix_(yi, xi)]
-        err = sel.slice(ls.metrics["error"], f)[np.ix_(yi, xi)]
+    for k_frame, (flabel, f) in enumerate(sel.frames):
+        lab, st = out["labels"][k_frame], out["status"][k_frame]
+        c = lab2code[np.where(lab >= 0, lab, n_sol)]
+        failed = np.isfinite(st) & (st != 0)
+        for code, k in status_class.items():
+            c[failed & (st == code)] = k
+        if unnamed is not None:
+            c[(st == 0) & (lab < 0)] = unnamed
+        its = drawn_cells(grid_source(ls, "iterations"), sel, f, s)
+        err = drawn_cells(grid_source(ls, "error"), sel, f, s)
         cls = names[np.where(np.isfinite(c), c, len(classes)).astype(int)]
+        frame_labels = out["frame_labels"][k_frame]
         for k in np.unique(c[np.isfinite(c)]).astype(int):
-            used[k] = used.get(k, 0) + int(np.sum(sel.slice(code, f) == k))
+            used[k] = used.get(k, 0) + _frame_count(k, named, other, frame_labels, out["frame_status"][k_frame],
+                                                     out["frame_unnamed"][k_frame], status_class, unnamed)
         custom = np.stack([cls, its, err], axis=-1).tolist()
         ctx = (f"<br>{esc(flabel)}" if flabel else "") + "".join(
             f"<br>{esc(value_text(ls.axes[d], sel.fixed[d]))}" for d in sel.held)
@@ -181,3 +165,24 @@ def basins_figure(res, ls, cap):
     if more:
         cap_text += " " + esc(more[0].upper() + more[1:]) + "."
     return {"data": data, "layout": layout}, cap_text + capped_note(sel, s, star=False), cells
+
+
+def _clusters(revolute):
+    """A labeler for scan: the final iterates clustered as they come (StreamClusters)."""
+    cl = StreamClusters(revolute, CLUSTER_TOLERANCE)
+    return lambda lo, hi, q: cl.label(q)
+
+
+def _frame_count(k, named, other, labels, status, unnamed_count, status_class, unnamed):
+    """How many cells of a frame have class k (the frame's counts of labels, failed codes, converged
+    runs without a solution)."""
+    if k < len(named):
+        return int(labels[named[k]]) if named[k] < len(labels) else 0
+    if other and k == len(named):
+        keep = np.ones(len(labels), dtype=bool)
+        keep[[n for n in named if n < len(labels)]] = False
+        return int(labels[keep].sum())
+    for code, kk in status_class.items():
+        if kk == k:
+            return int(status[code]) if code < len(status) else 0
+    return unnamed_count if k == unnamed else 0

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from kinesweep.grid_blocks import blocks, first_min, flat_start, frame_parts, grid_source, read_block, take_drawn
 from kinesweep.kinds import STATUS_COLOURS  # noqa: F401 (used below)
 from kinesweep.report_page import Rounded, esc, fmt
 
@@ -163,9 +164,13 @@ def colour_scale(values):
     """Linear or (for a positive range over more than two decades) log10 colour scale: returns
     (transform, zmin, zmax, colorbar ticks or None)."""
     finite = values[np.isfinite(values)]
-    if not finite.size:
+    return colour_scale_range(float(finite.min()), float(finite.max())) if finite.size else colour_scale_range()
+
+
+def colour_scale_range(lo=None, hi=None):
+    """colour_scale of values whose finite ones range from lo to hi (None: no finite value)."""
+    if lo is None:
         return (lambda v: v), 0.0, 1.0, None
-    lo, hi = float(finite.min()), float(finite.max())
     if lo > 0 and hi / lo > 100:
         vals = [m * 10.0 ** e for e in range(int(math.floor(math.log10(lo))), int(math.ceil(math.log10(hi))) + 1)
                 for m in (1, 2, 5) if lo <= m * 10.0 ** e <= hi]
@@ -174,42 +179,100 @@ def colour_scale(values):
     return (lambda v: v), lo, hi if hi > lo else lo + 1.0, None
 
 
+def best_cell(ls, metric):
+    """np.nanargmin's cell (an index per dim) of `metric` over the cells of good status, None when
+    none has a value: read a block at a time."""
+    status, values = grid_source(ls, "status_code"), grid_source(ls, metric)
+    best = None
+    for lo, hi in blocks(status.shape):
+        st = read_block(status, lo, hi)
+        v = np.where(st == 0, read_block(values, lo, hi), np.nan).ravel()
+        finite = np.isfinite(v)
+        if finite.any():
+            m = v[finite].min()
+            if best is None or m < best[0]:
+                best = (m, flat_start(lo, status.shape) + int(np.argmax(v == m)))
+    return np.unravel_index(best[1], status.shape) if best is not None else None
+
+
+def scan_landscape(ls, metric, sel, s, xi, yi):
+    """One pass over the landscape's grids, a block of cells at a time (kinesweep.grid_blocks): per
+    frame the drawn cells (every s-th of x and y) of the status, of `metric` where the status is good
+    and of every other metric, the counts of each status code and the smallest value (np.nanargmin's
+    cell); the range of the values over the frames; the metrics with a value in a good and in a failed
+    cell; whether a cell has no run. Memory: a few blocks and the drawn cells."""
+    others = [m for m in ls.metrics if m not in ls.status_grids()]
+    status = grid_source(ls, "status_code")
+    sources = {m: grid_source(ls, m) for m in others}
+    nf, shape = len(sel.frames), (len(yi), len(xi))
+    out = {"status": [np.full(shape, np.nan) for _ in range(nf)], "value": [np.full(shape, np.nan) for _ in range(nf)],
+           "sampled": {m: [np.full(shape, np.nan) for _ in range(nf)] for m in others},
+           "counts": [np.zeros(len(ls.statuses) + 1, dtype=np.int64) for _ in range(nf)], "best": [None] * nf,
+           "range": None, "good": set(), "failed": set(), "no_run": False}
+
+    def put(target, k, part, y0, x0):
+        cells, r, c = take_drawn(part, y0, x0, s)
+        target[k][r, c] = cells
+
+    for lo, hi in blocks(status.shape):
+        st = read_block(status, lo, hi)
+        good, finite_st = st == 0, np.isfinite(st)
+        failed = finite_st & ~good
+        out["no_run"] |= not finite_st.all()
+        for k, part, y0, x0 in frame_parts(sel, lo, hi, st):
+            put(out["status"], k, part, y0, x0)
+            codes = part[np.isfinite(part)].astype(np.int64)
+            n = np.bincount(codes, minlength=len(out["counts"][k]))
+            if len(n) > len(out["counts"][k]):
+                n[:len(out["counts"][k])] += out["counts"][k]
+                out["counts"][k] = n
+            else:
+                out["counts"][k] += n
+        for m in others:
+            g = read_block(sources[m], lo, hi)
+            finite = np.isfinite(g)
+            if m not in out["good"] and (finite & good).any():
+                out["good"].add(m)
+            if m not in out["failed"] and (finite & failed).any():  # the failed runs' metrics with values
+                out["failed"].add(m)
+            for k, part, y0, x0 in frame_parts(sel, lo, hi, g):
+                put(out["sampled"][m], k, part, y0, x0)
+            if m != metric:
+                continue
+            val = np.where(good, g, np.nan)
+            for k, part, y0, x0 in frame_parts(sel, lo, hi, val):
+                put(out["value"], k, part, y0, x0)
+                b = first_min(part, y0, x0)
+                if b is not None:
+                    out["best"][k] = b if out["best"][k] is None else min(out["best"][k], b)
+                    fin = part[np.isfinite(part)]
+                    lo_v, hi_v = float(fin.min()), float(fin.max())
+                    r = out["range"]
+                    out["range"] = (min(r[0], lo_v), max(r[1], hi_v)) if r else (lo_v, hi_v)
+    return out
+
+
 def landscape_figure(ls, cap):
     """The block's default metric (E; IK: iterations of converged runs) over the selected axes.
-    Returns (figure dict, caption html, cells drawn)."""
+    Returns (figure dict, caption html, cells drawn). The grids are read a block of cells at a time
+    (scan_landscape): the figure holds the drawn cells, not the grids."""
     if not ls.axes:
         return None
     metric = ls.objective
     if metric not in ls.metrics:
         metric = [m for m in ls.metrics if m not in ls.status_grids()][0]
-    status = ls.metrics["status_code"]
-    good = status == 0
-    val = np.where(good, ls.metrics[metric], np.nan)
-    best = np.unravel_index(np.nanargmin(val), val.shape) if np.isfinite(val).any() else None
-    sel = Selection(ls, best)
+    sel = Selection(ls, None)
+    if sel.held:  # dims held at the best cell: find it first
+        sel = Selection(ls, best_cell(ls, metric))
     xa, ya = ls.axes[sel.x], (ls.axes[sel.y] if sel.y is not None else None)
     s = sel.stride(cap)
     xi = np.arange(0, len(xa.values), s)
     yi = np.arange(0, len(ya.values), s) if ya is not None else np.array([0])
-    # One pass over the metric grids, each read once and let go (a grid not kept: kinesweep.read's
-    # lazy grids), keeping the drawn cells: memory is a few grids, not all of them.
-    fail_all = np.isfinite(status) & (status != 0)
-    read = getattr(ls.metrics, "read", ls.metrics.__getitem__)
-    sampled, hover_metrics, fail_metrics = {}, [], []
-    for m in ls.metrics:
-        if m in ls.status_grids():
-            continue
-        g = ls.metrics[m] if m == metric else read(m)
-        finite = np.isfinite(g)
-        if (finite & good).any():
-            hover_metrics.append(m)
-        if (finite & fail_all).any():  # the failed runs' metrics that have values (IK: iterations, error)
-            fail_metrics.append(m)
-        if m in hover_metrics or m in fail_metrics:
-            sampled[m] = [sel.slice(g, f)[np.ix_(yi, xi)] for _, f in sel.frames]
-        del g, finite
-    frames_val = [sel.slice(val, f) for _, f in sel.frames]
-    transform, zmin, zmax, ticks = colour_scale(np.concatenate([v.ravel() for v in frames_val]))
+    scan = scan_landscape(ls, metric, sel, s, xi, yi)
+    hover_metrics = [m for m in ls.metrics if m in scan["good"]]
+    fail_metrics = [m for m in ls.metrics if m in scan["failed"]]
+    sampled = scan["sampled"]
+    transform, zmin, zmax, ticks = colour_scale_range(*(scan["range"] or ()))
     statuses = ls.statuses
     unit = ls.units.get(metric, "")
     label = ls.label(metric) + (f" [{unit}]" if unit else "")
@@ -218,11 +281,11 @@ def landscape_figure(ls, cap):
     head = f"{xa.name} = {pos}" + (f"<br>{ya.name} = %{{y}}" + (f" {ya.unit}" if ya.unit else "") if ya else "")
     frames, failed_seen, cells = [], {}, 0
     dropdown = len(sel.frames) > MAX_FACETS  # then every frame carries its colour bar and legend entry
-    for k_frame, ((flabel, f), v) in enumerate(zip(sel.frames, frames_val)):
+    for k_frame, (flabel, f) in enumerate(sel.frames):
         ctx = (f"<br>{esc(flabel)}" if flabel else "") + "".join(
             f"<br>{esc(value_text(ls.axes[d], sel.fixed[d]))}" for d in sel.held)
-        st = sel.slice(status, f)[np.ix_(yi, xi)]
-        z = v[np.ix_(yi, xi)]
+        st = scan["status"][k_frame]
+        z = scan["value"][k_frame]
         custom = hover_data([sampled[m][k_frame] for m in hover_metrics], np.isfinite(z))
         tmpl = head + ctx + "".join(f"<br>{m} = %{{customdata[{k}]:.5g}}" + (f" {ls.units[m]}" if ls.units[m] else "")
                                     for k, m in enumerate(hover_metrics)) + f"<br>status {statuses[0]}<extra></extra>"
@@ -237,7 +300,7 @@ def landscape_figure(ls, cap):
         fm = fail_metrics if codes else []
         fvals = [sampled[m][k_frame] for m in fm]
         for c in codes:  # one trace per failed status: its name in the hover text, not in every cell
-            failed_seen[c] = failed_seen.get(c, 0) + int(np.sum(sel.slice(status, f) == c))
+            failed_seen[c] = failed_seen.get(c, 0) + int(scan["counts"][k_frame][c])
             cells_c = fail == c
             ftmpl = head + ctx + f"<br>status {esc(statuses[c])}" + "".join(
                 f"<br>{m} = %{{customdata[{k}]:.5g}}" + (f" {ls.units[m]}" if ls.units[m] else "")
@@ -246,15 +309,16 @@ def landscape_figure(ls, cap):
                            "customdata": hover_data(fvals, cells_c) if fm else None,
                            "zmin": 0, "zmax": max(1, len(statuses) - 1), "colorscale": _steps(statuses),
                            "showscale": False, "hoverongaps": False, "name": statuses[c], "hovertemplate": ftmpl})
-        if np.isfinite(v).any():
-            i, j = np.unravel_index(np.nanargmin(v), v.shape)
+        best = scan["best"][k_frame]
+        if best is not None:
+            v, i, j = best
             bx = axis_values(xa, [j])[0]
             by = axis_values(ya, [i])[0] if ya is not None else ""
             traces.append({"type": "scatter", "x": [bx], "y": [by], "mode": "markers", "name": "best cell",
                            "showlegend": dropdown or not frames, "legendgroup": "best",
                            "marker": {"symbol": "star", "size": 16, "color": "#ff3030",
                                       "line": {"color": "white", "width": 1.5}},
-                           "hovertemplate": f"best cell: {metric} = {fmt(v[i, j], 6)} {unit}<extra></extra>"})
+                           "hovertemplate": f"best cell: {metric} = {fmt(v, 6)} {unit}<extra></extra>"})
         cells += z.size
         frames.append((flabel, traces))
     if ya is None:  # a 1-D landscape: a one-row strip
@@ -274,7 +338,7 @@ def landscape_figure(ls, cap):
     if failed_seen:
         parts.append("Failed cells in their status colours: "
                      + ", ".join(f"{statuses[c]} {n}" for c, n in sorted(failed_seen.items())) + ".")
-    if np.isnan(status).any():
+    if scan["no_run"]:
         parts.append("White cells: no run.")
     more = sel.caption()
     if more:

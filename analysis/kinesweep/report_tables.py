@@ -69,23 +69,49 @@ class RunsView:
         return v
 
     def chunks(self, c, rows, size=SCAN_ROWS):
-        """Column c at ascending `rows`, as values() gives them, a piece at a time: each piece the rows
-        within `size` consecutive rows of the file, read as one slice (memory: one slice)."""
+        """Column c at ascending `rows` (or a BlockRows), as values() gives them, a piece at a time:
+        each piece the rows within `size` consecutive rows of the file, read as one slice (memory: one
+        slice)."""
         d = self.g[c]
-        rows = np.asarray(rows, dtype=np.int64)
         text = enum_labels(d) is not None or d.dtype.kind in "OSU"
         deg = self.units.get(c) == "deg"
+        if isinstance(rows, BlockRows):
+            for a, idx in rows.slices(size):
+                if len(idx):
+                    yield self._convert(d, d[a + int(idx[0]):a + int(idx[-1]) + 1][idx - idx[0]], text, deg)
+            return
+        rows = np.asarray(rows, dtype=np.int64)
         lo = 0
         while lo < len(rows):
             start = int(rows[lo])
             hi = int(np.searchsorted(rows, start + size))
-            v = d[start:int(rows[hi - 1]) + 1][rows[lo:hi] - start]
-            if text:
-                v = text_values(d, v)
-            elif deg and v.dtype.kind == "f":
-                v = v * RAD2DEG
-            yield v
+            yield self._convert(d, d[start:int(rows[hi - 1]) + 1][rows[lo:hi] - start], text, deg)
             lo = hi
+
+    @staticmethod
+    def _convert(d, v, text, deg):
+        if text:
+            return text_values(d, v)
+        return v * RAD2DEG if deg and v.dtype.kind == "f" else v
+
+    def column(self, c, rows):
+        """Column c at ascending `rows` read a slice at a time (chunks), as one array."""
+        parts = list(self.chunks(c, rows))
+        return np.concatenate(parts) if parts else self.values(c, rows)
+
+    def status_counts(self):
+        """(runs per block code, done runs per block code and status code): counted a slice of the
+        file at a time (no index of every row)."""
+        if getattr(self, "_status_counts", None) is None:
+            nb, ns = len(self.block_labels), len(self.status_labels)
+            every, done = np.zeros(nb, dtype=np.int64), np.zeros(nb * ns, dtype=np.int64)
+            for a in range(0, self.n, SCAN_ROWS):
+                b = self.block_codes[a:a + SCAN_ROWS].astype(np.int64)
+                every += np.bincount(b, minlength=nb)
+                d = self.done[a:a + SCAN_ROWS]
+                done += np.bincount(b[d] * ns + self.status_codes[a:a + SCAN_ROWS][d], minlength=nb * ns)
+            self._status_counts = every, done.reshape(nb, ns)
+        return self._status_counts
 
     def value(self, c, row):
         return self.values(c, [row])[0]
@@ -103,8 +129,8 @@ class RunsView:
 
     def kind(self, block):
         """The run kind of the block's runs (of its first done row; a block's runs are of one kind)."""
-        rows = self.rows(block)
-        k = self.row_kind(rows[0]) if len(rows) else ""
+        first = BlockRows(self, block, count=False).first
+        k = self.row_kind(first) if first is not None else ""
         if k:
             return k
         k = self.res.run_kinds()
@@ -115,24 +141,77 @@ class RunsView:
         trajectory by E, IK by iterations then error); ties by run id. Returns (row indices, the
         ranking metric names, how many rows the whole ranking has). limit: the first `limit` rows of
         it only (sorted among the rows whose first key is at most the limit-th smallest: the same
-        rows, without sorting them all)."""
+        rows, without sorting them all; found a slice of the file at a time, keeping those rows)."""
         meaning = self.res.kind_meaning(self.kind(block))
         keys = [k for k in meaning.get("ranking", []) if k in self.g]
-        rows = self.rows(block)
         good = [i for i, s in enumerate(self.status_labels) if s in meaning.get("good_statuses", [])]
-        rows = rows[np.isin(self.status_codes[rows], good)]
-        total = len(rows)
 
         def key(k, rows):
-            return np.nan_to_num(np.asarray(self.values(k, rows), dtype=float), nan=np.inf)
+            return np.nan_to_num(np.asarray(self.column(k, rows), dtype=float), nan=np.inf)
 
-        first = key(keys[0], rows) if keys else None
-        if limit is not None and keys and total > limit:
-            cut = np.partition(first, max(limit, 1) - 1)[max(limit, 1) - 1]
-            keep = first <= cut
-            rows, first = rows[keep], first[keep]  # the other keys are read for these rows only
-        cols = [rows] + [key(k, rows) for k in reversed(keys[1:])] + ([first] if keys else [])
-        return rows[np.lexsort(cols)][:limit], keys, total
+        if limit is None or not keys:
+            rows = self.rows(block)
+            rows = rows[np.isin(self.status_codes[rows], good)]
+            total = len(rows)
+            first = key(keys[0], rows) if keys else None
+            cols = [rows] + [key(k, rows) for k in reversed(keys[1:])] + ([first] if keys else [])
+            return rows[np.lexsort(cols)][:limit], keys, total
+        # the best `limit` by the whole ranking, kept from slice to slice (it is a total order)
+        m, best, total = max(limit, 1), None, 0
+        for a, idx in BlockRows(self, block, count=False).slices():
+            idx = a + idx[np.isin(self.status_codes[a + idx], good)]
+            total += len(idx)
+            if not len(idx):
+                continue
+            f = key(keys[0], idx)
+            if best is not None and len(best[0]) >= m:  # none past the kept rows' largest first key enters
+                keep = f <= best[-1].max()
+                idx, f = idx[keep], f[keep]
+                if not len(idx):
+                    continue
+            cols = [idx] + [key(k, idx) for k in reversed(keys[1:])] + [f]
+            if best is not None:
+                cols = [np.concatenate([b, c]) for b, c in zip(best, cols)]
+            best = [c[np.lexsort(cols)[:m]] for c in cols]
+        return (best[0] if best else np.zeros(0, dtype=np.int64))[:limit], keys, total
+
+
+class BlockRows:
+    """A block's rows (its done ones, or all), found a slice of the file at a time: len(), rows[0] and
+    rows[:k], and RunsView.chunks over them, without an index of every row."""
+
+    def __init__(self, view, block, done=True, count=True):
+        self.view, self.code, self.done = view, view.block_labels.index(block), done
+        self.n, self.first = 0, None
+        for a, idx in self.slices():
+            if self.first is None and len(idx):
+                self.first = a + int(idx[0])
+                if not count:
+                    break
+            self.n += len(idx)
+
+    def slices(self, size=SCAN_ROWS):
+        v = self.view
+        for a in range(0, v.n, size):
+            m = v.block_codes[a:a + size] == self.code
+            if self.done:
+                m &= v.done[a:a + size]
+            yield a, np.flatnonzero(m)
+
+    def __len__(self):
+        return self.n
+
+    def __getitem__(self, k):
+        if k == 0 and self.first is not None:
+            return self.first
+        if isinstance(k, slice) and k.start in (None, 0) and k.step in (None, 1) and k.stop is not None:
+            out = []
+            for a, idx in self.slices():
+                out += (a + idx[:k.stop - len(out)]).tolist()
+                if len(out) >= k.stop:
+                    break
+            return np.array(out, dtype=np.int64)
+        raise IndexError(k)
 
 
 def metadata_section(res, view):
@@ -160,19 +239,20 @@ def status_section(view):
     statuses = []
     for kind in view.res.run_kinds():
         statuses += [s for s in view.res.kind_meaning(kind).get("statuses", []) if s not in statuses]
-    present = {view.status_labels[c] for c in np.unique(view.status_codes[view.done])}
+    present = {view.status_labels[c] for c in np.flatnonzero(view.status_counts()[1].sum(axis=0))}
     extra = sorted(s for s in present if s not in statuses and s)
     shown = [s for s in statuses if s in present] + extra
     columns = [("block", ""), ("kind", ""), ("runs", ""), ("done", "")] + [(s, "") for s in shown] + [("not done", "")]
     rows = []
+    every, done = view.status_counts()
     for b in view.block_names:
-        all_rows, done_rows = view.rows(b, done=False), view.rows(b)
-        count = np.bincount(view.status_codes[done_rows], minlength=len(view.status_labels))
+        code = view.block_labels.index(b)
+        count = done[code]
         by_name = {}
-        for code, k in enumerate(count):
-            by_name[view.status_labels[code]] = by_name.get(view.status_labels[code], 0) + int(k)
-        rows.append([b, view.kind(b), len(all_rows), len(done_rows)] + [by_name.get(s, 0) for s in shown]
-                    + [len(all_rows) - len(done_rows)])
+        for c, k in enumerate(count):
+            by_name[view.status_labels[c]] = by_name.get(view.status_labels[c], 0) + int(k)
+        n_all, n_done = int(every[code]), int(count.sum())
+        rows.append([b, view.kind(b), n_all, n_done] + [by_name.get(s, 0) for s in shown] + [n_all - n_done])
     good = " and ".join(f"{'/'.join(view.res.kind_meaning(k).get('good_statuses', []))} ({k})"
                         for k in view.res.run_kinds())
     good = f"{good} are the successful statuses." if good else ""
@@ -240,7 +320,7 @@ def best_section(view, n_best):
     parts = []
     for b in view.block_names:
         top, keys, n_ranked = view.ranked(b, limit=n_best)
-        rows_done = view.rows(b)
+        rows_done = BlockRows(view, b)
         if not len(rows_done):
             continue
         kind = view.kind(b)
