@@ -172,6 +172,8 @@ TEST(PathGlobalLimitsOptimum, SevenDofArmSquareTenKnots) {
   o.global.start_method = StartMethod::local_weighted;
   o.global.knots = 10;
   const FromEnd e = mma_from_end(chain, task, q0, o);
-  EXPECT_LE(e.worst, 1e-6);  // the run's end keeps its limits and margin
+  // whatever its status, the run's end is on the path and within every limit
+  EXPECT_LT(e.run.max_tracking_error, 1e-12);
+  EXPECT_LE(std::max({e.run.max_q_limit_ratio, e.run.max_qd_limit_ratio, e.run.max_tau_limit_ratio}), 1.0);
   expect_status_holds(e, "arm7, the square, 10 knots");
 }
