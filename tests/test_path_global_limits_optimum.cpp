@@ -1,9 +1,10 @@
-// A path-global run on a chain under the robot's limits is `ok` only where an independent optimiser
-// cannot improve it: NLopt's MMA (method of moving asymptotes: its own conservative convex
-// approximations, no quasi-Newton model), started from the run's coefficients on the same objective
-// and limit constraints, lowers E by no more than 1e-4 relative within the limits, or the run is not
-// reported ok. A 4R whose unconstrained optimum crosses a joint limit, and the 7-DOF arm's square of
-// studies/path_global_arm7.toml at 10 knots (its global block), where SLSQP stalls.
+// A path-global run on a chain under the robot's limits is `ok` only where another optimiser cannot
+// improve it: NLopt's MMA (method of moving asymptotes: conservative convex approximations, no
+// quasi-Newton model), started from the run's coefficients on the same objective with the limits as
+// constraints (one per window of samples and limited quantity), lowers E by no more than 1e-4
+// relative within them, or the run is not reported ok. A 4R whose unconstrained optimum crosses a
+// joint limit, and the 7-DOF arm's square of studies/path_global_arm7.toml at 10 knots (its global
+// block), where SLSQP with those constraints stalled 11 % above the optimum.
 #include <gtest/gtest.h>
 
 #include <nlopt.hpp>
@@ -172,8 +173,8 @@ TEST(PathGlobalLimitsOptimum, SevenDofArmSquareTenKnots) {
   o.global.start_method = StartMethod::local_weighted;
   o.global.knots = 10;
   const FromEnd e = mma_from_end(chain, task, q0, o);
-  // whatever its status, the run's end is on the path and within every limit
-  EXPECT_LT(e.run.max_tracking_error, 1e-12);
+  EXPECT_EQ(e.run.status, RunStatus::ok) << to_string(e.run.status);
+  EXPECT_GE(e.run.opt_active_limits, 1.0);
   EXPECT_LE(std::max({e.run.max_q_limit_ratio, e.run.max_qd_limit_ratio, e.run.max_tau_limit_ratio}), 1.0);
   expect_status_holds(e, "arm7, the square, 10 knots");
 }

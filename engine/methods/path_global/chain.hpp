@@ -49,7 +49,11 @@ struct LimitConstraints {
   LimitTable table;
   std::vector<std::size_t> window_end;  ///< one past the last sample of each window
   std::vector<std::array<int, 2>> rows;  ///< the limited quantities: {0 position, 1 velocity, 2 effort; joint}
-  double margin = 1e-4;  // room for SLSQP's constraint tolerance and the peaks between samples
+  /// each ratio is kept <= 1 - margin at the samples: room for the peaks between them (the dense check)
+  double margin = 1e-3;
+  /// > 0: no constraints; the objective gains penalty / samples times the sum over every sample and
+  /// quantity of its excess over 1 - margin, squared (smooth: each sample's own ratio)
+  double penalty = 0.0;
 
   unsigned count() const { return static_cast<unsigned>(window_end.size() * rows.size()); }
   /// The limits of `chain` over `samples` samples cut into `windows` windows (none: count() = 0).

@@ -1,7 +1,8 @@
 // solve_global_spline_chain (methods/path_global/chain.hpp): the start from the chain's local run,
-// the extension, the SLSQP solve over every coordinate's spline with the robot's limits as
-// constraints, and the final measure.
+// the extension, the SLSQP solve over every coordinate's spline with the robot's limits as a
+// penalty (or constraints), and the final measure.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -19,6 +20,11 @@
 namespace ks {
 namespace {
 
+constexpr double kFirstPenalty = 10.0;  // the penalty's first weight: this times the objective over the penalty
+constexpr double kPenaltyGrowth = 1e9;  // the largest weight over the first
+constexpr double kPenaltyStep = 10.0;   // each weight over the last
+constexpr double kPenaltyStall = 0.5;  // a level that leaves more than this of the last one's excess ends it
+constexpr double kPenaltyExcess = 0.1;  // the largest excess accepted at a penalty's end, over the margin
 constexpr int kMaxRestarts = 2;    // SLSQP's restarts from its end under the limit constraints
 constexpr int kDescentSteps = 30;  // steps of the steepest-descent check, each half the last
 constexpr double kFirstStep = 0.1; // [rad]: the first step's largest change of a coefficient
@@ -154,13 +160,15 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
   // one pass gives the objective, the constraints and both gradients: NLopt asks for them in turn at each point
   std::vector<double> cached_x, con(rows), jac(static_cast<std::size_t>(rows) * c.size());
   double cached_f = 0.0;
-  bool constrained = false;
+  // the limits the objective evaluates: none, as constraints (limits), or as a penalty (penalised)
+  LimitConstraints penalised;
+  const LimitConstraints* bound_by = nullptr;
   const auto evaluate = [&](const double* xs) {
     if (!cached_x.empty() && std::equal(cached_x.begin(), cached_x.end(), xs)) return;
-    cached_f = solving->objective(*solving_basis, at(xs), g.objective, grad.data(), constrained ? &limits : nullptr,
-                                  con.data(), jac.data());
+    cached_f = solving->objective(*solving_basis, at(xs), g.objective, grad.data(), bound_by, con.data(), jac.data());
     cached_x.assign(xs, xs + free.size());
   };
+  const auto bind = [&](const LimitConstraints* by) { bound_by = by, cached_x.clear(); };
   SlsqpSpec spec;
   spec.bound = bound;
   spec.tolerance = g.tolerance;
@@ -201,48 +209,95 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
     }
     return false;
   };
-  // without the limits first; when the optimum leaves them, again from the start with the limits as
-  // constraints (SLSQP from a point beyond them may not get back within them)
+  // the first weight of the limits' penalty (each sample's excess over 1 - margin, squared), from x,
+  // the unconstrained optimum: kFirstPenalty times the objective there over the penalty there at
+  // weight 1 (or over 1, if that is larger: an optimum far beyond the limits)
+  const auto first_penalty = [&]() {
+    bind(nullptr);
+    evaluate(x.data());
+    const double f_x = cached_f;
+    penalised = limits;
+    penalised.penalty = 1.0;
+    bind(&penalised);
+    evaluate(x.data());
+    return kFirstPenalty * std::max(std::abs(f_x), 1e-12) / std::clamp(cached_f - f_x, 1e-300, 1.0);
+  };
+  // the penalty continuation from x: the weight grows tenfold from first, each SLSQP solve from the
+  // last one's end (a level SLSQP ends short of its tolerance leaves its best point to the next),
+  // until the end keeps every limit within the margin but kPenaltyExcess of it (true; status: the
+  // last solve's). False when a level leaves more than kPenaltyStall of the last one's excess, the
+  // weight reaches kPenaltyGrowth times the first, or the phase's budget runs out
+  const auto penalty = [&](double first, RunStatus& status) {
+    const long begun = evaluations;
+    penalised = limits;
+    double last = std::numeric_limits<double>::infinity();  // the last level's largest constraint
+    for (double mu = first; mu <= first * kPenaltyGrowth; mu *= kPenaltyStep) {
+      const long left = g.max_evaluations - (evaluations - begun);
+      if (left <= 0) return status = RunStatus::max_evaluations, false;
+      penalised.penalty = mu;
+      bind(&penalised);
+      spec.max_evaluations = left;
+      status = minimise_slsqp(spec, x);
+      bind(&limits);
+      if (status == RunStatus::interrupted || status == RunStatus::max_evaluations) return false;
+      evaluate(x.data());
+      const double worst = *std::ranges::max_element(con);
+      if (worst <= kPenaltyExcess * limits.margin) return true;
+      if (!(worst <= kPenaltyStall * last)) return status = RunStatus::not_converged, false;
+      last = worst;
+    }
+    return false;
+  };
+  // without the limits first; when the optimum leaves them, the limits as a penalty from there, and
+  // when that does not end within them (an optimum far beyond them, near a singularity of the
+  // extension), from the start; when neither does, again from the start with the limits as
+  // constraints, one per window of samples and limited quantity. Each phase has the whole budget.
   const auto solve = [&](std::vector<double> from) {
-    const long begun = evaluations;  // each solve has the whole budget
-    constrained = false;
-    cached_x.clear();
+    bind(nullptr);
     spec.constraints = 0;
     spec.max_evaluations = g.max_evaluations;
     x = from;
     RunStatus status = minimise_slsqp(spec, x);
-    if (status == RunStatus::interrupted) return status;
-    if (rows > 0 && evaluations - begun < g.max_evaluations) {
-      solving->objective(*solving_basis, at(x.data()), g.objective, nullptr, &limits, con.data(), nullptr);
-      if (std::ranges::any_of(con, [](double v) { return !(v <= 0.0); })) {
-        constrained = true;
-        cached_x.clear();
-        spec.constraints = rows;
-        spec.max_evaluations = g.max_evaluations - (evaluations - begun);
-        x = from;
-        status = minimise_slsqp(spec, x);
-        // SLSQP can stall on these constraints (their gradients jump where a window's largest sample
-        // changes, which spoils its quasi-Newton model): it is restarted from its end with a fresh
-        // model while a restart lowers the objective by more than the tolerance within the limits;
-        // a run whose last restart still did is not_converged
-        for (int restart = 0; status == RunStatus::ok; ++restart) {
-          const long left = g.max_evaluations - (evaluations - begun);
-          if (left <= 0) break;
-          evaluate(x.data());
-          const double f_end = cached_f, worst_end = *std::ranges::max_element(con);
-          std::vector<double> y = x;
-          spec.max_evaluations = left;
-          const RunStatus again = minimise_slsqp(spec, y);
-          if (again == RunStatus::interrupted) return again;
-          evaluate(y.data());
-          const double worst = *std::ranges::max_element(con);
-          if (!(f_end - cached_f > g.tolerance * std::abs(f_end)) || !(worst <= std::max(worst_end, 0.0))) break;
-          x = y, status = again;
-          if (restart + 1 == kMaxRestarts) status = RunStatus::not_converged;
-        }
+    if (status == RunStatus::interrupted || status == RunStatus::max_evaluations || rows == 0) return status;
+    bind(&limits);
+    evaluate(x.data());
+    if (std::ranges::all_of(con, [](double v) { return v <= 0.0; })) return status;
+    const double first = first_penalty();
+    const std::vector<double> unconstrained = x;
+    for (const std::vector<double>* origin : std::array<const std::vector<double>*, 2>{&unconstrained, &from}) {
+      x = *origin;
+      if (penalty(first, status)) {
         if (status == RunStatus::ok && descends()) status = RunStatus::not_converged;
+        return status;
       }
+      if (status == RunStatus::interrupted) return status;
     }
+    const long begun = evaluations;
+    bind(&limits);
+    spec.constraints = rows;
+    spec.max_evaluations = g.max_evaluations;
+    x = from;
+    status = minimise_slsqp(spec, x);
+    // SLSQP can stall on these constraints (their gradients jump where a window's largest sample
+    // changes, which spoils its quasi-Newton model): it is restarted from its end with a fresh
+    // model while a restart lowers the objective by more than the tolerance within the limits;
+    // a run whose last restart still did is not_converged
+    for (int restart = 0; status == RunStatus::ok; ++restart) {
+      const long left = g.max_evaluations - (evaluations - begun);
+      if (left <= 0) break;
+      evaluate(x.data());
+      const double f_end = cached_f, worst_end = *std::ranges::max_element(con);
+      std::vector<double> y = x;
+      spec.max_evaluations = left;
+      const RunStatus again = minimise_slsqp(spec, y);
+      if (again == RunStatus::interrupted) return again;
+      evaluate(y.data());
+      const double worst = *std::ranges::max_element(con);
+      if (!(f_end - cached_f > g.tolerance * std::abs(f_end)) || !(worst <= std::max(worst_end, 0.0))) break;
+      x = y, status = again;
+      if (restart + 1 == kMaxRestarts) status = RunStatus::not_converged;
+    }
+    if (status == RunStatus::ok && descends()) status = RunStatus::not_converged;
     return status;
   };
   const std::vector<double> x_start = x;
