@@ -1,6 +1,7 @@
 // The path-global method with joint coordinates (any chain): the joint path is on the task path and
 // its rates and accelerations are its time derivatives (central differences in time); the objective's
-// gradient and the limit constraints' Jacobian match finite differences; the 7-DOF arm's global run
+// gradient, the limit constraints' Jacobian and the limits' penalty's gradient match finite
+// differences; the 7-DOF arm's global run
 // is on its path, within its limits and below its local run; a limit the unconstrained optimum
 // crosses is kept by the constrained one; the KKT residual is the non-negative least-squares optimum.
 #include <gtest/gtest.h>
@@ -141,6 +142,38 @@ TEST(PathGlobalJoints, GradientAndLimitJacobianMatchFiniteDifferences) {
       EXPECT_NEAR(jac[row * size + v], cd, 1e-5 * std::max(1.0, std::abs(cd))) << "constraint " << row << ", variable " << v;
     }
   }
+}
+
+// The limits as a penalty (LimitConstraints::penalty): the objective gains penalty / N times the
+// squared excess of every sample's ratios over 1 - margin; its gradient matches central differences.
+// The margin is widened to 0.6 so that many samples and quantities are penalised.
+TEST(PathGlobalJoints, PenaltyGradientMatchesFiniteDifferences) {
+  const Chain chain = arm7();
+  const ChainTask task(TaskSpace::spatial_position, arm7_path(1), 1e-2);
+  const VecN q = start_on(chain, task, arm7_guess());
+  const JointExtensionProblem p(chain, task, {0, 1, 3}, q);
+  const int K = 5, size = K * p.coordinates();
+  const AlphaBasis b = cubic_spline_basis(task.path.size(), 1e-2, 2.0, K);
+  const std::vector<double> c = near_start(p, q, K, 0.1);
+  LimitConstraints penalty = LimitConstraints::of(chain, p.samples(), K);
+  penalty.margin = 0.6;
+  penalty.penalty = 50.0;
+  std::vector<double> grad(size), plain(size);
+  const double f = p.objective(b, c.data(), GlobalObjective::E, grad.data(), &penalty);
+  const double e = p.objective(b, c.data(), GlobalObjective::E, plain.data());
+  std::printf("E %.6f, with the penalty %.6f\n", e, f);
+  ASSERT_GT(f - e, 0.01 * e);  // the penalty is active
+  const double h = 1e-6;
+  double differs = 0.0;  // the penalty's share of the gradient
+  for (int v = 0; v < size; ++v) {
+    std::vector<double> up = c, down = c;
+    up[v] += h, down[v] -= h;
+    const double fd = (p.objective(b, up.data(), GlobalObjective::E, nullptr, &penalty) -
+                       p.objective(b, down.data(), GlobalObjective::E, nullptr, &penalty)) / (2 * h);
+    EXPECT_NEAR(grad[v], fd, 1e-5 * std::max(1.0, std::abs(fd))) << v;
+    differs = std::max(differs, std::abs(grad[v] - plain[v]));
+  }
+  EXPECT_GT(differs, 0.1);
 }
 
 // The first side of arm7_square's square from its best local run's start: the global run ends on its
