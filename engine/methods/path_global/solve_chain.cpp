@@ -211,7 +211,8 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
   };
   // the first weight of the limits' penalty (each sample's excess over 1 - margin, squared), from x,
   // the unconstrained optimum: kFirstPenalty times the objective there over the penalty there at
-  // weight 1 (or over 1, if that is larger: an optimum far beyond the limits)
+  // weight 1, taken within [1e-12, 1] (1: an optimum far beyond the limits; 1e-12: excess only at
+  // samples off the extension, which the penalty leaves to the objective's own floor)
   const auto first_penalty = [&]() {
     bind(nullptr);
     evaluate(x.data());
@@ -220,7 +221,7 @@ TrajectoryMetrics solve_global_spline_chain(const Chain& chain, const ChainTask&
     penalised.penalty = 1.0;
     bind(&penalised);
     evaluate(x.data());
-    return kFirstPenalty * std::max(std::abs(f_x), 1e-12) / std::clamp(cached_f - f_x, 1e-300, 1.0);
+    return kFirstPenalty * std::max(std::abs(f_x), 1e-12) / std::clamp(cached_f - f_x, 1e-12, 1.0);
   };
   // the penalty continuation from x: the weight grows tenfold from first, each SLSQP solve from the
   // last one's end (a level SLSQP ends short of its tolerance leaves its best point to the next),
