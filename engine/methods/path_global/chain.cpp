@@ -10,6 +10,7 @@
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 #include "common/angles.hpp"
 
@@ -101,7 +102,7 @@ double ChainGlobalProblem::objective(const AlphaBasis& basis, const double* c, G
   // a penalty instead of constraints: every sample's excess of each limited quantity, squared
   const bool penalised = limits && limits->penalty > 0.0;
   const double weight = penalised ? limits->penalty / static_cast<double>(samples()) : 0.0;
-  std::vector<std::array<double, 2>> excess;  // {quantity, excess} of this sample
+  std::vector<std::pair<std::size_t, double>> excess;  // {quantity, excess} of this sample
   const std::size_t P = limits && !penalised ? limits->rows.size() : 0, rows = P > 0 ? limits->count() : 0;
   if (grad) std::fill(grad, grad + static_cast<std::ptrdiff_t>(K) * r, 0.0);
   // per constraint: the largest ratio so far, its sample and the ratio's partials there (z, zd, zdd of each coordinate)
@@ -124,7 +125,7 @@ double ChainGlobalProblem::objective(const AlphaBasis& basis, const double* c, G
     if (penalised && !(s.violation > 0.0))
       for (std::size_t p = 0; p < limits->rows.size(); ++p) {
         const double v = ratio(*limits, limits->rows[p], s) - (1.0 - limits->margin);
-        if (v > 0.0) f += weight * v * v, excess.push_back({static_cast<double>(p), v});
+        if (v > 0.0) f += weight * v * v, excess.emplace_back(p, v);
       }
     if (P > 0) {
       while (limits->window_end[window] <= i) ++window;
@@ -140,7 +141,7 @@ double ChainGlobalProblem::objective(const AlphaBasis& basis, const double* c, G
       for (const auto& [p, v] : excess)
         for (int input = 0; input < width; ++input)
           exact.cost[input] += 2.0 * weight * v *
-                               ratio_partial(*limits, limits->rows[static_cast<std::size_t>(p)], s, exact, input);
+                               ratio_partial(*limits, limits->rows[p], s, exact, input);
       for (int k = 0; k < r; ++k)
         for (int d = 0; d < 3; ++d) {
           const int input = 3 * k + d;
@@ -167,7 +168,7 @@ double ChainGlobalProblem::objective(const AlphaBasis& basis, const double* c, G
         if (grad) {
           double dfdz = (f_up - f_down) / (2.0 * h);
           for (const auto& [p, v] : excess) {
-            const auto& lim = limits->rows[static_cast<std::size_t>(p)];
+            const auto& lim = limits->rows[p];
             dfdz += 2.0 * weight * v * (ratio(*limits, lim, up) - ratio(*limits, lim, down)) / (2.0 * h);
           }
           for (int m = 0; m < kBasisWidth && brow.first + m < K; ++m) grad[k * K + brow.first + m] += dfdz * brow.w[d][m];
