@@ -149,7 +149,9 @@ def main(argv=None):
     xv = np.arange(len(xa.values)) if xa.categorical else xa.values
     yv = np.arange(len(ya.values)) if ya.categorical else ya.values
     dx, dy = d["centres"]
-    X, Y = np.meshgrid(*d["edges"])
+    # the cells as an image in a PNG on linear axes (drawn at the picture's pixels), else one
+    # quadrilateral each (vector cells in SVG; log axes)
+    image = not xlog and not ylog and not ksplot.output_path(args, "landscape").lower().endswith(".svg")
     any_finite = d["finite"]  # one colour scale for every panel
     vmin = args.vmin if args.vmin is not None else (d["vmin"] if any_finite else 0.0)
     vmax = args.vmax if args.vmax is not None else (d["vmax"] if any_finite else 1.0)
@@ -173,7 +175,7 @@ def main(argv=None):
     for p in range(n):
         ax, z, cat = axs.flat[p], Z[p], CAT[p]
         has_values = d["best"][p] is not None
-        mesh = ax.pcolormesh(X, Y, np.ma.masked_invalid(z), cmap=cmap, norm=norm, shading="flat")
+        mesh = ksplot.cells(ax, *d["edges"], np.ma.masked_invalid(z), image, cmap=cmap, norm=norm)
         # Failed cells in their own colours (counted over the full grid).
         handles = []
         counts = d["counts"][p]
@@ -187,8 +189,8 @@ def main(argv=None):
             if d["no_run"][p]:
                 handles.append(Patch(facecolor="#ffffff", edgecolor="0.3", label="no run"))
             c = np.where(cat == -2, len(statuses), cat).astype(float)
-            ax.pcolormesh(X, Y, np.ma.masked_less(c, 0), cmap=ListedColormap(colours),
-                          vmin=-0.5, vmax=len(statuses) + 0.5, shading="flat")
+            ksplot.cells(ax, *d["edges"], np.ma.masked_less(c, 0), image, cmap=ListedColormap(colours),
+                         vmin=-0.5, vmax=len(statuses) + 0.5)
         if len(levels) and has_values:
             cs = ax.contour(dx, dy, np.ma.masked_invalid(z), levels=levels, colors="white", linewidths=0.7, alpha=0.8)
             ax.clabel(cs, fmt=lambda v: f"{v:g}", fontsize=7, inline=True)
@@ -237,7 +239,7 @@ def main(argv=None):
     sub = "; ".join(d["notes"] + ([f"one panel per {d['facet']}"] if d["facet"] else []))
     title = args.title or (f"{what} over {xa.name} × {ya.name} — block {ls.block}{(' (' + sub + ')') if sub else ''}"
                            f"\n{os.path.basename(args.file)}{' (log colour scale)' if args.log else ''}")
-    (fig.suptitle if n > 1 else axs.flat[0].set_title)(title, fontsize=10)
+    (fig.suptitle if n > 1 else axs.flat[0].set_title)(ksplot.fit_title(title, fig, 10), fontsize=10)
     for pan in panels:  # the failed cells' statuses by name: printed data only (a list per cell)
         cat = pan.pop("cat")
         if args.print_data:

@@ -43,6 +43,17 @@ def agg_figure(size, **kw):
     return fig
 
 
+def cells(ax, xedges, yedges, z, image, **kw):
+    """Draw the rectangular cells of z (rows along y, columns along x) between the 1-D edges with the
+    colour keywords kw; returns the mappable. image: as a picture resampled to the output's pixels
+    (pcolorfast: one image, however many cells; linear axes only), else one quadrilateral per cell
+    (pcolormesh: vector cells in SVG, any axis scale)."""
+    if image:
+        return ax.pcolorfast(xedges, yedges, z, **kw)
+    X, Y = np.meshgrid(xedges, yedges)
+    return ax.pcolormesh(X, Y, z, shading="flat", **kw)
+
+
 def output_path(args, suffix):
     out = args.output
     if not out:
@@ -106,6 +117,14 @@ def axis_label(name, unit):
     if name.startswith("q0_") and name[3:].isdigit() and unit:  # an initial guess, named by its joint's unit
         pretty = f"{joint_symbol(name, unit)} initial guess ({name})"
     return f"{pretty} [{unit}]" if unit else pretty
+
+
+def fit_title(text, fig, fontsize):
+    """text with each line longer than the figure is wide broken at spaces (a character taken as
+    0.6 of the font size): a title set on one line is clipped at the picture's edges."""
+    import textwrap
+    width = max(20, int(fig.get_figwidth() * 72.0 / (0.6 * fontsize)))
+    return "\n".join(textwrap.fill(line, width) if len(line) > width else line for line in text.split("\n"))
 
 
 def fmt_num(v):
