@@ -9,11 +9,28 @@
 // the plain evaluation bit for bit. Only what those templates and the path-global evaluators use is
 // defined.
 #include <cmath>
+#include <cstring>
+#include <type_traits>
 
 #include "model/lanes.hpp"
 #include "model/sincos.hpp"
 
 namespace ks {
+namespace dual_detail {
+/// Four doubles as one vector of GCC's (and clang's) vector extension: the derivatives of a DualOf
+/// of doubles in groups of four. Each element rounds as the double operation does (no contraction).
+using Four = double __attribute__((vector_size(32)));
+inline Four load(const double* p) {
+  Four v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void store(double* p, Four v) { std::memcpy(p, &v, sizeof v); }
+inline Four all(double x) { return Four{x, x, x, x}; }
+/// Whether a DualOf<L, N>'s derivatives go four at a time.
+template <class L, int N>
+constexpr bool kFours = std::is_same_v<L, double> && N % 4 == 0;
+}  // namespace dual_detail
 
 /// A value v and its derivatives d[k] = dv/dx_k with respect to N inputs, in lanes of type L.
 template <class L, int N>
@@ -42,31 +59,58 @@ struct DualOf {
   friend DualOf operator+(const DualOf& a, const DualOf& b) {
     DualOf r;
     r.v = a.v + b.v;
-    for (int k = 0; k < N; ++k) r.d[k] = a.d[k] + b.d[k];
+    if constexpr (dual_detail::kFours<L, N>) {
+      using namespace dual_detail;
+      for (int k = 0; k < N; k += 4) store(&r.d[k], load(&a.d[k]) + load(&b.d[k]));
+    } else {
+      for (int k = 0; k < N; ++k) r.d[k] = a.d[k] + b.d[k];
+    }
     return r;
   }
   friend DualOf operator-(const DualOf& a, const DualOf& b) {
     DualOf r;
     r.v = a.v - b.v;
-    for (int k = 0; k < N; ++k) r.d[k] = a.d[k] - b.d[k];
+    if constexpr (dual_detail::kFours<L, N>) {
+      using namespace dual_detail;
+      for (int k = 0; k < N; k += 4) store(&r.d[k], load(&a.d[k]) - load(&b.d[k]));
+    } else {
+      for (int k = 0; k < N; ++k) r.d[k] = a.d[k] - b.d[k];
+    }
     return r;
   }
   friend DualOf operator-(const DualOf& a) {
     DualOf r;
     r.v = -a.v;
-    for (int k = 0; k < N; ++k) r.d[k] = -a.d[k];
+    if constexpr (dual_detail::kFours<L, N>) {
+      using namespace dual_detail;
+      for (int k = 0; k < N; k += 4) store(&r.d[k], -load(&a.d[k]));
+    } else {
+      for (int k = 0; k < N; ++k) r.d[k] = -a.d[k];
+    }
     return r;
   }
   friend DualOf operator*(const DualOf& a, const DualOf& b) {
     DualOf r;
     r.v = a.v * b.v;
-    for (int k = 0; k < N; ++k) r.d[k] = a.d[k] * b.v + a.v * b.d[k];
+    if constexpr (dual_detail::kFours<L, N>) {
+      using namespace dual_detail;
+      const Four av = all(a.v), bv = all(b.v);
+      for (int k = 0; k < N; k += 4) store(&r.d[k], load(&a.d[k]) * bv + av * load(&b.d[k]));
+    } else {
+      for (int k = 0; k < N; ++k) r.d[k] = a.d[k] * b.v + a.v * b.d[k];
+    }
     return r;
   }
   friend DualOf operator*(double a, const DualOf& b) {
     DualOf r;
     r.v = a * b.v;
-    for (int k = 0; k < N; ++k) r.d[k] = a * b.d[k];
+    if constexpr (dual_detail::kFours<L, N>) {
+      using namespace dual_detail;
+      const Four av = all(a);
+      for (int k = 0; k < N; k += 4) store(&r.d[k], av * load(&b.d[k]));
+    } else {
+      for (int k = 0; k < N; ++k) r.d[k] = a * b.d[k];
+    }
     return r;
   }
   friend DualOf operator*(const DualOf& a, double b) { return b * a; }
@@ -74,14 +118,26 @@ struct DualOf {
     DualOf r;
     r.v = a.v / b.v;
     const L inv = L(1.0) / b.v;
-    for (int k = 0; k < N; ++k) r.d[k] = (a.d[k] - r.v * b.d[k]) * inv;
+    if constexpr (dual_detail::kFours<L, N>) {
+      using namespace dual_detail;
+      const Four rv = all(r.v), iv = all(inv);
+      for (int k = 0; k < N; k += 4) store(&r.d[k], (load(&a.d[k]) - rv * load(&b.d[k])) * iv);
+    } else {
+      for (int k = 0; k < N; ++k) r.d[k] = (a.d[k] - r.v * b.d[k]) * inv;
+    }
     return r;
   }
   friend DualOf operator/(const DualOf& a, double b) {
     DualOf r;
     r.v = a.v / b;
     const double inv = 1.0 / b;
-    for (int k = 0; k < N; ++k) r.d[k] = a.d[k] * inv;
+    if constexpr (dual_detail::kFours<L, N>) {
+      using namespace dual_detail;
+      const Four iv = all(inv);
+      for (int k = 0; k < N; k += 4) store(&r.d[k], load(&a.d[k]) * iv);
+    } else {
+      for (int k = 0; k < N; ++k) r.d[k] = a.d[k] * inv;
+    }
     return r;
   }
 };
@@ -112,7 +168,13 @@ template <class L, int N>
 inline DualOf<L, N> chain(const DualOf<L, N>& x, const L& fv, const L& slope) {
   DualOf<L, N> r;
   r.v = fv;
-  for (int k = 0; k < N; ++k) r.d[k] = slope * x.d[k];
+  if constexpr (dual_detail::kFours<L, N>) {
+    using namespace dual_detail;
+    const Four sv = all(slope);
+    for (int k = 0; k < N; k += 4) store(&r.d[k], sv * load(&x.d[k]));
+  } else {
+    for (int k = 0; k < N; ++k) r.d[k] = slope * x.d[k];
+  }
   return r;
 }
 

@@ -157,14 +157,24 @@ void partials(const JointSampleAt& at, GlobalObjective objective, double weight,
     B.m = j.mass;
     for (int a2 = 0; a2 < 3; ++a2) B.h[a2] = j.mass * c[a2];
     const Dual<N> cc = dot(c, c);
+    // d X = W X - X W, W = [w_k]x: (W X) + (W X)^T, column b of W X the cross product w_k x X_b
+    double WX[kMaxJoints][3][3];  // [coordinate][column][row]
+    for (int k = 0; k < r; ++k)
+      for (int b = 0; b < 3; ++b) {
+        const V3 col = tw[k].cross(V3(X.col(b)));
+        for (int a2 = 0; a2 < 3; ++a2) WX[k][b][a2] = col[a2];
+      }
+    Dual<N> dX[3][3];  // X on derivative numbers: all written before any is read as a whole
     for (int a2 = 0; a2 < 3; ++a2)
       for (int b = 0; b < 3; ++b) {
-        Dual<N> x(X(a2, b));
-        for (int k = 0; k < r; ++k) {  // d X = W X - X W, W = [w_k]x: (W X) + (W X)^T
-          const double wx = tw[k].cross(V3(X.col(b)))[a2], wxT = tw[k].cross(V3(X.col(a2)))[b];
-          x.d[k] = wx + wxT;
-        }
-        B.J[a2][b] = x + j.mass * ((a2 == b ? cc : Dual<N>(0.0)) - c[a2] * c[b]);
+        dX[a2][b] = Dual<N>(X(a2, b));
+        for (int k = 0; k < r; ++k) dX[a2][b].d[k] = WX[k][b][a2] + WX[k][a2][b];
+      }
+    for (int a2 = 0; a2 < 3; ++a2)
+      for (int b = 0; b < 3; ++b) {
+        const Dual<N> cab = c[a2] * c[b];
+        const Dual<N> e = a2 == b ? cc - cab : Dual<N>(0.0) - cab;
+        B.J[a2][b] = dX[a2][b] + j.mass * e;
       }
   }
   const V3D<N> tip = seeded<N>(data.tip.p, tw, tv, r);  // moved by every joint
