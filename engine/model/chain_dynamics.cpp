@@ -5,6 +5,8 @@
 // are plain sums and the joint twists are the columns of the base-origin Jacobian.
 #include "model/chain_dynamics.hpp"
 
+#include <type_traits>
+
 #include "model/chain_spatial.hpp"
 
 namespace ks {
@@ -61,9 +63,10 @@ struct Spatial {
   /// The base acceleration -gravity that stands for gravity in the recursion.
   static Motion lift(const Chain& chain) { return {V3::Zero(), -chain.gravity}; }
 
-  /// Forward kinematics into data, the joint twists and (when `inertias`) the body inertias.
-  static void bodies(const Chain& chain, ChainData& data, const VecN& q, Bodies& B, bool inertias, bool = true) {
-    forward_kinematics(chain, data, q);
+  /// Forward kinematics into data (unless `kinematics` is false: data holds q's frames), the joint
+  /// twists and (when `inertias`) the body inertias.
+  static void bodies(const Chain& chain, ChainData& data, const VecN& q, Bodies& B, bool inertias, bool kinematics = true) {
+    if (kinematics) forward_kinematics(chain, data, q);
     for (int i = 0; i < chain.dof(); ++i) {
       const ChainJoint& j = chain.joints[i];
       const Frame& F = data.joint[i];
@@ -238,9 +241,12 @@ void gravity_impl(const Chain& chain, ChainData& data, const VecN& q, VecN& g) {
 // One forward pass (velocities, bias accelerations, body forces), one inward pass (composite
 // inertias for M and g, summed forces for c), then the tip quantities.
 template <class A>
-void evaluate_impl(const Chain& chain, ChainData& data, const VecN& q, const VecN& qd, ChainState& st) {
+void evaluate_impl(const Chain& chain, ChainData& data, const VecN& q, const VecN& qd, ChainState& st, bool frames_at_q) {
   typename A::Bodies B;
-  A::bodies(chain, data, q, B, true, false);
+  if constexpr (std::is_same_v<A, Spatial>)
+    A::bodies(chain, data, q, B, true, !frames_at_q);
+  else
+    A::bodies(chain, data, q, B, true, false);  // (the planar pose from q; data's frames left as they are)
   const int n = chain.dof();
   typename A::Motion v = A::zero_motion(), a = A::zero_motion();
   typename A::Force f[kMaxJoints];
@@ -297,11 +303,12 @@ void coriolis_torques(const Chain& chain, ChainData& data, const VecN& q, const 
     rnea_impl<Spatial>(chain, data, q, qd, nullptr, Spatial::zero_motion(), c);
 }
 
-void evaluate_dynamics(const Chain& chain, ChainData& data, const VecN& q, const VecN& qd, ChainState& state) {
+void evaluate_dynamics(const Chain& chain, ChainData& data, const VecN& q, const VecN& qd, ChainState& state,
+                       bool frames_at_q) {
   if (chain.planar_fast_path)
-    evaluate_impl<Planar>(chain, data, q, qd, state);
+    evaluate_impl<Planar>(chain, data, q, qd, state, frames_at_q);
   else
-    evaluate_impl<Spatial>(chain, data, q, qd, state);
+    evaluate_impl<Spatial>(chain, data, q, qd, state, frames_at_q);
 }
 
 }  // namespace ks

@@ -32,6 +32,9 @@ struct ChainState {
 /// tip_jacobian and tip_bias_acceleration called one by one; faster. Chains with
 /// Chain::planar_fast_path take the 2-D specialisation, which leaves data's frames as they were (the
 /// other functions here write those of q): call forward_kinematics when they are needed.
-void evaluate_dynamics(const Chain& chain, ChainData& data, const VecN& q, const VecN& qd, ChainState& state);
+/// frames_at_q: data already holds forward_kinematics(chain, data, q), which spatial chains then
+/// do not compute again (the same frames, the same results).
+void evaluate_dynamics(const Chain& chain, ChainData& data, const VecN& q, const VecN& qd, ChainState& state,
+                       bool frames_at_q = false);
 
 }  // namespace ks

@@ -129,7 +129,7 @@ void JointExtensionProblem::sample(std::size_t i, const double (*z)[3], ChainGlo
     const TaskV qdS = lu.solve(xd - JC * zd);
     for (int k = 0; k < r; ++k) s.qd[coordinate_joints_[k]] = z[k][1];
     for (int b = 0; b < m; ++b) s.qd[solved_[b]] = qdS[b];
-    evaluate_dynamics(chain_, data_, s.q, s.qd, state_);
+    evaluate_dynamics(chain_, data_, s.q, s.qd, state_, !same_q);  // (Newton's last step left q's frames)
   }
   const ChainState& st = same_qd ? accepted_state_ : state_;
   const TaskV qddS = lu.solve(xdd - JC * zdd - first(st.bias.head<3>(), m));
