@@ -101,18 +101,7 @@ struct DualOf {
     }
     return r;
   }
-  friend DualOf operator*(double a, const DualOf& b) {
-    DualOf r;
-    r.v = a * b.v;
-    if constexpr (dual_detail::kFours<L, N>) {
-      using namespace dual_detail;
-      const Four av = all(a);
-      for (int k = 0; k < N; k += 4) store(&r.d[k], av * load(&b.d[k]));
-    } else {
-      for (int k = 0; k < N; ++k) r.d[k] = a * b.d[k];
-    }
-    return r;
-  }
+  friend DualOf operator*(double a, const DualOf& b) { return chain(b, L(a * b.v), L(a)); }
   friend DualOf operator*(const DualOf& a, double b) { return b * a; }
   friend DualOf operator/(const DualOf& a, const DualOf& b) {  // the value as a double division rounds it
     DualOf r;
@@ -127,18 +116,8 @@ struct DualOf {
     }
     return r;
   }
-  friend DualOf operator/(const DualOf& a, double b) {
-    DualOf r;
-    r.v = a.v / b;
-    const double inv = 1.0 / b;
-    if constexpr (dual_detail::kFours<L, N>) {
-      using namespace dual_detail;
-      const Four iv = all(inv);
-      for (int k = 0; k < N; k += 4) store(&r.d[k], load(&a.d[k]) * iv);
-    } else {
-      for (int k = 0; k < N; ++k) r.d[k] = a.d[k] * inv;
-    }
-    return r;
+  friend DualOf operator/(const DualOf& a, double b) {  // (chain, below, is found when instantiated)
+    return chain(a, L(a.v / b), L(1.0 / b));
   }
 };
 template <int N>
