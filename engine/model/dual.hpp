@@ -26,10 +26,19 @@ inline Four load(const double* p) {
   return v;
 }
 inline void store(double* p, Four v) { std::memcpy(p, &v, sizeof v); }
-inline Four all(double x) { return Four{x, x, x, x}; }
 /// Whether a DualOf<L, N>'s derivatives go four at a time.
 template <class L, int N>
 constexpr bool kFours = std::is_same_v<L, double> && N % 4 == 0;
+/// r[k] = f(x[k], y[k]) for the N derivatives: four at a time when kFours<L, N> (f then takes Fours,
+/// its doubles spread over the four), else one at a time.
+template <class L, int N, class F>
+inline void each(L* r, const L* x, const L* y, F f) {
+  if constexpr (kFours<L, N>) {
+    for (int k = 0; k < N; k += 4) store(r + k, f(load(x + k), load(y + k)));
+  } else {
+    for (int k = 0; k < N; ++k) r[k] = f(x[k], y[k]);
+  }
+}
 }  // namespace dual_detail
 
 /// A value v and its derivatives d[k] = dv/dx_k with respect to N inputs, in lanes of type L.
@@ -59,46 +68,25 @@ struct DualOf {
   friend DualOf operator+(const DualOf& a, const DualOf& b) {
     DualOf r;
     r.v = a.v + b.v;
-    if constexpr (dual_detail::kFours<L, N>) {
-      using namespace dual_detail;
-      for (int k = 0; k < N; k += 4) store(&r.d[k], load(&a.d[k]) + load(&b.d[k]));
-    } else {
-      for (int k = 0; k < N; ++k) r.d[k] = a.d[k] + b.d[k];
-    }
+    dual_detail::each<L, N>(r.d, a.d, b.d, [](auto x, auto y) { return x + y; });
     return r;
   }
   friend DualOf operator-(const DualOf& a, const DualOf& b) {
     DualOf r;
     r.v = a.v - b.v;
-    if constexpr (dual_detail::kFours<L, N>) {
-      using namespace dual_detail;
-      for (int k = 0; k < N; k += 4) store(&r.d[k], load(&a.d[k]) - load(&b.d[k]));
-    } else {
-      for (int k = 0; k < N; ++k) r.d[k] = a.d[k] - b.d[k];
-    }
+    dual_detail::each<L, N>(r.d, a.d, b.d, [](auto x, auto y) { return x - y; });
     return r;
   }
   friend DualOf operator-(const DualOf& a) {
     DualOf r;
     r.v = -a.v;
-    if constexpr (dual_detail::kFours<L, N>) {
-      using namespace dual_detail;
-      for (int k = 0; k < N; k += 4) store(&r.d[k], -load(&a.d[k]));
-    } else {
-      for (int k = 0; k < N; ++k) r.d[k] = -a.d[k];
-    }
+    dual_detail::each<L, N>(r.d, a.d, a.d, [](auto x, auto) { return -x; });
     return r;
   }
   friend DualOf operator*(const DualOf& a, const DualOf& b) {
     DualOf r;
     r.v = a.v * b.v;
-    if constexpr (dual_detail::kFours<L, N>) {
-      using namespace dual_detail;
-      const Four av = all(a.v), bv = all(b.v);
-      for (int k = 0; k < N; k += 4) store(&r.d[k], load(&a.d[k]) * bv + av * load(&b.d[k]));
-    } else {
-      for (int k = 0; k < N; ++k) r.d[k] = a.d[k] * b.v + a.v * b.d[k];
-    }
+    dual_detail::each<L, N>(r.d, a.d, b.d, [&](auto x, auto y) { return x * b.v + a.v * y; });
     return r;
   }
   friend DualOf operator*(double a, const DualOf& b) { return chain(b, L(a * b.v), L(a)); }
@@ -107,13 +95,7 @@ struct DualOf {
     DualOf r;
     r.v = a.v / b.v;
     const L inv = L(1.0) / b.v;
-    if constexpr (dual_detail::kFours<L, N>) {
-      using namespace dual_detail;
-      const Four rv = all(r.v), iv = all(inv);
-      for (int k = 0; k < N; k += 4) store(&r.d[k], (load(&a.d[k]) - rv * load(&b.d[k])) * iv);
-    } else {
-      for (int k = 0; k < N; ++k) r.d[k] = (a.d[k] - r.v * b.d[k]) * inv;
-    }
+    dual_detail::each<L, N>(r.d, a.d, b.d, [&](auto x, auto y) { return (x - r.v * y) * inv; });
     return r;
   }
   friend DualOf operator/(const DualOf& a, double b) {  // (chain, below, is found when instantiated)
@@ -147,13 +129,7 @@ template <class L, int N>
 inline DualOf<L, N> chain(const DualOf<L, N>& x, const L& fv, const L& slope) {
   DualOf<L, N> r;
   r.v = fv;
-  if constexpr (dual_detail::kFours<L, N>) {
-    using namespace dual_detail;
-    const Four sv = all(slope);
-    for (int k = 0; k < N; k += 4) store(&r.d[k], sv * load(&x.d[k]));
-  } else {
-    for (int k = 0; k < N; ++k) r.d[k] = slope * x.d[k];
-  }
+  dual_detail::each<L, N>(r.d, x.d, x.d, [&](auto d, auto) { return slope * d; });
   return r;
 }
 
