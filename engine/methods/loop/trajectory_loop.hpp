@@ -57,11 +57,11 @@ inline bool bit(M m, int l) {
   else return bits(m) >> l & 1;
 }
 
-/// The runs of `model` along its samples from its start at rest: out[l] the sums of lane l (one for
-/// T = double), with its loop status (singular, diverged, a prescribed model's, else ok; finish_run turns the sums into the
-/// run's metrics and status).
-template <class T, class Model>
-void trajectory_loop(Model& model, RunSums* out) {
+namespace loop_detail {
+
+/// trajectory_loop with its integrator fixed at compile time (kEuler: semi-implicit Euler, else RK4).
+template <bool kEuler, class T, class Model>
+void run_loop(Model& model, RunSums* out) {
   using M = MaskOf<T>;
   constexpr bool one = std::is_same_v<T, double>;
   constexpr int N = Model::max_joints;
@@ -149,7 +149,7 @@ void trajectory_loop(Model& model, RunSums* out) {
     if (i + 1 == samples) break;  // the last sample is measured, not integrated past
     if (shape.prescribed) continue;
     // integrate to the next sample
-    if (shape.integrator == Integrator::semi_implicit_euler) {
+    if constexpr (kEuler) {
       T dq[N];
       for (int j = 0; j < n; ++j) {
         qd[j] = keep(qd[j] + dt * e.qdd[j], T(0.0));
@@ -191,6 +191,20 @@ void trajectory_loop(Model& model, RunSums* out) {
     const bool sing = bit(singular, l), div = bit(diverged, l);
     out[l] = sums.of_lane(l, sing ? RunStatus::singular : div ? RunStatus::diverged : stopped, n);
   }
+}
+
+}  // namespace loop_detail
+
+/// The runs of `model` along its samples from its start at rest: out[l] the sums of lane l (one for
+/// T = double), with its loop status (singular, diverged, a prescribed model's, else ok; finish_run
+/// turns the sums into the run's metrics and status). Each integrator has its own instance of the
+/// loop, so that the registers of one are not shared with the other's stages.
+template <class T, class Model>
+void trajectory_loop(Model& model, RunSums* out) {
+  if (model.shape().integrator == Integrator::semi_implicit_euler)
+    loop_detail::run_loop<true, T>(model, out);
+  else
+    loop_detail::run_loop<false, T>(model, out);
 }
 
 }  // namespace ks
