@@ -12,6 +12,7 @@
 #include "methods/closed_form/seed_cases.hpp"
 #include "methods/base/trajectory.hpp"
 #include "methods/closed_form/lanes.hpp"
+#include "methods/metrics/sample_metrics.hpp"
 #include "model/chain_dynamics.hpp"
 
 using namespace ks;
@@ -284,6 +285,10 @@ TEST(TrajectoryBounds, LanesEqualSingleRunsWithBoundsAndFeedback) {
           const double b[] = {together[i].E, together[i].max_tracking_error, together[i].mean_tracking_error,
                               together[i].max_orientation_error};
           for (int k = 0; k < 4; ++k) EXPECT_TRUE(std::memcmp(&a[k], &b[k], sizeof(double)) == 0) << k;
+          // runs that stop at a crossing take the last sample's entries there
+          for (int k = 0; k < kSampleMetricCount; ++k)
+            EXPECT_TRUE(std::memcmp(&alone.sampled[k], &together[i].sampled[k], sizeof(double)) == 0)
+                << k;
         }
       }
 }

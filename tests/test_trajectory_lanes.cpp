@@ -14,6 +14,7 @@
 
 #include "methods/closed_form/seed_cases.hpp"
 #include "methods/closed_form/lanes.hpp"
+#include "methods/metrics/sample_metrics.hpp"
 
 using namespace ks;
 
@@ -40,6 +41,9 @@ std::string differences(const TrajectoryMetrics& a, const TrajectoryMetrics& b) 
   if (a.tau_inf.size() != b.tau_inf.size() ||
       std::memcmp(a.tau_inf.data(), b.tau_inf.data(), sizeof(double) * a.tau_inf.size()) != 0)
     d += " tau_inf";
+  // the per-sample table's entries (sample_metrics.hpp), among them those of the last sample a run adds
+  for (int k = 0; k < kSampleMetricCount; ++k)
+    if (!same(a.sampled[k], b.sampled[k])) d += " sampled[" + std::to_string(k) + "]";
   return d;
 }
 

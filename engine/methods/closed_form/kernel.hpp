@@ -63,6 +63,8 @@ struct Shared {
   const std::uint32_t* segment = nullptr;  ///< SampledPath::segments()
   bool closed_loop = false;             ///< the runs feed the task error back (TrajectoryOptions::closed_loop)
   bool stop_on_bound = false;           ///< on_violation = stop
+  /// lanes: the Reduce::last entries taken at every sample (no replay needed; LoopShape::last_every_sample)
+  bool last_every_sample = false;
   /// end = rest (local methods): the time from which the terminal feedback replaces the method's
   /// null-space term [s] (infinity: never), and its gain K_S [1/s]
   double rest_from = std::numeric_limits<double>::infinity();
@@ -85,6 +87,10 @@ struct Runs {
   const double* alpha_from = nullptr;  ///< vertex_alpha: alpha at the start of segment s, the same layout [rad]
   const HistoryView* history[kMaxLanes] = {};
   bool any_history = false;
+  /// a replay of lanes that stopped before adding a sample (RunSums::last_pending): lane l's last
+  /// sample index, where its Reduce::last entries are taken
+  bool replay = false;
+  double last_at[kMaxLanes] = {};
 };
 
 /// A lane's sums when the loop ends (finish_run turns them into TrajectoryMetrics).
@@ -252,9 +258,12 @@ class Model {
       : s_(s), in_(in), resolver_(resolver), vertex_(s.method == TrajectoryMethod::vertex_alpha), trig_(trig) {}
 
   int joints() const { return 3; }
-  LoopShape shape() const { return {s_.n, s_.dt, s_.integrator, s_.stop_on_bound}; }
+  LoopShape shape() const { return {s_.n, s_.dt, s_.integrator, s_.stop_on_bound, false, s_.last_every_sample}; }
   SampleSums<T, 3> sums() const {
-    return SampleSums<T, 3>(load_lanes<T>(in_.tracking_bound), load_lanes<T>(in_.orientation_bound));
+    SampleSums<T, 3> sums(load_lanes<T>(in_.tracking_bound), load_lanes<T>(in_.orientation_bound));
+    if constexpr (!std::is_same_v<T, double>)
+      if (in_.replay) sums.replay_last_at(load_lanes<T>(in_.last_at));
+    return sums;
   }
   M start(T* q) const {
     for (int j = 0; j < 3; ++j) q[j] = load_lanes<T>(in_.q0[j]);
@@ -281,11 +290,15 @@ class Model {
     const double* xa = s_.samples + 4 * i;
     const T ex = e.J(1, 0) - xa[0], ey = -e.J(0, 0) - xa[1];  // tip = (x1, y1) = (J10, -J00)
     const T a = alpha(q);
-    const V3 qdv{qd[0], qd[1], qd[2]};
-    const V3 Mqd = e.M * qdv;
     v.q = q, v.qd = qd, v.tau = tau;
     v.qf = e.Mi.P.quadratic_form(V3{tau[0], tau[1], tau[2]}), v.det = e.Mi.det, v.w2 = e.w2;
     v.err2 = ex * ex + ey * ey, v.orient = vertex_ ? vabs(a - alpha_d_) : T(0.0), v.alpha = a;
+    if constexpr (std::is_same_v<T, double>) last_values(e, qd, v);
+  }
+  /// The kinetic energy qd^T M qd / 2, read only by the Reduce::last entries (lanes: at a lane's last
+  /// sample only).
+  static void last_values(const Evaluation& e, const T* qd, SampleValues<T>& v) {
+    const V3 Mqd = e.M * V3{qd[0], qd[1], qd[2]};
     v.ke = 0.5 * (qd[0] * Mqd[0] + qd[1] * Mqd[1] + qd[2] * Mqd[2]);
   }
   void record(std::size_t i, double t, const Evaluation& e, const T* q, const T* qd, const T* tau, M active) const {

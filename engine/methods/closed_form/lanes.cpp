@@ -32,6 +32,41 @@ int detect_lanes() {
 #endif
   return 1;
 }
+/// The kernel at `lanes` lanes (supported_lanes() admits only the widths this build has).
+void run_width(int lanes, const kernel::Shared& s, const kernel::Runs& in, kernel::Sums* out) {
+#if defined(KS_LANES_X8)
+  if (lanes == 8) kernel::run_x8(s, in, out);
+#endif
+#if defined(KS_LANES_X4)
+  if (lanes == 4) kernel::run_x4(s, in, out);
+#endif
+  if (lanes == 1) kernel::run<double>(s, in, out);
+}
+
+/// Lanes take the Reduce::last entries at a lane's last sample only; a lane that stopped before
+/// adding a sample (singular, diverged) had moved past its last one. Those lanes alone run again, the
+/// same operations in the same order, with their last sample's index known, and their sums replace
+/// the first pass's (equal to them but for those entries). No history is written twice.
+void replay_pending(int lanes, const kernel::Batch& b, int count, kernel::Sums* sums) {
+  if (b.shared.last_every_sample) return;  // taken at every sample: nothing pending
+  kernel::Runs again = b.runs;
+  bool any = false;
+  for (int l = 0; l < kernel::kMaxLanes; ++l) {
+    const bool pending = l < count && sums[l].last_pending;
+    again.active[l] = pending ? b.runs.active[l] : 0.0;
+    again.last_at[l] = pending ? static_cast<double>(sums[l].done - 1) : -1.0;
+    again.history[l] = nullptr;
+    any = any || pending;
+  }
+  if (!any) return;
+  again.any_history = false;
+  again.replay = true;
+  kernel::Sums second[kernel::kMaxLanes];
+  run_width(lanes, b.shared, again, second);
+  for (int l = 0; l < count; ++l)
+    if (sums[l].last_pending) sums[l] = second[l], sums[l].last_pending = false;
+}
+
 }  // namespace
 
 int supported_lanes() {
@@ -67,14 +102,15 @@ void simulate_lanes(int lanes, const PlanarArm3& arm, const SampledPath& sampled
   kernel::prepare(b, lanes, arm, sampled, options, count, histories);
   kernel::Sums sums[kernel::kMaxLanes];
   if (b.any_active) {
-    // supported_lanes() admits only the widths this build has
-#if defined(KS_LANES_X8)
-    if (lanes == 8) kernel::run_x8(b.shared, b.runs, sums);
-#endif
-#if defined(KS_LANES_X4)
-    if (lanes == 4) kernel::run_x4(b.shared, b.runs, sums);
-#endif
-    if (lanes == 1) kernel::run<double>(b.shared, b.runs, sums);
+    // Lanes take the Reduce::last entries at each lane's last sample only (with a replay of runs that
+    // stop before adding a sample), unless the thread's last batch had such a run (one of a study's
+    // many, as where torque bounds stop most runs): then at every sample. The same bits either way.
+    thread_local bool stops_seen = false;
+    b.shared.last_every_sample = lanes > 1 && stops_seen;
+    run_width(lanes, b.shared, b.runs, sums);
+    stops_seen = false;
+    for (int l = 0; l < count; ++l) stops_seen = stops_seen || sums[l].last_pending;
+    replay_pending(lanes, b, count, sums);
   }
   for (int i = 0; i < count; ++i) results[i] = kernel::finish(b, i, sums[i]);
 }

@@ -31,6 +31,9 @@
 // and optionally:
 //   T squared_torque(const T* tau);                 tau^T tau in the model's own order
 //   void finish(SampleSums<T, max_joints>& sums);   after the last sample
+//   void last_values(e, qd, SampleValues<T>& v);    lanes: the fields only the Reduce::last entries
+//                                                   read, which values() then leaves out: called at a
+//                                                   lane's last sample only (with that sample's e, qd)
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -48,6 +51,10 @@ struct LoopShape {
   bool stop_on_violation = false;  ///< on_violation = stop: the tracking bound or a limit crossed stops
   /// the model sets the state at each sample (a path-global run's spline): nothing is integrated
   bool prescribed = false;
+  /// lanes: the Reduce::last entries are taken at every sample, as one lane takes them, rather than at
+  /// each lane's last sample (with a replay of the lanes that stop before adding a sample): the same
+  /// bits either way, the cheaper way depending on how many runs stop early
+  bool last_every_sample = false;
 };
 
 /// Lane l of mask m.
@@ -97,6 +104,17 @@ void run_loop(Model& model, RunSums* out) {
       return !any(active);
     }
   };
+  // lanes: the Reduce::last entries of sample i's values v, in the lanes of `ending` (the model fills
+  // what only they read, when it has last_values)
+  const auto take_last = [&](M ending, SampleValues<T>& v) {
+    if constexpr (!one) {
+      const bool all_lanes = all(ending);
+      if (!all_lanes && !any(ending)) return;
+      if constexpr (requires { model.last_values(e, qd, v); }) model.last_values(e, qd, v);
+      sums.take_last(ending, all_lanes, v);
+    }
+  };
+  const bool early_last = sums.replaying() || shape.stop_on_violation;  // lanes: a last sample before the end
   const T bound = model.torque_bound();
   const T infinity(std::numeric_limits<double>::infinity());
 
@@ -108,8 +126,10 @@ void run_loop(Model& model, RunSums* out) {
         stopped = state;
         break;
       }
-    } else if (stop(state, singular)) {
-      break;
+    } else {
+      if constexpr (!one)
+        if (i > 0) sums.stopped_before_sample(active & !state);
+      if (stop(state, singular)) break;
     }
     model.torques(e, qd, tau);
     // the sums start at joint 0's terms (a sum from 0 would add 0.0, which IEEE does not drop)
@@ -135,6 +155,8 @@ void run_loop(Model& model, RunSums* out) {
     // one test catches non-finite values and the bound
     good = good & (vabs(tt) < infinity);
     if constexpr (Model::prismatic_joints) good = good & (vabs(ff) < infinity);
+    if constexpr (!one)
+      if (i > 0) sums.stopped_before_sample(active & !good);
     if (stop(good, diverged)) break;
     SampleValues<T> v;  // field by field: no zero-filling aggregate initialiser per sample
     v.n = n, v.tt = tt, v.ff = ff, v.p6 = p6;
@@ -143,6 +165,15 @@ void run_loop(Model& model, RunSums* out) {
     bool beyond = false;
     if constexpr (one) beyond = sums.limits(v.q, v.qd, v.tau, n);
     sums.mark(crossed, beyond);
+    if constexpr (!one) {  // the lanes whose last sample this is take the Reduce::last entries
+      if (shape.last_every_sample || i + 1 == samples) {
+        take_last(active, v);
+      } else if (early_last) {  // a replay's lanes, or lanes that stop at a crossing
+        M ending = sums.last_here(i) & active;
+        if (shape.stop_on_violation) ending = ending | crossed;
+        take_last(ending, v);
+      }
+    }
     model.record(i, t, e, q, qd, tau, active);
     if constexpr (one) crossed = crossed || beyond;
     if (shape.stop_on_violation && any(crossed) && stop(!crossed, bounded)) break;
@@ -177,6 +208,7 @@ void run_loop(Model& model, RunSums* out) {
       }
       for (int j = 0; j < n; ++j) yq[j] = q[j] + dt * k3q[j], k4q[j] = qd[j] + dt * k3v[j];
       good_stages = good_stages & model.stage(true, yq, k4q, s);
+      if constexpr (!one) take_last(active & !good_stages, v);  // sample i, already added, is their last
       if (stop(good_stages, singular)) break;
       for (int j = 0; j < n; ++j) {
         q[j] = keep(q[j] + w * (qd[j] + 2.0 * k2q[j] + 2.0 * k3q[j] + k4q[j]), q_start[j]);

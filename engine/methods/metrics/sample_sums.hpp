@@ -54,6 +54,9 @@ struct RunSums {
   double inf[kMaxJoints] = {};
   double min_w2 = 0, max_err2 = 0, max_orient = 0, last_alpha = 0, last_t = 0;
   double ratio_q = 0, ratio_qd = 0, ratio_tau = 0;
+  /// lanes: the lane stopped before adding a sample, so its Reduce::last entries are not taken yet
+  /// (simulate_lanes replays the lane to take them)
+  bool last_pending = false;
   TrapezoidSums trapezoid;
   double sampled[kSampleMetricCount > 0 ? kSampleMetricCount : 1] = {};  ///< the table's reductions
 };
@@ -111,6 +114,7 @@ class SampleSums {
     last_alpha = keep(v.alpha, last_alpha);
     done = keep(done + 1.0, done);
     for_each_sample_metric([&](const auto& m, int k) {
+      if (!one && m.reduce == Reduce::last) return;  // lanes: take_last(), at a lane's last sample only
       const T x = m.value(v);
       sampled_[k] = keep(m.reduce == Reduce::mean ? sampled_[k] + x
                          : m.reduce == Reduce::max ? vmax(sampled_[k], x)
@@ -120,6 +124,29 @@ class SampleSums {
     });
     return (err > bound_) | (v.orient > obound_);
   }
+
+  /// Lanes: the Reduce::last entries take sample i's values v in the lanes of `ending`, those for
+  /// which sample i is the last added (one lane: add() takes them at every sample, and the loop stops
+  /// after its last). A lane that stops before its sample is added (singular, diverged) has already
+  /// moved past its last one: stopped_before_sample() marks it, and its batch is replayed with
+  /// replay_last_at() to take them there.
+  /// `all`: every lane is in `ending`.
+  void take_last(M ending, bool all, const SampleValues<T>& v) {
+    static_assert(!one);
+    for_each_sample_metric([&](const auto& m, int k) {
+      if (m.reduce == Reduce::last) sampled_[k] = all ? m.value(v) : select(ending, m.value(v), sampled_[k]);
+    });
+  }
+  /// Lanes: the lanes whose last sample is sample i (the replay's; none outside a replay).
+  M last_here(std::size_t i) const {
+    if (!replay_) return M{};
+    return T(static_cast<double>(i)) == last_at_;
+  }
+  bool replaying() const { return replay_; }
+  /// Lanes: `lanes` stop at a sample before adding it, after having added at least one.
+  void stopped_before_sample(M lanes) { pending_ = pending_ | lanes; }
+  /// Lanes: a replay, in which lane l's last sample is index[l] (known from the first pass).
+  void replay_last_at(const T& index) { last_at_ = index, replay_ = true; }
 
   /// T = double: the ratios of sample values q, qd, tau (n joints, actual joint coordinates) to the
   /// limits; true when one is beyond its limit (ratio > 1).
@@ -160,6 +187,7 @@ class SampleSums {
       r.crossed = crossed_;
     } else {
       r.crossed = (bits(off_) >> l & 1) ? RunStatus::off_path : RunStatus::ok;
+      r.last_pending = (bits(pending_) >> l & 1) != 0;
     }
     r.done = static_cast<std::size_t>(lane(done, l));
     r.sumE = lane(sumE, l), r.sumEM = lane(sumEM, l), r.sumEF = lane(sumEF, l), r.sum_err = lane(sum_err_, l);
@@ -193,6 +221,9 @@ class SampleSums {
   std::conditional_t<one, RootSums, NoRoots> roots_;
   RunStatus crossed_ = RunStatus::ok;  // one lane
   M off_{};                            // lanes
+  M pending_{};                        // lanes: the Reduce::last entries wait for a replay
+  T last_at_ = 0.0;                    // lanes, in a replay: the index of each lane's last sample
+  bool replay_ = false;
 };
 
 /// What finish_run needs to know of the run besides its sums.
