@@ -239,6 +239,7 @@ def main(argv=None):
     xlog = not xa.categorical and ksplot.is_log_spaced(xa.values)
     ylog = not ya.categorical and ksplot.is_log_spaced(ya.values)
     xe, ye = ksplot.cell_edges(xa.values, xlog), ksplot.cell_edges(ya.values, ylog)
+    image = not xlog and not ylog and not ksplot.output_path(args, f"basins_{ls.block}").lower().endswith(".svg")
     used = {}
     data_panels = []
     for r in range(nrows):
@@ -264,11 +265,11 @@ def main(argv=None):
                         rgb[i, j] = mcolors.to_rgb(FAIL_COLOURS.get(key, "#ffffff"))
                         cls[i, j] = key
                         used[("fail", key)] = used.get(("fail", key), 0) + 1
-            # The cells' colours as indices into their palette: pcolormesh draws cells of any width
-            # (a log-spaced axis), which imshow cannot.
+            # The cells' colours as indices into their palette, drawn as cells of any width (a
+            # log-spaced axis): one image in a PNG on linear axes, else a quadrilateral per cell.
             palette, idx = np.unique(rgb.reshape(-1, 3), axis=0, return_inverse=True)
-            ax.pcolormesh(xe, ye, idx.reshape(st.shape), cmap=mcolors.ListedColormap(palette),
-                          vmin=-0.5, vmax=len(palette) - 0.5, shading="flat")
+            ksplot.cells(ax, xe, ye, idx.reshape(st.shape), image, cmap=mcolors.ListedColormap(palette),
+                         vmin=-0.5, vmax=len(palette) - 0.5)
             if xlog:
                 ksplot.log_axis(ax, "x")
             if ylog:
