@@ -293,10 +293,10 @@ class Model {
     v.q = q, v.qd = qd, v.tau = tau;
     v.qf = e.Mi.P.quadratic_form(V3{tau[0], tau[1], tau[2]}), v.det = e.Mi.det, v.w2 = e.w2;
     v.err2 = ex * ex + ey * ey, v.orient = vertex_ ? vabs(a - alpha_d_) : T(0.0), v.alpha = a;
-    if constexpr (std::is_same_v<T, double>) last_values(e, qd, v);
+    if constexpr (!SampleSums<T, 3>::last_at_end) last_values(e, qd, v);
   }
-  /// The kinetic energy qd^T M qd / 2, read only by the Reduce::last entries (lanes: at a lane's last
-  /// sample only).
+  /// The kinetic energy qd^T M qd / 2, read only by the Reduce::last entries (at 8 lanes: at a lane's
+  /// last sample only).
   static void last_values(const Evaluation& e, const T* qd, SampleValues<T>& v) {
     const V3 Mqd = e.M * V3{qd[0], qd[1], qd[2]};
     v.ke = 0.5 * (qd[0] * Mqd[0] + qd[1] * Mqd[1] + qd[2] * Mqd[2]);

@@ -43,7 +43,7 @@ void run_width(int lanes, const kernel::Shared& s, const kernel::Runs& in, kerne
   if (lanes == 1) kernel::run<double>(s, in, out);
 }
 
-/// Lanes take the Reduce::last entries at a lane's last sample only; a lane that stopped before
+/// 8 lanes take the Reduce::last entries at a lane's last sample only; a lane that stopped before
 /// adding a sample (singular, diverged) had moved past its last one. Those lanes alone run again, the
 /// same operations in the same order, with their last sample's index known, and their sums replace
 /// the first pass's (equal to them but for those entries). No history is written twice.
@@ -102,11 +102,12 @@ void simulate_lanes(int lanes, const PlanarArm3& arm, const SampledPath& sampled
   kernel::prepare(b, lanes, arm, sampled, options, count, histories);
   kernel::Sums sums[kernel::kMaxLanes];
   if (b.any_active) {
-    // Lanes take the Reduce::last entries at each lane's last sample only (with a replay of runs that
-    // stop before adding a sample), unless the thread's last batch had such a run (one of a study's
-    // many, as where torque bounds stop most runs): then at every sample. The same bits either way.
+    // 8 lanes take the Reduce::last entries at each lane's last sample only (SampleSums::last_at_end,
+    // with a replay of runs that stop before adding a sample), unless the thread's last batch had such
+    // a run (one of a study's many, as where torque bounds stop most runs): then at every sample. The
+    // same bits either way.
     thread_local bool stops_seen = false;
-    b.shared.last_every_sample = lanes > 1 && stops_seen;
+    b.shared.last_every_sample = lanes == 8 && stops_seen;
     run_width(lanes, b.shared, b.runs, sums);
     stops_seen = false;
     for (int l = 0; l < count; ++l) stops_seen = stops_seen || sums[l].last_pending;

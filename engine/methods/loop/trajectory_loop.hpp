@@ -31,9 +31,10 @@
 // and optionally:
 //   T squared_torque(const T* tau);                 tau^T tau in the model's own order
 //   void finish(SampleSums<T, max_joints>& sums);   after the last sample
-//   void last_values(e, qd, SampleValues<T>& v);    lanes: the fields only the Reduce::last entries
-//                                                   read, which values() then leaves out: called at a
-//                                                   lane's last sample only (with that sample's e, qd)
+//   void last_values(e, qd, SampleValues<T>& v);    the fields only the Reduce::last entries read,
+//                                                   which values() leaves out where the sums take them
+//                                                   at a lane's last sample only (SampleSums::
+//                                                   last_at_end): called there (that sample's e, qd)
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -85,6 +86,7 @@ void run_loop(Model& model, RunSums* out) {
   for (int j = 0; j < n; ++j) q_start[j] = q[j], qd[j] = T(0.0);
   M singular = T(0.0) != T(0.0), diverged = singular, bounded = singular;
   auto sums = model.sums();
+  constexpr bool last_at_end = decltype(sums)::last_at_end;  // the Reduce::last entries at a lane's last sample
   sums.start_alpha(model.alpha(q));
   // a sample's value enters a lane's sums only while the lane runs (one lane: the loop stops instead;
   // while every lane runs, nothing is masked)
@@ -104,17 +106,17 @@ void run_loop(Model& model, RunSums* out) {
       return !any(active);
     }
   };
-  // lanes: the Reduce::last entries of sample i's values v, in the lanes of `ending` (the model fills
-  // what only they read, when it has last_values)
+  // last_at_end: the Reduce::last entries of sample i's values v, in the lanes of `ending` (the model
+  // fills what only they read, when it has last_values)
   const auto take_last = [&](M ending, SampleValues<T>& v) {
-    if constexpr (!one) {
+    if constexpr (last_at_end) {
       const bool all_lanes = all(ending);
       if (!all_lanes && !any(ending)) return;
       if constexpr (requires { model.last_values(e, qd, v); }) model.last_values(e, qd, v);
       sums.take_last(ending, all_lanes, v);
     }
   };
-  const bool early_last = sums.replaying() || shape.stop_on_violation;  // lanes: a last sample before the end
+  const bool early_last = sums.replaying() || shape.stop_on_violation;  // a last sample before the end
   const T bound = model.torque_bound();
   const T infinity(std::numeric_limits<double>::infinity());
 
@@ -127,7 +129,7 @@ void run_loop(Model& model, RunSums* out) {
         break;
       }
     } else {
-      if constexpr (!one)
+      if constexpr (last_at_end)
         if (i > 0) sums.stopped_before_sample(active & !state);
       if (stop(state, singular)) break;
     }
@@ -155,7 +157,7 @@ void run_loop(Model& model, RunSums* out) {
     // one test catches non-finite values and the bound
     good = good & (vabs(tt) < infinity);
     if constexpr (Model::prismatic_joints) good = good & (vabs(ff) < infinity);
-    if constexpr (!one)
+    if constexpr (last_at_end)
       if (i > 0) sums.stopped_before_sample(active & !good);
     if (stop(good, diverged)) break;
     SampleValues<T> v;  // field by field: no zero-filling aggregate initialiser per sample
@@ -165,7 +167,7 @@ void run_loop(Model& model, RunSums* out) {
     bool beyond = false;
     if constexpr (one) beyond = sums.limits(v.q, v.qd, v.tau, n);
     sums.mark(crossed, beyond);
-    if constexpr (!one) {  // the lanes whose last sample this is take the Reduce::last entries
+    if constexpr (last_at_end) {  // the lanes whose last sample this is take the Reduce::last entries
       if (shape.last_every_sample || i + 1 == samples) {
         take_last(active, v);
       } else if (early_last) {  // a replay's lanes, or lanes that stop at a crossing
@@ -208,7 +210,7 @@ void run_loop(Model& model, RunSums* out) {
       }
       for (int j = 0; j < n; ++j) yq[j] = q[j] + dt * k3q[j], k4q[j] = qd[j] + dt * k3v[j];
       good_stages = good_stages & model.stage(true, yq, k4q, s);
-      if constexpr (!one) take_last(active & !good_stages, v);  // sample i, already added, is their last
+      if constexpr (last_at_end) take_last(active & !good_stages, v);  // sample i, already added, is their last
       if (stop(good_stages, singular)) break;
       for (int j = 0; j < n; ++j) {
         q[j] = keep(q[j] + w * (qd[j] + 2.0 * k2q[j] + 2.0 * k3q[j] + k4q[j]), q_start[j]);

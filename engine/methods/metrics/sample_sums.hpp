@@ -68,6 +68,10 @@ class SampleSums {
  public:
   using M = MaskOf<T>;
   static constexpr bool one = std::is_same_v<T, double>;
+  /// The Reduce::last entries are taken at each lane's last sample only (take_last) at 8 lanes, whose
+  /// step is bound by throughput; one lane and 4 lanes (bound by the latency of the step's chain) take
+  /// them at every sample, in add(), where they cost less (tests/bench/README.md).
+  static constexpr bool last_at_end = lanes_of<T> >= 8;
 
   /// bound: tracking bound [m] and orientation bound [rad] per lane; limits: the run's (T = double
   /// only; null = none).
@@ -114,7 +118,7 @@ class SampleSums {
     last_alpha = keep(v.alpha, last_alpha);
     done = keep(done + 1.0, done);
     for_each_sample_metric([&](const auto& m, int k) {
-      if (!one && m.reduce == Reduce::last) return;  // lanes: take_last(), at a lane's last sample only
+      if (last_at_end && m.reduce == Reduce::last) return;  // take_last(), at a lane's last sample only
       const T x = m.value(v);
       sampled_[k] = keep(m.reduce == Reduce::mean ? sampled_[k] + x
                          : m.reduce == Reduce::max ? vmax(sampled_[k], x)
@@ -125,14 +129,14 @@ class SampleSums {
     return (err > bound_) | (v.orient > obound_);
   }
 
-  /// Lanes: the Reduce::last entries take sample i's values v in the lanes of `ending`, those for
-  /// which sample i is the last added (one lane: add() takes them at every sample, and the loop stops
-  /// after its last). A lane that stops before its sample is added (singular, diverged) has already
+  /// last_at_end: the Reduce::last entries take sample i's values v in the lanes of `ending`, those for
+  /// which sample i is the last added (otherwise add() takes them at every sample, as one lane does
+  /// before the loop stops after its last). A lane that stops before its sample is added (singular, diverged) has already
   /// moved past its last one: stopped_before_sample() marks it, and its batch is replayed with
   /// replay_last_at() to take them there.
   /// `all`: every lane is in `ending`.
   void take_last(M ending, bool all, const SampleValues<T>& v) {
-    static_assert(!one);
+    static_assert(last_at_end);
     for_each_sample_metric([&](const auto& m, int k) {
       if (m.reduce == Reduce::last) sampled_[k] = all ? m.value(v) : select(ending, m.value(v), sampled_[k]);
     });
