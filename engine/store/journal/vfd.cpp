@@ -9,7 +9,7 @@
 // leaves the file untouched below `committed` (recovery just truncates the appended bytes); a kill
 // after it is replayed by the next writer's open (idempotent) once it has checked that the journal
 // belongs to the file as it is. The journal's layout, recovery and the readers' consistency stamp:
-// journal_format.cpp; the writer lock: journal_lock.cpp.
+// journal_format.cpp; the writer lock: journal_lock.cpp; the commit itself: commit.cpp.
 #include "store/journal/heap_check.hpp"
 #include "store/journal/vfd.hpp"
 
@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "store/journal/format.hpp"
+#include "store/journal/jfile.hpp"
 #include "store/journal/pages.hpp"
 
 namespace ks::store::detail {
@@ -36,41 +37,10 @@ namespace {
 
 using namespace journal;  // the on-disk layout and its file I/O (journal_format.cpp)
 
-struct JFile {
-  H5FD_t pub;  // must be first
-  int fd = -1, jfd = -1;
-  std::uint64_t dev = 0, ino = 0;
-  haddr_t eoa = 0;
-  std::uint64_t eof = 0;        // physical size
-  std::uint64_t committed = 0;  // physical size at the last commit
-  std::uint64_t seq = 0, session = 0;  // commits in this session; random id of this writer session
-  bool durable = false;
-  bool poisoned = false;        // an I/O error happened: never commit again (the journal stays)
-  bool abandoned = false;       // the writer gave up (abandon_journal_file): flushes and close commit nothing
-  bool readonly = false;        // a reader's overlay of an unapplied commit (open_overlay): no journal
-  std::string path;
-  std::map<std::uint64_t, unsigned char*> pages;  // page number -> kPage bytes of page_pool
-  PagePool page_pool;
-  // Small writes past the committed size (new chunks, mostly) that continue one another, gathered
-  // into one pwrite of up to kGather bytes: a sweep with short histories writes several small
-  // chunks per run. Writes of kDirect bytes or more go straight to the file (no extra copy).
-  static constexpr std::size_t kGather = std::size_t{1} << 20, kDirect = std::size_t{16} << 10;
-  std::vector<unsigned char> gathered;
-  std::uint64_t gathered_at = 0;
-  // Test hook (crash-safety tests only): KS_STORE_TEST_CRASH="<n>:<phase>" makes the process
-  // _exit(86) during its n-th commit, phase = journal_half | journal_done | apply_half.
-  long crash_commit = -1, commits = 0;
-  std::string crash_phase;
-};
-
 /// The writers' open files by the address of their descriptor (what get_handle gives), for
 /// poison_journal_file.
 std::mutex g_open_mutex;
 std::map<const int*, JFile*> g_open;
-
-void maybe_crash(JFile* f, const char* phase) {
-  if (f->commits == f->crash_commit && f->crash_phase == phase) ::_exit(86);
-}
 
 struct JFapl {
   int durable;
@@ -86,12 +56,6 @@ unsigned char* page_for(JFile* f, std::uint64_t pno) {
   if (!pg || !read_all(f->fd, pg, kPage, pno * kPage)) return nullptr;
   f->pages.emplace(pno, pg);
   return pg;
-}
-
-/// Empties the overlay (after a commit).
-void clear_pages(JFile* f) {
-  f->pages.clear();
-  f->page_pool.reset();
 }
 
 void* j_fapl_get(H5FD_t* file) {
@@ -207,102 +171,6 @@ H5FD_t* j_open(const char* name, unsigned flags, hid_t fapl, haddr_t /*maxaddr*/
     g_open[&f->fd] = f;
   }
   return &f->pub;
-}
-
-/// Writes the gathered bytes; false (errno set) on an I/O error.
-bool write_gathered(JFile* f) {
-  if (f->gathered.empty()) return true;
-  const bool ok = write_all(f->fd, f->gathered.data(), f->gathered.size(), f->gathered_at);
-  f->gathered.clear();
-  return ok;
-}
-
-/// Writes [a, a + n) past the committed size: appended to the gathered bytes when it continues them
-/// and fits, else after writing those (directly when n >= kDirect).
-bool write_past_committed(JFile* f, const unsigned char* in, std::size_t n, std::uint64_t a) {
-  if (!f->gathered.empty() && a == f->gathered_at + f->gathered.size() && f->gathered.size() + n <= JFile::kGather) {
-    f->gathered.insert(f->gathered.end(), in, in + n);
-    return true;
-  }
-  if (!write_gathered(f)) return false;
-  if (n >= JFile::kDirect) return write_all(f->fd, in, n, a);
-  if (f->gathered.capacity() < JFile::kGather) f->gathered.reserve(JFile::kGather);
-  f->gathered.assign(in, in + n);
-  f->gathered_at = a;
-  return true;
-}
-
-bool commit_impl(JFile* f) {
-  if (!write_gathered(f)) return false;  // appended data first: the commit's new size covers it
-  struct stat st{};
-  if (::fstat(f->fd, &st) != 0) return false;
-  const std::uint64_t new_size = std::max<std::uint64_t>(f->eof, static_cast<std::uint64_t>(st.st_size));
-  if (f->pages.empty() && new_size == f->committed) return true;
-  if (f->durable && ::fdatasync(f->fd) != 0) return false;  // appended data before the commit record
-  // The commit record (page records, then the tail) is written in pieces of at most kPiece bytes,
-  // so a commit needs no second copy of its pages. `limit`: the "journal_half" crash test's cut.
-  std::uint64_t records = 0, bytes = kTailSize;
-  for (auto& [pno, pg] : f->pages)
-    if (pno * kPage < f->committed) ++records, bytes += 16 + std::min<std::uint64_t>(kPage, f->committed - pno * kPage);
-  ++f->commits;
-  const bool half = f->commits == f->crash_commit && f->crash_phase == "journal_half";
-  const std::uint64_t limit = half ? bytes / 2 : bytes;
-  constexpr std::size_t kPiece = 1 << 20;
-  std::vector<unsigned char> buf;
-  buf.reserve(std::min<std::uint64_t>(bytes, kPiece + kPage + 16));
-  std::uint64_t at = kHeadSize, written = 0;
-  auto put = [&](const unsigned char* p, std::size_t n, bool last) {
-    buf.insert(buf.end(), p, p + n);
-    if (buf.size() < kPiece && !last) return true;
-    const std::size_t keep = static_cast<std::size_t>(std::min<std::uint64_t>(buf.size(), limit - written));
-    if (!write_all(f->jfd, buf.data(), keep, at)) return false;
-    at += keep, written += keep;
-    buf.clear();
-    return true;
-  };
-  uLong crc = crc32(0L, Z_NULL, 0);
-  for (auto& [pno, pg] : f->pages) {
-    const std::uint64_t addr = pno * kPage;
-    if (addr >= f->committed) continue;
-    const std::uint64_t len = std::min<std::uint64_t>(kPage, f->committed - addr);  // never above committed
-    unsigned char rh[16];
-    put64(rh, addr); put64(rh + 8, len);
-    crc = crc32(crc, rh, 16);
-    crc = crc32(crc, pg, static_cast<uInt>(len));
-    if (!put(rh, 16, false) || !put(pg, len, false)) return false;
-  }
-  unsigned char tail[kTailSize] = {};
-  std::memcpy(tail, kTailMagic, 8);
-  put64(tail + 8, records); put64(tail + 16, new_size);
-  crc = crc32(crc, tail + 8, 16);
-  const std::uint32_t c32 = static_cast<std::uint32_t>(crc);
-  std::memcpy(tail + 24, &c32, 4);
-  if (!put(tail, kTailSize, true)) return false;
-  if (half) ::_exit(86);
-  if (f->durable && ::fdatasync(f->jfd) != 0) return false;
-  maybe_crash(f, "journal_done");
-  // the commit point has passed: apply
-  std::size_t applied = 0;
-  for (auto& [pno, pg] : f->pages) {
-    if (applied++ == f->pages.size() / 2) maybe_crash(f, "apply_half");
-    const std::uint64_t addr = pno * kPage;
-    if (addr >= f->committed) continue;
-    const std::uint64_t len = std::min<std::uint64_t>(kPage, f->committed - addr);
-    if (!write_all(f->fd, pg, len, addr)) return false;
-  }
-  if (f->durable && ::fdatasync(f->fd) != 0) return false;
-  if (!reset_journal(f->jfd, f->fd, f->dev, f->ino, new_size, f->seq + 1, f->session)) return false;
-  ++f->seq;
-  f->committed = new_size;
-  f->eof = new_size;
-  clear_pages(f);
-  return true;
-}
-
-bool commit(JFile* f) {
-  if (f->poisoned) return false;
-  if (!commit_impl(f)) { f->poisoned = true; return false; }
-  return true;
 }
 
 herr_t j_close(H5FD_t* file) {
@@ -516,6 +384,5 @@ hid_t make_journal_read_fapl() {
   H5Pset_driver(fapl, journal_driver_id(), &fa);
   return fapl;
 }
-
 
 }  // namespace ks::store::detail
